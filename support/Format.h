@@ -1,0 +1,21 @@
+// Number formatting shared by every text output: deterministic, locale-free,
+// never `-0`, never exponent notation unless asked for.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+namespace stepnc {
+
+/// Shortest decimal text that reads back as the same double (C++ to_chars);
+/// may use exponent notation ("1e-05"). `-0` prints as "0".
+std::string formatShortest(double value);
+
+/// Fixed-point with exactly `decimals` digits after the point; `-0.000` prints
+/// as "0.000". Non-finite values print as "nan"/"inf" (callers reject them first).
+std::string formatFixed(double value, int decimals);
+
+/// "#123": a Part 21 instance name as written in files and messages.
+std::string hashId(uint64_t id);
+
+} // namespace stepnc

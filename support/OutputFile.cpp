@@ -1,0 +1,89 @@
+#include "support/OutputFile.h"
+
+#include <cerrno>
+#include <cstdlib>
+#include <sys/stat.h>
+#include <cstring>
+#include <unistd.h>
+
+namespace stepnc {
+
+OutputFile::~OutputFile() { discard(); }
+
+bool OutputFile::open(const std::string &path, std::string &error) {
+  path_ = path;
+  if (path == "-") {
+    isStdout_ = true;
+    file_ = stdout;
+    return true;
+  }
+  tempPath_ = path + ".tmp.XXXXXX";
+  int fd = ::mkstemp(tempPath_.data());
+  if (fd < 0) {
+    error = "cannot create '" + path + "': " + std::strerror(errno);
+    tempPath_.clear();
+    return false;
+  }
+  file_ = ::fdopen(fd, "wb");
+  if (!file_) {
+    error = "cannot write '" + path + "': " + std::strerror(errno);
+    ::close(fd);
+    ::unlink(tempPath_.c_str());
+    tempPath_.clear();
+    return false;
+  }
+  static thread_local char buffer[1 << 16];
+  std::setvbuf(file_, buffer, _IOFBF, sizeof buffer);
+  return true;
+}
+
+void OutputFile::write(std::string_view bytes) {
+  if (!bytes.empty())
+    std::fwrite(bytes.data(), 1, bytes.size(), file_);
+}
+
+bool OutputFile::commit(std::string &error) {
+  if (!file_) {
+    error = "no output file is open";
+    return false;
+  }
+  if (isStdout_) {
+    bool ok = std::fflush(file_) == 0 && !std::ferror(file_);
+    file_ = nullptr;
+    if (!ok)
+      error = std::string("cannot write standard output: ") + std::strerror(errno);
+    return ok;
+  }
+  bool ok = std::fflush(file_) == 0 && !std::ferror(file_) && ::fsync(::fileno(file_)) == 0;
+  int saved = errno;
+  ok = (std::fclose(file_) == 0) && ok;
+  file_ = nullptr;
+  if (!ok) {
+    error = "cannot write '" + path_ + "': " + std::strerror(saved ? saved : errno);
+    discard();
+    return false;
+  }
+  // mkstemp creates 0600; give the result the usual permissions.
+  mode_t mask = ::umask(0);
+  ::umask(mask);
+  ::chmod(tempPath_.c_str(), 0666 & ~mask);
+  if (std::rename(tempPath_.c_str(), path_.c_str()) != 0) {
+    error = "cannot write '" + path_ + "': " + std::strerror(errno);
+    discard();
+    return false;
+  }
+  tempPath_.clear();
+  return true;
+}
+
+void OutputFile::discard() {
+  if (file_ && !isStdout_)
+    std::fclose(file_);
+  file_ = nullptr;
+  if (!tempPath_.empty()) {
+    ::unlink(tempPath_.c_str());
+    tempPath_.clear();
+  }
+}
+
+} // namespace stepnc

@@ -1,0 +1,38 @@
+// Atomic output files: a program or converted file is written to a temporary
+// file beside the target and renamed over it only when complete, so a failure
+// never leaves a partial file behind. "-" means standard output.
+#pragma once
+
+#include <cstdio>
+#include <string>
+#include <string_view>
+
+namespace stepnc {
+
+class OutputFile {
+public:
+  OutputFile() = default;
+  ~OutputFile();  // discards the temporary file unless commit() succeeded
+  OutputFile(const OutputFile &) = delete;
+  OutputFile &operator=(const OutputFile &) = delete;
+
+  /// Opens a temporary file next to `path` (or stdout for "-").
+  bool open(const std::string &path, std::string &error);
+  void write(std::string_view bytes);
+  void put(char c) { std::fputc(c, file_); }
+  /// Flushes, syncs and renames the temporary file onto the target.
+  bool commit(std::string &error);
+  /// Removes the temporary file; the target is left untouched.
+  void discard();
+
+  std::FILE *stream() { return file_; }
+  const std::string &path() const { return path_; }
+
+private:
+  std::string path_;
+  std::string tempPath_;
+  std::FILE *file_ = nullptr;
+  bool isStdout_ = false;
+};
+
+} // namespace stepnc

@@ -1,0 +1,45 @@
+#include "tools/stepnc/Driver.h"
+
+#include <CLI/CLI.hpp>
+#include <iostream>
+
+namespace stepnc::tool {
+
+void addDiagnosticOptions(CLI::App &cmd, DiagnosticOptions &opts) {
+  cmd.add_option("--diagnostics", opts.format,
+                 "Diagnostic output: 'text' (file:line:col: error: ..., with the source line) or "
+                 "'json' (one JSON array on stderr)")
+      ->check(CLI::IsMember({"text", "json"}))
+      ->default_str("text");
+  cmd.add_option("--max-errors", opts.maxErrors,
+                 "Stop after this many errors (0: no limit)")
+      ->default_str("50");
+  cmd.add_flag("--warnings-as-errors", opts.warningsAsErrors, "Treat warnings as errors");
+}
+
+DiagnosticSession::DiagnosticSession(const DiagnosticOptions &opts) {
+  if (opts.format == "json")
+    consumer_ = std::make_unique<JsonDiagnosticPrinter>(std::cerr);
+  else
+    consumer_ = std::make_unique<TextDiagnosticPrinter>(std::cerr);
+  engine_ = std::make_unique<DiagnosticEngine>(*consumer_);
+  engine_->setMaxErrors(opts.maxErrors);
+  engine_->setWarningsAsErrors(opts.warningsAsErrors);
+}
+
+DiagnosticSession::~DiagnosticSession() { engine_->finish(); }
+
+void printToolError(const std::string &message) {
+  std::cout.flush();
+  std::cerr << "stepnc: error: " << message << '\n';
+}
+
+std::unique_ptr<SourceFile> openInput(const std::string &path) {
+  std::string error;
+  auto file = SourceFile::open(path, error);
+  if (!file)
+    printToolError(error);
+  return file;
+}
+
+} // namespace stepnc::tool

@@ -1,0 +1,37 @@
+// The stepnc command: a thin layer of subcommands over the stepnc libraries.
+#include "tools/stepnc/Driver.h"
+
+#include <CLI/CLI.hpp>
+#include <iostream>
+
+namespace stepnc::tool {
+void registerCheck(CLI::App &app, std::function<void(int)> setResult);
+void registerConvert(CLI::App &app, std::function<void(int)> setResult);
+} // namespace stepnc::tool
+
+int main(int argc, char **argv) {
+  using namespace stepnc::tool;
+  CLI::App app("stepnc: a compiler from STEP-NC (ISO 14649 / ISO 10303-238) to machine tools.\n"
+               "Run 'stepnc <command> --help' for a command's options.",
+               "stepnc");
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "stepnc 0.1.0");
+  app.footer("Exit status: 0 success, 1 the input has errors, 2 usage or I/O error.");
+  int result = kExitOk;
+  auto setResult = [&result](int r) { result = r; };
+  registerCheck(app, setResult);
+  registerConvert(app, setResult);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp &e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp &e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion &e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError &e) {
+    app.exit(e);
+    return kExitUsage;
+  }
+  return result;
+}
