@@ -578,7 +578,8 @@ bool Decoder::parseInstance(const char *p, const char *end) {
   }
   if (!layout())
     return false;
-  if (p_ >= end_ || *p_ != ';')
+  // An instance whose ';' is missing ends at its ')': the scanner reported it.
+  if (p_ < end_ && *p_ != ';')
     return fail(p_, "expected ';' at end of instance");
   return true;
 }

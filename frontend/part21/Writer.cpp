@@ -3,6 +3,7 @@
 #include "support/Format.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cstring>
 #include <numeric>
 
@@ -80,7 +81,11 @@ void appendString(std::string &out, std::string_view s) {
 }
 
 void appendReal(std::string &out, double value) {
-  std::string s = formatShortest(value);
+  // Shortest exact digits; unlike formatShortest, -0 stays -0 so that the
+  // graph reads back bit for bit.
+  char digits[64];
+  auto r = std::to_chars(digits, digits + sizeof digits, value);
+  std::string s(digits, r.ptr);
   size_t e = s.find('e');
   std::string mantissa = s.substr(0, e);
   if (mantissa.find('.') == std::string::npos)
@@ -146,13 +151,25 @@ void appendRecord(std::string &out, const Record &r, const ValueArena &arena, co
 }
 
 bool writePart21(const Part21File &file, OutputFile &out, DiagnosticEngine &diags) {
+  return writePart21(file, [&out](std::string_view chunk) { out.write(chunk); }, diags);
+}
+
+std::string writePart21ToString(const Part21File &file, DiagnosticEngine &diags, bool *ok) {
+  std::string text;
+  bool done = writePart21(file, [&text](std::string_view chunk) { text += chunk; }, diags);
+  if (ok)
+    *ok = done;
+  return text;
+}
+
+bool writePart21(const Part21File &file, const ByteSink &sink, DiagnosticEngine &diags) {
   const NameTable &names = file.names();
   const ValueArena &meta = file.metadata();
   std::string buf;
   buf.reserve(1 << 16);
   auto flush = [&](bool force) {
     if (force || buf.size() >= (1 << 16)) {
-      out.write(buf);
+      sink(buf);
       buf.clear();
     }
   };

@@ -11,6 +11,7 @@
 #include "frontend/part21/Part21File.h"
 #include "support/OutputFile.h"
 
+#include <functional>
 #include <string>
 
 namespace stepnc::p21 {
@@ -24,9 +25,15 @@ void appendString(std::string &out, std::string_view utf8);
 /// Appends a Part 21 real literal.
 void appendReal(std::string &out, double value);
 
+/// Receives the written text in chunks of about 64 KiB.
+using ByteSink = std::function<void(std::string_view)>;
+
 /// Writes `file` in canonical form. Instances that fail to decode are reported
 /// and make the call fail; the caller then discards the output.
+bool writePart21(const Part21File &file, const ByteSink &sink, DiagnosticEngine &diags);
 bool writePart21(const Part21File &file, OutputFile &out, DiagnosticEngine &diags);
+/// Convenience for small files and tests: the canonical text as a string.
+std::string writePart21ToString(const Part21File &file, DiagnosticEngine &diags, bool *ok = nullptr);
 
 /// Compares two files' instance graphs: header entities, sections, anchors,
 /// references and every instance (ids, entity names, values; reals bit for

@@ -1,6 +1,7 @@
 // `stepnc check FILE...`: reads each file, reports its diagnostics and prints a
 // one-line summary per file (and an entity histogram with --stats).
 #include "frontend/part21/Part21File.h"
+#include "support/VerifyDiagnostics.h"
 #include "tools/stepnc/Driver.h"
 
 #include <CLI/CLI.hpp>
@@ -15,6 +16,7 @@ namespace {
 struct CheckOptions {
   std::vector<std::string> files;
   bool stats = false;
+  bool verify = false;
   DiagnosticOptions diag;
 };
 
@@ -36,7 +38,29 @@ void printStats(const p21::Part21File &file) {
 
 } // namespace
 
+// --verify-diagnostics: collect instead of printing, then match the
+// expectations written in each file's comments.
+int verifyFiles(const CheckOptions &opts) {
+  int status = kExitOk;
+  for (const std::string &path : opts.files) {
+    auto source = openInput(path);
+    if (!source) {
+      status = kExitUsage;
+      continue;
+    }
+    DiagnosticCollector collector;
+    DiagnosticEngine diags(collector);
+    auto file = p21::readPart21(*source, diags);
+    p21::checkInstances(*file, diags);
+    if (!verifyDiagnostics(*source, collector.diags, std::cerr) && status == kExitOk)
+      status = kExitDiagnostics;
+  }
+  return status;
+}
+
 int runCheckFiles(const CheckOptions &opts) {
+  if (opts.verify)
+    return verifyFiles(opts);
   DiagnosticSession session(opts.diag);
   DiagnosticEngine &diags = session.engine();
   int status = kExitOk;
@@ -74,6 +98,9 @@ void registerCheck(CLI::App &app, std::function<void(int)> setResult) {
                "Exit status: 0 no errors (warnings allowed), 1 errors found, 2 usage or I/O error.");
   cmd->add_option("files", opts->files, "Part 21 files to check")->required();
   cmd->add_flag("--stats", opts->stats, "Also print a histogram of entity types");
+  cmd->add_flag("--verify-diagnostics", opts->verify,
+                "Check diagnostics against 'expected-error@+1 {{text}}' annotations in the "
+                "files' comments instead of printing them (exit 0 when all match)");
   addDiagnosticOptions(*cmd, opts->diag);
   cmd->callback([opts, setResult] { setResult(runCheckFiles(*opts)); });
 }

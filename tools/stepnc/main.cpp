@@ -21,6 +21,19 @@ int main(int argc, char **argv) {
   auto setResult = [&result](int r) { result = r; };
   registerCheck(app, setResult);
   registerConvert(app, setResult);
+  // A first word that is neither an option nor a command is a typo.
+  if (argc > 1 && argv[1][0] != '-') {
+    std::string names;
+    bool known = false;
+    for (const CLI::App *sub : app.get_subcommands({})) {
+      names += (names.empty() ? "" : ", ") + sub->get_name();
+      known |= sub->get_name() == argv[1];
+    }
+    if (!known) {
+      printToolError(std::string("unknown command '") + argv[1] + "' (commands: " + names + ")");
+      return kExitUsage;
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp &e) {

@@ -1,0 +1,35 @@
+# lit configuration for stepnc's golden tests.
+#
+# Tests are *.test files and Part 21 inputs (*.p21) carrying their own RUN
+# lines. Tests that read the third-party sample corpus say `REQUIRES: corpus`;
+# the corpus is found at $STEPNC_CORPUS, else at the path given to CMake
+# (STEPNC_CORPUS_DIR, default ../shared/corpus beside the checkout). When it
+# is absent those tests are reported UNSUPPORTED and a note says so.
+import os
+
+import lit.formats
+
+config.name = "stepnc"
+config.test_format = lit.formats.ShTest(execute_external=True)
+config.suffixes = [".test", ".p21"]
+config.test_source_root = os.path.dirname(__file__)
+config.test_exec_root = os.path.join(config.stepnc_obj_root, "tests")
+config.excludes = ["Inputs", "unit", "fuzz", "CMakeLists.txt", "lit.cfg.py"]
+
+config.environment["PATH"] = os.pathsep.join(
+    [config.stepnc_tools_dir, config.llvm_tools_dir, config.environment.get("PATH", os.environ["PATH"])])
+for var in ("ASAN_OPTIONS", "UBSAN_OPTIONS"):
+    if var in os.environ:
+        config.environment[var] = os.environ[var]
+
+corpus = os.path.abspath(os.environ.get("STEPNC_CORPUS") or config.corpus_dir)
+if os.path.isdir(corpus):
+    config.available_features.add("corpus")
+else:
+    lit_config.warning(
+        "sample corpus not found at %s: tests that need it are UNSUPPORTED (skipped); "
+        "set STEPNC_CORPUS or -DSTEPNC_CORPUS_DIR to run them" % corpus)
+
+config.substitutions.append(("%stepnc", os.path.join(config.stepnc_tools_dir, "stepnc")))
+config.substitutions.append(("%corpus", corpus))
+config.substitutions.append(("%inputs", os.path.join(config.test_source_root, "Inputs")))

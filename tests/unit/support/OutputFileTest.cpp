@@ -1,0 +1,68 @@
+#include "support/OutputFile.h"
+
+#include <catch2/catch.hpp>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+using namespace stepnc;
+namespace fs = std::filesystem;
+
+namespace {
+std::string slurp(const fs::path &p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+fs::path scratchDir() {
+  fs::path d = fs::temp_directory_path() / ("stepnc-output-test-" + std::to_string(::getpid()));
+  fs::create_directories(d);
+  return d;
+}
+} // namespace
+
+TEST_CASE("an output file appears only when committed", "[support]") {
+  fs::path dir = scratchDir();
+  fs::path target = dir / "out.txt";
+  std::string error;
+  {
+    OutputFile out;
+    REQUIRE(out.open(target.string(), error));
+    out.write("partial");
+    CHECK_FALSE(fs::exists(target));
+    // destroyed without commit: nothing is left behind
+  }
+  CHECK_FALSE(fs::exists(target));
+  CHECK(fs::is_empty(dir));
+  {
+    OutputFile out;
+    REQUIRE(out.open(target.string(), error));
+    out.write("complete\n");
+    REQUIRE(out.commit(error));
+  }
+  CHECK(slurp(target) == "complete\n");
+  fs::remove_all(dir);
+}
+
+TEST_CASE("a failed write keeps the previous file intact", "[support]") {
+  fs::path dir = scratchDir();
+  fs::path target = dir / "keep.txt";
+  { std::ofstream(target) << "old\n"; }
+  std::string error;
+  {
+    OutputFile out;
+    REQUIRE(out.open(target.string(), error));
+    out.write("new but abandoned");
+    out.discard();
+  }
+  CHECK(slurp(target) == "old\n");
+  fs::remove_all(dir);
+}
+
+TEST_CASE("opening in a missing directory reports the path", "[support]") {
+  OutputFile out;
+  std::string error;
+  CHECK_FALSE(out.open("/nonexistent-dir-for-stepnc/x.stp", error));
+  CHECK(error.find("/nonexistent-dir-for-stepnc/x.stp") != std::string::npos);
+}
