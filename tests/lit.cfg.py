@@ -15,6 +15,7 @@ config.suffixes = [".test", ".p21"]
 config.test_source_root = os.path.dirname(__file__)
 config.test_exec_root = os.path.join(config.stepnc_obj_root, "tests")
 config.excludes = ["Inputs", "unit", "fuzz", "CMakeLists.txt", "lit.cfg.py"]
+# Helper scripts beside tests (foo.test.sh) are not tests themselves.
 
 config.environment["PATH"] = os.pathsep.join(
     [config.stepnc_tools_dir, config.llvm_tools_dir, config.environment.get("PATH", os.environ["PATH"])])

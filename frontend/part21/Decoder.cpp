@@ -12,6 +12,7 @@
 #include "frontend/part21/Lexing.h"
 
 #include <charconv>
+#include <cstdio>
 #include <cstring>
 #include <iconv.h>
 
@@ -86,6 +87,16 @@ bool appendIso8859(std::string &out, unsigned part, unsigned char byte) {
 }
 
 // Length of the valid UTF-8 sequence at p (0 if invalid).
+// A byte for a message: 'c' when printable ASCII, else its hex code.
+std::string describeByte(char c) {
+  const auto u = static_cast<unsigned char>(c);
+  if (u >= 0x20 && u < 0x7F)
+    return std::string("'") + c + "'";
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "byte 0x%02X", u);
+  return buf;
+}
+
 size_t utf8Length(const unsigned char *p, const unsigned char *end) {
   unsigned char c = p[0];
   size_t n = c >= 0xF0 ? 4 : c >= 0xE0 ? 3 : c >= 0xC2 ? 2 : 0;
@@ -214,7 +225,7 @@ bool Decoder::parseParam(unsigned depth) {
       std::snprintf(buf, sizeof buf, "0x%02X", static_cast<unsigned char>(c));
       return fail(p_, std::string("control character ") + buf + " in parameters");
     } else {
-      return fail(p_, std::string("unexpected '") + c + "' where a parameter was expected");
+      return fail(p_, "unexpected " + describeByte(c) + " where a parameter was expected");
     }
   }
   scratch_.push_back(v);
@@ -246,7 +257,7 @@ bool Decoder::parseListInto(unsigned depth, Value &list) {
       }
       if (p_ >= end_ || *p_ == ';')
         return fail(open, "unbalanced '(': no matching ')'");
-      return fail(p_, std::string("expected ',' or ')' in parameter list, found '") + *p_ + "'");
+      return fail(p_, "expected ',' or ')' in parameter list, found " + describeByte(*p_));
     }
   }
   auto &values = arena_.mutableValues();

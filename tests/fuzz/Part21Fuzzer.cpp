@@ -325,16 +325,19 @@ void exerciseQueries(const p21::Part21File &file) {
     std::abort();
 }
 
-std::string writeCanonical(const p21::Part21File &file, const char *which) {
+/// The canonical text of `file`; false (after a suppressed violation) when
+/// the writer failed.
+bool writeCanonical(const p21::Part21File &file, const char *which, std::string &text) {
   DiagnosticCollector collected;
   DiagnosticEngine diags(collected);
   bool ok = false;
-  std::string text = p21::writePart21ToString(file, diags, &ok);
+  text = p21::writePart21ToString(file, diags, &ok);
   renderDiagnostics(collected.diags);
-  if (!ok || diags.hasErrors())
-    violation("write", "writePart21 failed on a file that read without errors",
-              std::string("writing the ") + which + " read\n" + textOf(collected.diags));
-  return text;
+  if (ok && !diags.hasErrors())
+    return true;
+  violation("write", "writePart21 failed on a file that read without errors",
+            std::string("writing the ") + which + " read\n" + textOf(collected.diags));
+  return false;
 }
 
 void checkInput(std::string_view input) {
@@ -347,10 +350,10 @@ void checkInput(std::string_view input) {
   // A clean file ends with END-ISO-10303-21; anything cut before its first
   // occurrence has lost the real end keyword and must be an error.
   const size_t endPos = input.find(kEndKeyword);
-  if (endPos == std::string_view::npos)
+  if (endPos == std::string_view::npos) {
     violation("end-keyword", "input without 'END-ISO-10303-21' read without errors",
               "--- input ---\n" + clip(input));
-  {
+  } else {
     const size_t cut = static_cast<size_t>((input.size() * 2654435761u) % (endPos + 1));
     Parsed truncated("fuzz-truncated.p21", input.substr(0, cut));
     renderDiagnostics(truncated.collected.diags);
@@ -363,23 +366,31 @@ void checkInput(std::string_view input) {
   if (std::string self = p21::compareGraphs(*first.file, *first.file); !self.empty())
     violation("self-compare", "compareGraphs(file, file) is not empty", self);
 
-  const std::string text1 = writeCanonical(*first.file, "first");
+  std::string text1;
+  if (!writeCanonical(*first.file, "first", text1))
+    return;
   Parsed second("fuzz-canonical.p21", text1);
   renderDiagnostics(second.collected.diags);
-  if (second.diags.hasErrors())
+  if (second.diags.hasErrors()) {
     violation("reread", "the canonical text does not read back without errors",
               textOf(second.collected.diags) + "--- canonical text ---\n" + clip(text1) +
                   "\n--- input ---\n" + clip(input));
+    return;
+  }
   if (second.diags.warningCount() > first.diags.warningCount())
     violation("new-warnings", "the canonical text reads back with new warnings",
               textOf(second.collected.diags) + "--- canonical text ---\n" + clip(text1));
 
-  if (std::string diff = p21::compareGraphs(*first.file, *second.file); !diff.empty())
+  if (std::string diff = p21::compareGraphs(*first.file, *second.file); !diff.empty()) {
     violation("graph", "write -> read changed the instance graph",
               diff + "\n--- canonical text ---\n" + clip(text1) + "\n--- input ---\n" +
                   clip(input));
+    return;
+  }
 
-  const std::string text2 = writeCanonical(*second.file, "second");
+  std::string text2;
+  if (!writeCanonical(*second.file, "second", text2))
+    return;
   if (text1 != text2) {
     size_t at = 0;
     while (at < text1.size() && at < text2.size() && text1[at] == text2[at])

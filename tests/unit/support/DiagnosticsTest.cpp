@@ -97,3 +97,12 @@ TEST_CASE("verifyDiagnostics matches expectations by line, column and text", "[s
   CHECK(os2.str().find("unexpected error") != std::string::npos);
   CHECK(os2.str().find("was not produced: {{boom}}") != std::string::npos);
 }
+
+TEST_CASE("json output stays valid UTF-8 whatever the message holds", "[support]") {
+  std::ostringstream os;
+  JsonDiagnosticPrinter printer(os);
+  DiagnosticEngine engine(printer);
+  engine.error({}, std::string("bad \xFF byte, good \xC3\xA9, ctl \x01"));
+  engine.finish();
+  CHECK(os.str() == "[\n  {\"severity\":\"error\",\"message\":\"bad \\ufffd byte, good \xC3\xA9, ctl \\u0001\"}\n]\n");
+}
