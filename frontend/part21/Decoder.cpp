@@ -86,7 +86,6 @@ bool appendIso8859(std::string &out, unsigned part, unsigned char byte) {
   return true;
 }
 
-// Length of the valid UTF-8 sequence at p (0 if invalid).
 // A byte for a message: 'c' when printable ASCII, else its hex code.
 std::string describeByte(char c) {
   const auto u = static_cast<unsigned char>(c);
@@ -97,12 +96,33 @@ std::string describeByte(char c) {
   return buf;
 }
 
+// Length of the well-formed UTF-8 sequence at p, or 0: no overlong forms, no
+// surrogates, nothing above U+10FFFF (Unicode 15, table 3-7), so that every
+// accepted string re-encodes to the same characters.
 size_t utf8Length(const unsigned char *p, const unsigned char *end) {
-  unsigned char c = p[0];
-  size_t n = c >= 0xF0 ? 4 : c >= 0xE0 ? 3 : c >= 0xC2 ? 2 : 0;
-  if (n == 0 || c > 0xF4 || static_cast<size_t>(end - p) < n)
+  const unsigned char c = p[0];
+  size_t n;
+  unsigned char lo = 0x80, hi = 0xBF;  // bounds of the second byte
+  if (c >= 0xC2 && c <= 0xDF) {
+    n = 2;
+  } else if (c >= 0xE0 && c <= 0xEF) {
+    n = 3;
+    if (c == 0xE0)
+      lo = 0xA0;
+    else if (c == 0xED)
+      hi = 0x9F;
+  } else if (c >= 0xF0 && c <= 0xF4) {
+    n = 4;
+    if (c == 0xF0)
+      lo = 0x90;
+    else if (c == 0xF4)
+      hi = 0x8F;
+  } else {
     return 0;
-  for (size_t i = 1; i < n; ++i)
+  }
+  if (static_cast<size_t>(end - p) < n || p[1] < lo || p[1] > hi)
+    return 0;
+  for (size_t i = 2; i < n; ++i)
     if ((p[i] & 0xC0) != 0x80)
       return 0;
   return n;

@@ -1,6 +1,8 @@
 // `stepnc check FILE...`: reads each file, reports its diagnostics and prints a
 // one-line summary per file (and an entity histogram with --stats).
+#include "frontend/binding/Binder.h"
 #include "frontend/part21/Part21File.h"
+#include "tools/stepnc/SchemaSelection.h"
 #include "support/VerifyDiagnostics.h"
 #include "tools/stepnc/Driver.h"
 
@@ -17,6 +19,7 @@ struct CheckOptions {
   std::vector<std::string> files;
   bool stats = false;
   bool verify = false;
+  SchemaOptions schema;
   DiagnosticOptions diag;
 };
 
@@ -36,12 +39,30 @@ void printStats(const p21::Part21File &file) {
   }
 }
 
+/// Reads and checks one file: Part 21 syntax and references, then the schema.
+/// Returns the schema checked against (null if none).
+const express::Schema *checkFile(const p21::Part21File &file, const SchemaSelection &schemas,
+                                 DiagnosticEngine &diags) {
+  if (!diags.limitReached())
+    p21::checkInstances(file, diags);
+  const express::Model *model = nullptr;
+  const express::Schema *schema = diags.limitReached() ? nullptr : schemas.select(file, diags, model);
+  if (schema)
+    binding::bind(file, *model, *schema, diags);
+  return schema;
+}
+
 } // namespace
 
 // --verify-diagnostics: collect instead of printing, then match the
 // expectations written in each file's comments.
 int verifyFiles(const CheckOptions &opts) {
   int status = kExitOk;
+  DiagnosticSession session(opts.diag);
+  SchemaSelection schemas(opts.schema);
+  bool io = false;
+  if (!schemas.load(session.engine(), io))
+    return io ? kExitUsage : kExitDiagnostics;
   for (const std::string &path : opts.files) {
     auto source = openInput(path);
     if (!source) {
@@ -51,7 +72,7 @@ int verifyFiles(const CheckOptions &opts) {
     DiagnosticCollector collector;
     DiagnosticEngine diags(collector);
     auto file = p21::readPart21(*source, diags);
-    p21::checkInstances(*file, diags);
+    checkFile(*file, schemas, diags);
     if (!verifyDiagnostics(*source, collector.diags, std::cerr) && status == kExitOk)
       status = kExitDiagnostics;
   }
@@ -63,6 +84,10 @@ int runCheckFiles(const CheckOptions &opts) {
     return verifyFiles(opts);
   DiagnosticSession session(opts.diag);
   DiagnosticEngine &diags = session.engine();
+  SchemaSelection schemas(opts.schema);
+  bool io = false;
+  if (!schemas.load(diags, io))
+    return io ? kExitUsage : kExitDiagnostics;
   int status = kExitOk;
   for (const std::string &path : opts.files) {
     auto source = openInput(path);
@@ -72,14 +97,15 @@ int runCheckFiles(const CheckOptions &opts) {
     }
     diags.resetCounts();
     auto file = p21::readPart21(*source, diags);
-    if (!diags.limitReached())
-      p21::checkInstances(*file, diags);
-    std::string schemas;
+    const express::Schema *checked = checkFile(*file, schemas, diags);
+    std::string names;
     for (const std::string &s : file->schemaNames())
-      schemas += (schemas.empty() ? "" : ", ") + s;
+      names += (names.empty() ? "" : ", ") + s;
     std::cout << path << ": " << file->entries().size()
               << (file->entries().size() == 1 ? " instance, schema " : " instances, schema ")
-              << (schemas.empty() ? "(none)" : schemas) << "; " << diags.errorCount()
+              << (names.empty() ? "(none)" : names)
+              << (checked ? " (checked against " + checked->name + ")" : std::string(" (syntax only)"))
+              << "; " << diags.errorCount()
               << (diags.errorCount() == 1 ? " error, " : " errors, ") << diags.warningCount()
               << (diags.warningCount() == 1 ? " warning" : " warnings") << '\n';
     if (opts.stats)
@@ -101,6 +127,7 @@ void registerCheck(CLI::App &app, std::function<void(int)> setResult) {
   cmd->add_flag("--verify-diagnostics", opts->verify,
                 "Check diagnostics against 'expected-error@+1 {{text}}' annotations in the "
                 "files' comments instead of printing them (exit 0 when all match)");
+  addSchemaOptions(*cmd, opts->schema);
   addDiagnosticOptions(*cmd, opts->diag);
   cmd->callback([opts, setResult] { setResult(runCheckFiles(*opts)); });
 }

@@ -7,6 +7,7 @@
 namespace stepnc::tool {
 void registerCheck(CLI::App &app, std::function<void(int)> setResult);
 void registerConvert(CLI::App &app, std::function<void(int)> setResult);
+void registerSchema(CLI::App &app, std::function<void(int)> setResult);
 } // namespace stepnc::tool
 
 int main(int argc, char **argv) {
@@ -21,6 +22,7 @@ int main(int argc, char **argv) {
   auto setResult = [&result](int r) { result = r; };
   registerCheck(app, setResult);
   registerConvert(app, setResult);
+  registerSchema(app, setResult);
   // A first word that is neither an option nor a command is a typo.
   if (argc > 1 && argv[1][0] != '-') {
     std::string names;

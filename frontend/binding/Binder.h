@@ -1,0 +1,65 @@
+// Schema-checked binding of Part 21 data.
+//
+// bind() gives every instance of a Part21File its entity in an EXPRESS schema
+// and checks it the way a compiler type-checks its input: known entity name
+// (or an alias from the alias table, with a warning), not abstract, attribute
+// count, each value against its attribute's type (simple types, enumerations,
+// SELECTs with typed parameters, references to a compatible subtype,
+// aggregates and their bounds), `$` only where OPTIONAL, `*` only where
+// derived, and complex instances against the supertype constraints. Every
+// error names the instance, the attribute, what was expected and what was found.
+#pragma once
+
+#include "frontend/binding/Aliases.h"
+#include "frontend/express/Schema.h"
+#include "frontend/part21/Part21File.h"
+
+#include <memory>
+#include <vector>
+
+namespace stepnc::binding {
+
+/// The result of binding: the entity (or entities, for a complex instance) of
+/// every instance table entry.
+class BoundFile {
+public:
+  BoundFile(const p21::Part21File &file, const express::Model &model, const express::Schema &schema)
+      : file_(file), model_(model), schema_(schema) {}
+
+  const p21::Part21File &file() const { return file_; }
+  const express::Model &model() const { return model_; }
+  const express::Schema &schema() const { return schema_; }
+
+  /// Entity of entry `index` (the most specific, for a complex instance the
+  /// first record's), or express::kNone when unknown.
+  express::EntityId entity(size_t index) const { return entities_[index]; }
+  /// Every entity of entry `index` (one for a simple instance).
+  std::vector<express::EntityId> entitySet(size_t index) const;
+  /// True if the instance is `of` or a subtype of it.
+  bool isA(size_t index, express::EntityId of) const;
+
+private:
+  friend class Binder;
+  const p21::Part21File &file_;
+  const express::Model &model_;
+  const express::Schema &schema_;
+  std::vector<express::EntityId> entities_;
+  /// For complex instances: entry index -> all record entities.
+  std::vector<std::pair<uint32_t, std::vector<express::EntityId>>> complex_;
+};
+
+struct BindOptions {
+  const AliasTable *aliases = &AliasTable::builtin();
+  /// Report common drift as errors instead of warnings: `$` written for a
+  /// mandatory aggregate that may be empty (read as empty) or for a mandatory
+  /// string such as a name or label (read as '').
+  bool strict = false;
+};
+
+/// Binds and checks every instance of `file` against `schema` (which must
+/// belong to the resolved `model`). Diagnostics go to `diags`.
+std::unique_ptr<BoundFile> bind(const p21::Part21File &file, const express::Model &model,
+                                const express::Schema &schema, DiagnosticEngine &diags,
+                                const BindOptions &options = {});
+
+} // namespace stepnc::binding

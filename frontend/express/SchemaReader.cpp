@@ -1,0 +1,464 @@
+// Builds the schema model from the ANTLR parse tree of an EXPRESS file.
+//
+// This is the only file that sees ANTLR: the generated parser lives in the
+// stepnc_express_grammar library and everything else works on the model.
+// Names are lower-cased. Expressions (WHERE rules, DERIVE) are kept as their
+// source text; the model does not evaluate them.
+#include "frontend/express/SchemaReader.h"
+
+#include "ExpressLexer.h"
+#include "ExpressParser.h"
+
+#include <antlr4-runtime.h>
+
+namespace stepnc::express {
+
+namespace g = stepnc::express::grammar;
+using P = g::ExpressParser;
+
+namespace {
+
+// SourceLoc of an ANTLR position (1-based line, column in code points).
+SourceLoc locAt(const SourceFile &file, size_t line, size_t column) {
+  if (line == 0)
+    return {&file, 0};
+  // Find the line start through the line table, then walk code points.
+  const LineCol probe{static_cast<uint32_t>(line), 1};
+  std::string_view text = file.lineText(probe.line);
+  uint64_t offset = static_cast<uint64_t>(text.data() - file.begin());
+  size_t cp = 0, i = 0;
+  while (i < text.size() && cp < column) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    i += c < 0x80 ? 1 : c >= 0xF0 ? 4 : c >= 0xE0 ? 3 : c >= 0xC0 ? 2 : 1;
+    ++cp;
+  }
+  return {&file, offset + std::min(i, text.size())};
+}
+
+class ErrorListener final : public antlr4::BaseErrorListener {
+public:
+  ErrorListener(const SourceFile &file, DiagnosticEngine &diags) : file_(file), diags_(diags) {}
+  void syntaxError(antlr4::Recognizer *, antlr4::Token *, size_t line, size_t column,
+                   const std::string &msg, std::exception_ptr) override {
+    ++count;
+    diags_.error(locAt(file_, line, column), "EXPRESS syntax: " + msg);
+  }
+  unsigned count = 0;
+
+private:
+  const SourceFile &file_;
+  DiagnosticEngine &diags_;
+};
+
+class Builder {
+public:
+  Builder(Model &model, const SourceFile &file, antlr4::CharStream &input)
+      : model_(model), file_(file), input_(input) {}
+
+  void schema(P::Schema_declContext *ctx);
+
+private:
+  SourceLoc loc(antlr4::ParserRuleContext *ctx) const {
+    antlr4::Token *t = ctx->getStart();
+    return locAt(file_, t->getLine(), t->getCharPositionInLine());
+  }
+  std::string text(antlr4::ParserRuleContext *ctx) const {
+    if (!ctx || !ctx->getStart() || !ctx->getStop())
+      return {};
+    return input_.getText(antlr4::misc::Interval(ctx->getStart()->getStartIndex(),
+                                                 ctx->getStop()->getStopIndex()));
+  }
+  static std::string id(P::Simple_idContext *ctx) { return lower(ctx->getText()); }
+
+  int64_t bound(P::Numeric_expressionContext *ctx) const;
+  TypeId parameterType(P::Parameter_typeContext *ctx);
+  TypeId concreteType(P::Concrete_typesContext *ctx);
+  TypeId simpleType(P::Simple_typesContext *ctx);
+  TypeId named(const std::string &name);
+  TypeId aggregate(AggregateKind kind, P::Bound_specContext *bounds, bool optional, bool unique,
+                   TypeId element);
+  SupertypeExpr supertypeExpression(P::Supertype_expressionContext *ctx);
+  SupertypeExpr supertypeTerm(P::Supertype_termContext *ctx);
+  void typeDecl(Schema &schema, P::Type_declContext *ctx);
+  void entityDecl(Schema &schema, P::Entity_declContext *ctx);
+  void attributeName(P::Attribute_declContext *ctx, std::string &name, std::string &entity,
+                     std::string &attribute);
+
+  Model &model_;
+  const SourceFile &file_;
+  antlr4::CharStream &input_;
+  size_t schemaIndex_ = 0;
+  std::vector<std::pair<std::string, P::Subtype_constraint_declContext *>> constraints_;
+};
+
+int64_t Builder::bound(P::Numeric_expressionContext *ctx) const {
+  if (!ctx)
+    return -1;
+  const std::string t = ctx->getText();
+  if (t == "?")
+    return -1;
+  try {
+    size_t used = 0;
+    long long v = std::stoll(t, &used);
+    return used == t.size() ? v : -1;
+  } catch (...) {
+    return -1;  // a constant expression: treated as unbounded
+  }
+}
+
+TypeId Builder::named(const std::string &name) {
+  TypeExpr t;
+  t.kind = TypeExpr::Named;
+  t.name = name;
+  return model_.addTypeExpr(std::move(t));
+}
+
+TypeId Builder::aggregate(AggregateKind kind, P::Bound_specContext *bounds, bool optional,
+                          bool unique, TypeId element) {
+  TypeExpr t;
+  t.kind = TypeExpr::Aggregate;
+  t.aggregate = kind;
+  t.optionalElements = optional;
+  t.unique = unique;
+  t.element = element;
+  if (bounds) {
+    t.lower = bound(bounds->bound_1);
+    if (t.lower < 0)
+      t.lower = 0;
+    t.upper = bound(bounds->bound_2);
+  }
+  return model_.addTypeExpr(std::move(t));
+}
+
+TypeId Builder::simpleType(P::Simple_typesContext *ctx) {
+  TypeExpr t;
+  t.kind = TypeExpr::Simple;
+  if (ctx->binary_type())
+    t.simple = SimpleKind::Binary;
+  else if (ctx->boolean_type())
+    t.simple = SimpleKind::Boolean;
+  else if (ctx->integer_type())
+    t.simple = SimpleKind::Integer;
+  else if (ctx->logical_type())
+    t.simple = SimpleKind::Logical;
+  else if (ctx->number_type())
+    t.simple = SimpleKind::Number;
+  else if (ctx->real_type())
+    t.simple = SimpleKind::Real;
+  else
+    t.simple = SimpleKind::String;
+  return model_.addTypeExpr(std::move(t));
+}
+
+TypeId Builder::concreteType(P::Concrete_typesContext *ctx) {
+  if (ctx->simple_types())
+    return simpleType(ctx->simple_types());
+  if (ctx->named_types())
+    return named(id(ctx->named_types()->simple_id()));
+  auto *agg = ctx->aggregation_types();
+  if (auto *a = agg->array_type())
+    return aggregate(AggregateKind::Array, a->bound_spec(), a->K_OPTIONAL() != nullptr,
+                     a->K_UNIQUE() != nullptr, concreteType(a->instantiable_type()->concrete_types()));
+  if (auto *l = agg->list_type())
+    return aggregate(AggregateKind::List, l->bound_spec(), false, l->K_UNIQUE() != nullptr,
+                     concreteType(l->instantiable_type()->concrete_types()));
+  if (auto *b = agg->bag_type())
+    return aggregate(AggregateKind::Bag, b->bound_spec(), false, false,
+                     concreteType(b->instantiable_type()->concrete_types()));
+  auto *s = agg->set_type();
+  return aggregate(AggregateKind::Set, s->bound_spec(), false, false,
+                   concreteType(s->instantiable_type()->concrete_types()));
+}
+
+TypeId Builder::parameterType(P::Parameter_typeContext *ctx) {
+  if (ctx->simple_types())
+    return simpleType(ctx->simple_types());
+  if (ctx->named_types())
+    return named(id(ctx->named_types()->simple_id()));
+  auto *gen = ctx->generalized_types();
+  if (auto *ga = gen->general_aggregation_types()) {
+    if (auto *a = ga->general_array_type())
+      return aggregate(AggregateKind::Array, a->bound_spec(), a->K_OPTIONAL() != nullptr,
+                       a->K_UNIQUE() != nullptr, parameterType(a->parameter_type()));
+    if (auto *l = ga->general_list_type())
+      return aggregate(AggregateKind::List, l->bound_spec(), false, l->K_UNIQUE() != nullptr,
+                       parameterType(l->parameter_type()));
+    if (auto *b = ga->general_bag_type())
+      return aggregate(AggregateKind::Bag, b->bound_spec(), false, false, parameterType(b->parameter_type()));
+    auto *s = ga->general_set_type();
+    return aggregate(AggregateKind::Set, s->bound_spec(), false, false, parameterType(s->parameter_type()));
+  }
+  TypeExpr t;
+  t.kind = TypeExpr::Generic;
+  if (auto *a = gen->aggregate_type())
+    t.element = parameterType(a->parameter_type());
+  return model_.addTypeExpr(std::move(t));
+}
+
+SupertypeExpr Builder::supertypeTerm(P::Supertype_termContext *ctx) {
+  if (ctx->entity_ref()) {
+    SupertypeExpr leaf;
+    leaf.entity = id(ctx->entity_ref()->simple_id());
+    return leaf;
+  }
+  if (auto *one = ctx->one_of()) {
+    SupertypeExpr e;
+    e.op = SupertypeExpr::OneOf;
+    for (auto *sub : one->supertype_expression())
+      e.operands.push_back(supertypeExpression(sub));
+    return e;
+  }
+  return supertypeExpression(ctx->supertype_expression());
+}
+
+SupertypeExpr Builder::supertypeExpression(P::Supertype_expressionContext *ctx) {
+  std::vector<SupertypeExpr> factors;
+  for (auto *f : ctx->supertype_factor()) {
+    std::vector<SupertypeExpr> terms;
+    for (auto *t : f->supertype_term())
+      terms.push_back(supertypeTerm(t));
+    if (terms.size() == 1) {
+      factors.push_back(std::move(terms[0]));
+    } else {
+      SupertypeExpr andExpr;
+      andExpr.op = SupertypeExpr::And;
+      andExpr.operands = std::move(terms);
+      factors.push_back(std::move(andExpr));
+    }
+  }
+  if (factors.size() == 1)
+    return std::move(factors[0]);
+  SupertypeExpr andor;
+  andor.op = SupertypeExpr::AndOr;
+  andor.operands = std::move(factors);
+  return andor;
+}
+
+void Builder::typeDecl(Schema &schema, P::Type_declContext *ctx) {
+  TypeDecl decl;
+  decl.name = id(ctx->type_id()->simple_id());
+  decl.schema = schema.name;
+  decl.loc = loc(ctx->type_id());
+  auto *u = ctx->underlying_type();
+  if (auto *c = u->constructed_types()) {
+    TypeExpr t;
+    if (auto *sel = c->select_type()) {
+      t.kind = TypeExpr::Select;
+      decl.extensible = sel->K_EXTENSIBLE() != nullptr;
+      decl.genericEntity = sel->K_GENERIC_ENTITY() != nullptr;
+      P::Select_listContext *list = sel->select_list();
+      if (auto *ext = sel->select_extension()) {
+        decl.basedOn = id(ext->type_ref()->simple_id());
+        list = ext->select_list();
+      }
+      if (list)
+        for (auto *n : list->named_types())
+          decl.selectItems.push_back(id(n->simple_id()));
+    } else {
+      auto *en = c->enumeration_type();
+      t.kind = TypeExpr::Enumeration;
+      decl.extensible = en->K_EXTENSIBLE() != nullptr;
+      P::Enumeration_itemsContext *items = en->enumeration_items();
+      if (auto *ext = en->enumeration_extension()) {
+        decl.basedOn = id(ext->type_ref()->simple_id());
+        items = ext->enumeration_items();
+      }
+      if (items)
+        for (auto *e : items->enumeration_id())
+          decl.enumValues.push_back(id(e->simple_id()));
+    }
+    decl.underlying = model_.addTypeExpr(std::move(t));
+  } else {
+    decl.underlying = concreteType(u->concrete_types());
+  }
+  if (auto *w = ctx->where_clause())
+    for (auto *r : w->domain_rule())
+      decl.where.emplace_back(r->rule_label_id() ? id(r->rule_label_id()->simple_id()) : "",
+                              text(r->expression()));
+  schema.types.push_back(model_.addTypeDecl(std::move(decl)));
+}
+
+void Builder::attributeName(P::Attribute_declContext *ctx, std::string &name, std::string &entity,
+                            std::string &attribute) {
+  if (ctx->attribute_id()) {
+    name = id(ctx->attribute_id()->simple_id());
+    return;
+  }
+  auto *re = ctx->redeclared_attribute();
+  auto *q = re->qualified_attribute();
+  entity = id(q->group_qualifier()->entity_ref()->simple_id());
+  attribute = id(q->attribute_qualifier()->attribute_ref()->simple_id());
+  name = re->attribute_id() ? id(re->attribute_id()->simple_id()) : attribute;
+}
+
+void Builder::entityDecl(Schema &schema, P::Entity_declContext *ctx) {
+  Entity e;
+  auto *head = ctx->entity_head();
+  e.name = id(head->entity_id()->simple_id());
+  e.schema = schema.name;
+  e.loc = loc(head->entity_id());
+  if (auto *ss = head->subsuper()) {
+    if (auto *sc = ss->supertype_constraint()) {
+      if (auto *abs = sc->abstract_supertype_declaration()) {
+        e.abstract = true;
+        if (abs->subtype_constraint())
+          e.supertypeConstraints.push_back(
+              supertypeExpression(abs->subtype_constraint()->supertype_expression()));
+      } else if (sc->abstract_entity_declaration()) {
+        e.abstract = true;
+      } else if (auto *rule = sc->supertype_rule()) {
+        e.supertypeConstraints.push_back(supertypeExpression(rule->subtype_constraint()->supertype_expression()));
+      }
+    }
+    if (auto *sd = ss->subtype_declaration())
+      for (auto *r : sd->entity_ref())
+        e.supertypeNames.push_back(id(r->simple_id()));
+  }
+  auto *body = ctx->entity_body();
+  for (auto *ea : body->explicit_attr()) {
+    TypeId type = parameterType(ea->parameter_type());
+    for (auto *ad : ea->attribute_decl()) {
+      Attribute a;
+      attributeName(ad, a.name, a.redeclaresEntity, a.redeclaresAttribute);
+      a.type = type;
+      a.optional = ea->K_OPTIONAL() != nullptr;
+      a.loc = loc(ad);
+      e.attributes.push_back(std::move(a));
+    }
+  }
+  if (auto *dc = body->derive_clause())
+    for (auto *da : dc->derived_attr()) {
+      DerivedAttribute d;
+      attributeName(da->attribute_decl(), d.name, d.redeclaresEntity, d.redeclaresAttribute);
+      d.type = parameterType(da->parameter_type());
+      d.expression = text(da->expression());
+      e.derived.push_back(std::move(d));
+    }
+  if (auto *ic = body->inverse_clause())
+    for (auto *ia : ic->inverse_attr()) {
+      InverseAttribute inv;
+      std::string ignoredEntity, ignoredAttr;
+      attributeName(ia->attribute_decl(), inv.name, ignoredEntity, ignoredAttr);
+      if (auto *agg = ia->inverse_aggregate()) {
+        inv.aggregate = true;
+        inv.bag = agg->K_BAG() != nullptr;
+        if (agg->bound_spec()) {
+          inv.lower = std::max<int64_t>(0, bound(agg->bound_spec()->bound_1));
+          inv.upper = bound(agg->bound_spec()->bound_2);
+        }
+      }
+      inv.entity = id(ia->referencing_entity->simple_id());
+      inv.attribute = id(ia->attribute_ref()->simple_id());
+      e.inverse.push_back(std::move(inv));
+    }
+  if (auto *uc = body->unique_clause())
+    for (auto *ur : uc->unique_rule()) {
+      std::vector<std::string> attrs;
+      for (auto *ra : ur->referenced_attribute())
+        attrs.push_back(lower(ra->getText()));
+      e.unique.push_back(std::move(attrs));
+    }
+  if (auto *w = body->where_clause())
+    for (auto *r : w->domain_rule())
+      e.where.emplace_back(r->rule_label_id() ? id(r->rule_label_id()->simple_id()) : "",
+                           text(r->expression()));
+  schema.entities.push_back(model_.addEntity(std::move(e)));
+}
+
+void Builder::schema(P::Schema_declContext *ctx) {
+  Schema &s = model_.addSchema(ctx->schema_id()->getText(), loc(ctx->schema_id()));
+  schemaIndex_ = model_.schemas().size() - 1;
+  auto *body = ctx->schema_body();
+  for (auto *iface : body->interface_specification()) {
+    Interface in;
+    in.loc = loc(iface);
+    if (auto *use = iface->use_clause()) {
+      in.use = true;
+      in.schema = id(use->schema_ref()->simple_id());
+      for (auto *item : use->named_type_or_rename())
+        in.items.emplace_back(id(item->named_types()->simple_id()),
+                              item->rename_id() ? id(item->rename_id()->simple_id()) : "");
+    } else {
+      auto *ref = iface->reference_clause();
+      in.use = false;
+      in.schema = id(ref->schema_ref()->simple_id());
+      for (auto *item : ref->resource_or_rename())
+        in.items.emplace_back(id(item->resource_ref()->simple_id()),
+                              item->rename_id() ? id(item->rename_id()->simple_id()) : "");
+    }
+    s.interfaces.push_back(std::move(in));
+  }
+  if (auto *cd = body->constant_decl())
+    for (auto *c : cd->constant_body())
+      s.constants.push_back(id(c->constant_id()->simple_id()));
+  for (auto *decl : body->declaration()) {
+    Schema &cur = model_.mutableSchema(schemaIndex_);
+    if (auto *t = decl->type_decl())
+      typeDecl(cur, t);
+    else if (auto *e = decl->entity_decl())
+      entityDecl(cur, e);
+    else if (auto *f = decl->function_decl())
+      cur.functions.push_back(id(f->function_head()->function_id()->simple_id()));
+    else if (auto *p = decl->procedure_decl())
+      cur.procedures.push_back(id(p->procedure_head()->procedure_id()->simple_id()));
+    else if (auto *sc = decl->subtype_constraint_decl())
+      constraints_.emplace_back(cur.name, sc);
+  }
+  Schema &cur = model_.mutableSchema(schemaIndex_);
+  for (auto *r : body->rule_decl())
+    cur.rules.push_back(id(r->rule_head()->rule_id()->simple_id()));
+  // SUBTYPE_CONSTRAINTs apply to an entity of this schema.
+  for (auto &[schemaName, sc] : constraints_) {
+    const std::string target = id(sc->subtype_constraint_head()->entity_ref()->simple_id());
+    for (EntityId eid : cur.entities) {
+      Entity &ent = model_.mutableEntity(eid);
+      if (ent.name != target)
+        continue;
+      auto *b = sc->subtype_constraint_body();
+      if (b->abstract_supertype())
+        ent.abstract = true;
+      if (b->supertype_expression())
+        ent.supertypeConstraints.push_back(supertypeExpression(b->supertype_expression()));
+    }
+  }
+  constraints_.clear();
+}
+
+} // namespace
+
+bool readExpress(std::unique_ptr<SourceFile> file, Model &model, DiagnosticEngine &diags) {
+  const SourceFile &src = *file;
+  antlr4::ANTLRInputStream input(std::string(src.text()));
+  g::ExpressLexer lexer(&input);
+  ErrorListener listener(src, diags);
+  lexer.removeErrorListeners();
+  lexer.addErrorListener(&listener);
+  antlr4::CommonTokenStream tokens(&lexer);
+  g::ExpressParser parser(&tokens);
+  parser.removeErrorListeners();
+  parser.addErrorListener(&listener);
+  // Two-stage parsing: SLL first (fast, enough for every known schema), full
+  // LL only if SLL fails.
+  parser.getInterpreter<antlr4::atn::ParserATNSimulator>()->setPredictionMode(antlr4::atn::PredictionMode::SLL);
+  parser.setErrorHandler(std::make_shared<antlr4::BailErrorStrategy>());
+  g::ExpressParser::SyntaxContext *tree = nullptr;
+  try {
+    tree = parser.syntax();
+  } catch (const antlr4::ParseCancellationException &) {
+    tokens.seek(0);
+    parser.reset();
+    parser.setErrorHandler(std::make_shared<antlr4::DefaultErrorStrategy>());
+    parser.getInterpreter<antlr4::atn::ParserATNSimulator>()->setPredictionMode(antlr4::atn::PredictionMode::LL);
+    tree = parser.syntax();
+  }
+  const bool ok = listener.count == 0;
+  if (ok) {
+    Builder builder(model, src, input);
+    for (auto *schema : tree->schema_decl())
+      builder.schema(schema);
+  }
+  model.keepSource(std::move(file));
+  return ok;
+}
+
+} // namespace stepnc::express

@@ -1,0 +1,69 @@
+#include "tools/stepnc/SchemaSelection.h"
+
+#include "frontend/express/Builtin.h"
+#include "frontend/express/SchemaReader.h"
+#include "tools/stepnc/Driver.h"
+
+#include <CLI/CLI.hpp>
+
+namespace stepnc::tool {
+
+void addSchemaOptions(CLI::App &cmd, SchemaOptions &opts) {
+  cmd.add_option("--schema", opts.files,
+                 "Check against the schema(s) in this EXPRESS file instead of the built-in ISO 14649 "
+                 "ARM (repeatable: files are resolved together)");
+  cmd.add_flag("--no-schema", opts.none, "Check Part 21 syntax and references only");
+}
+
+bool SchemaSelection::load(DiagnosticEngine &diags, bool &ioError) {
+  if (opts_.files.empty())
+    return true;
+  const unsigned before = diags.errorCount();
+  for (const std::string &path : opts_.files) {
+    std::string error;
+    auto file = SourceFile::open(path, error);
+    if (!file) {
+      printToolError(error);
+      ioError = true;
+      return false;
+    }
+    express::readExpress(std::move(file), loaded_, diags);
+  }
+  if (diags.errorCount() == before)
+    loaded_.resolve(diags);
+  return diags.errorCount() == before;
+}
+
+const express::Schema *SchemaSelection::select(const p21::Part21File &file, DiagnosticEngine &diags,
+                                               const express::Model *&model) const {
+  if (opts_.none)
+    return nullptr;
+  const std::vector<std::string> names = file.schemaNames();
+  const p21::HeaderEntity *header = file.headerEntity("FILE_SCHEMA");
+  const SourceLoc at = file.loc(header ? header->begin : 0);
+  std::string listed;
+  for (const std::string &n : names)
+    listed += (listed.empty() ? "" : ", ") + n;
+  if (!opts_.files.empty()) {
+    model = &loaded_;
+    for (const std::string &n : names)
+      if (const express::Schema *s = loaded_.findSchema(n))
+        return s;
+    const express::Schema *first = &loaded_.schemas().front();
+    diags.warning(at, "FILE_SCHEMA names " + (listed.empty() ? std::string("no schema") : listed) +
+                          "; checking against schema '" + first->name + "' given with --schema");
+    return first;
+  }
+  for (const std::string &n : names)
+    if (const express::Schema *s = express::builtinSchemaFor(n)) {
+      model = &express::builtinModel();
+      return s;
+    }
+  diags.warning(at, names.empty() ? "FILE_SCHEMA names no schema; checked for Part 21 syntax only"
+                                  : "schema " + listed +
+                                        " is not built in; checked for Part 21 syntax only (give its "
+                                        "EXPRESS file with --schema FILE.exp)");
+  return nullptr;
+}
+
+} // namespace stepnc::tool
