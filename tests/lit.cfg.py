@@ -34,3 +34,4 @@ else:
 config.substitutions.append(("%stepnc", os.path.join(config.stepnc_tools_dir, "stepnc")))
 config.substitutions.append(("%corpus", corpus))
 config.substitutions.append(("%inputs", os.path.join(config.test_source_root, "Inputs")))
+config.substitutions.append(("%examples", os.path.join(config.stepnc_src_root, "examples")))

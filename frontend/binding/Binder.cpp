@@ -37,6 +37,14 @@ bool BoundFile::isA(size_t index, EntityId of) const {
 
 namespace {
 
+// "a tool", "an elementary_surface".
+std::string article(std::string_view word) {
+  const char c = word.empty() ? 'x' : word[0];
+  const bool vowel = c == 'a' || c == 'e' || c == 'i' || c == 'o' || c == 'u' || c == 'A' || c == 'E' ||
+                     c == 'I' || c == 'O' || c == 'U';
+  return std::string(vowel ? "an " : "a ") + std::string(word);
+}
+
 size_t editDistance(std::string_view a, std::string_view b) {
   std::vector<size_t> prev(b.size() + 1), cur(b.size() + 1);
   for (size_t j = 0; j <= b.size(); ++j)
@@ -198,11 +206,11 @@ std::string Binder::expected(TypeId id) const {
   const TypeExpr &t = model_.type(id);
   switch (t.kind) {
   case TypeExpr::Simple: return simpleKindName(t.simple);
-  case TypeExpr::Aggregate: return "a " + model_.typeText(id);
+  case TypeExpr::Aggregate: return article(model_.typeText(id));
   case TypeExpr::Named:
     if (t.entity != kNone)
       return "a reference to " + t.name;
-    return "a " + t.name;
+    return article(t.name);
   default: return model_.typeText(id);
   }
 }
@@ -320,7 +328,7 @@ bool Binder::checkNamed(const Value &v, const TypeExpr &t, const Context &ctx) {
     if (out_.entity(static_cast<size_t>(i)) == kNone && out_.entitySet(static_cast<size_t>(i)).empty())
       return true;  // the target's own entity is unknown: reported there
     if (!out_.isA(static_cast<size_t>(i), t.entity)) {
-      error(ctx, v, "expected a reference to " + t.name + ", found " + describe(v) + ", which is not a " + t.name);
+      error(ctx, v, "expected a reference to " + t.name + ", found " + describe(v) + ", which is not " + article(t.name));
       return false;
     }
     return true;
@@ -351,7 +359,7 @@ bool Binder::checkNamed(const Value &v, const TypeExpr &t, const Context &ctx) {
   if (v.kind == ValueKind::Typed) {
     const std::string name = express::lower(file_.names().name(v.node.name));
     if (name != td.name) {
-      error(ctx, v, "expected a " + td.name + ", found " + describe(v));
+      error(ctx, v, "expected " + article(td.name) + ", found " + describe(v));
       return false;
     }
     return checkValue(arena_.children(v)[0], td.underlying, ctx, false);

@@ -149,7 +149,7 @@ struct Resolver {
       if (target < 0) {
         diags.error(iface.loc, "schema '" + s.name + "' " + (iface.use ? "uses" : "references") +
                                    " schema '" + iface.schema + "', which is not loaded")
-            .note("load it with another --schema FILE.exp; names it provides stay unresolved");
+            .note("give the EXPRESS file that declares it as well; names it provides stay unresolved");
         incomplete[si] = true;
         ok = false;
         continue;

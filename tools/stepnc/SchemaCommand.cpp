@@ -1,5 +1,6 @@
 // `stepnc schema FILE.exp...`: reads EXPRESS schemas, resolves them together
 // and prints a summary, or an entity's attribute list in Part 21 order.
+#include "frontend/express/Builtin.h"
 #include "frontend/express/SchemaReader.h"
 #include "tools/stepnc/Driver.h"
 
@@ -13,6 +14,7 @@ namespace {
 struct SchemaOptions {
   std::vector<std::string> files;
   std::vector<std::string> entities;
+  bool builtin = false;
   DiagnosticOptions diag;
 };
 
@@ -50,7 +52,45 @@ void printEntity(const express::Model &model, express::EntityId id) {
   }
 }
 
+void printSummary(const express::Model &model) {
+  for (const express::Schema &s : model.schemas())
+    std::cout << "schema " << s.name << ": " << s.entities.size() << " entities, " << s.types.size()
+              << " types, " << s.functions.size() << " functions, " << s.procedures.size()
+              << " procedures, " << s.rules.size() << " rules, " << s.interfaces.size()
+              << " interface clauses\n";
+}
+
+int printEntities(const express::Model &model, const std::vector<std::string> &names) {
+  for (const std::string &name : names) {
+    bool found = false;
+    for (const express::Schema &s : model.schemas()) {
+      express::EntityId id = model.findEntity(s, express::lower(name));
+      if (id != express::kNone) {
+        printEntity(model, id);
+        found = true;
+        break;
+      }
+    }
+    if (!found) {
+      printToolError("no entity '" + name + "' in the loaded schemas");
+      return kExitUsage;
+    }
+  }
+  return kExitOk;
+}
+
 int runSchema(const SchemaOptions &opts) {
+  if (opts.builtin != opts.files.empty()) {
+    printToolError("give EXPRESS files or --builtin, not both");
+    return kExitUsage;
+  }
+  if (opts.builtin) {
+    const express::Model &model = express::builtinModel();
+    printSummary(model);
+    int status = printEntities(model, opts.entities);
+    std::cout.flush();
+    return status;
+  }
   DiagnosticSession session(opts.diag);
   DiagnosticEngine &diags = session.engine();
   express::Model model;
@@ -69,26 +109,9 @@ int runSchema(const SchemaOptions &opts) {
     return kExitUsage;
   if (!diags.hasErrors())
     model.resolve(diags);
-  for (const express::Schema &s : model.schemas())
-    std::cout << "schema " << s.name << ": " << s.entities.size() << " entities, " << s.types.size()
-              << " types, " << s.functions.size() << " functions, " << s.procedures.size()
-              << " procedures, " << s.rules.size() << " rules, " << s.interfaces.size()
-              << " interface clauses\n";
-  for (const std::string &name : opts.entities) {
-    bool found = false;
-    for (const express::Schema &s : model.schemas()) {
-      express::EntityId id = model.findEntity(s, express::lower(name));
-      if (id != express::kNone) {
-        printEntity(model, id);
-        found = true;
-        break;
-      }
-    }
-    if (!found) {
-      printToolError("no entity '" + name + "' in the loaded schemas");
-      return kExitUsage;
-    }
-  }
+  printSummary(model);
+  if (int status = printEntities(model, opts.entities))
+    return status;
   std::cout.flush();
   return diags.hasErrors() ? kExitDiagnostics : kExitOk;
 }
@@ -100,8 +123,9 @@ void registerSchema(CLI::App &app, std::function<void(int)> setResult) {
   CLI::App *cmd = app.add_subcommand(
       "schema", "Read EXPRESS (ISO 10303-11) schemas, resolve them together (USE/REFERENCE FROM\n"
                 "across the files given) and print a summary; --entity prints an entity's\n"
-                "attributes in Part 21 order.");
-  cmd->add_option("files", opts->files, "EXPRESS files (.exp)")->required();
+                "attributes in Part 21 order. --builtin shows the built-in ISO 14649 ARM.");
+  cmd->add_option("files", opts->files, "EXPRESS files (.exp)");
+  cmd->add_flag("--builtin", opts->builtin, "Use the built-in ISO 14649 ARM schema instead of files");
   cmd->add_option("--entity", opts->entities, "Print this entity's Part 21 attribute list (repeatable)");
   addDiagnosticOptions(*cmd, opts->diag);
   cmd->callback([opts, setResult] { setResult(runSchema(*opts)); });

@@ -1,0 +1,224 @@
+#include "frontend/binding/Binder.h"
+#include "frontend/express/SchemaReader.h"
+
+#include <catch2/catch.hpp>
+
+using namespace stepnc;
+
+namespace {
+
+const char *kSchema = R"(
+SCHEMA shop;
+TYPE length_measure = REAL; END_TYPE;
+TYPE label = STRING; END_TYPE;
+TYPE hand = ENUMERATION OF (cw, ccw); END_TYPE;
+TYPE measure_select = SELECT (length_measure, count_measure, tool); END_TYPE;
+TYPE count_measure = INTEGER; END_TYPE;
+ENTITY tool ABSTRACT SUPERTYPE OF (ONEOF (drill, mill));
+  name : label;
+  diameter : length_measure;
+END_ENTITY;
+ENTITY drill SUBTYPE OF (tool);
+  tip_angle : REAL;
+END_ENTITY;
+ENTITY mill SUBTYPE OF (tool);
+  flutes : INTEGER;
+  rotation : hand;
+END_ENTITY;
+ENTITY coated SUBTYPE OF (tool);
+  coating : label;
+END_ENTITY;
+ENTITY step;
+  its_tool : tool;
+  passes : LIST [1:3] OF length_measure;
+  empty_ok : SET [0:?] OF tool;
+  amount : measure_select;
+  flag : OPTIONAL BOOLEAN;
+END_ENTITY;
+ENTITY special_step SUBTYPE OF (step);
+DERIVE
+  SELF\step.flag : BOOLEAN := TRUE;
+END_ENTITY;
+END_SCHEMA;
+)";
+
+struct Fixture {
+  express::Model model;
+  binding::AliasTable aliases;
+  Fixture() {
+    DiagnosticCollector c;
+    DiagnosticEngine engine(c);
+    REQUIRE(express::readExpress(SourceFile::fromString("shop.exp", kSchema), model, engine));
+    REQUIRE(model.resolve(engine));
+    std::string error;
+    REQUIRE(aliases.parse("# test aliases\nentity BORER drill\n", error));
+  }
+};
+
+Fixture &fixture() {
+  static Fixture f;
+  return f;
+}
+
+struct Result {
+  std::unique_ptr<SourceFile> source;
+  std::unique_ptr<p21::Part21File> file;
+  std::unique_ptr<binding::BoundFile> bound;
+  DiagnosticCollector diags;
+  std::vector<std::string> messages;  // "line:col: severity: message" (notes excluded)
+};
+
+std::unique_ptr<Result> bindText(std::string_view data, bool strict = false) {
+  auto r = std::make_unique<Result>();
+  r->source = SourceFile::fromString("t.stp", "ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION((''),'2;1');\n"
+                                              "FILE_NAME('','',(''),(''),'','','');\nFILE_SCHEMA(('SHOP'));\n"
+                                              "ENDSEC;\nDATA;\n" +
+                                                  std::string(data) + "ENDSEC;\nEND-ISO-10303-21;\n");
+  DiagnosticEngine engine(r->diags);
+  r->file = p21::readPart21(*r->source, engine);
+  p21::checkInstances(*r->file, engine);
+  binding::BindOptions opts;
+  opts.aliases = &fixture().aliases;
+  opts.strict = strict;
+  r->bound = binding::bind(*r->file, fixture().model, fixture().model.schemas().front(), engine, opts);
+  for (const Diagnostic &d : r->diags.diags) {
+    LineCol lc = d.loc.valid() ? d.loc.file->lineCol(d.loc.offset) : LineCol{};
+    r->messages.push_back(std::to_string(lc.line) + ":" + std::to_string(lc.col) + ": " +
+                          severityName(d.severity) + ": " + d.message);
+  }
+  return r;
+}
+
+const char *kGoodStep = "#1=DRILL('d',10.,118.);\n#2=STEP(#1,(1.,2.),(),LENGTH_MEASURE(3.),.T.);\n";
+
+} // namespace
+
+TEST_CASE("a valid file binds clean and every instance gets its entity", "[binding]") {
+  auto r = bindText(kGoodStep);
+  CHECK(r->messages.empty());
+  const auto &m = fixture().model;
+  express::EntityId tool = m.findEntity(m.schemas().front(), "tool");
+  CHECK(r->bound->isA(0, tool));
+  CHECK(m.entity(r->bound->entity(1)).name == "step");
+}
+
+TEST_CASE("binding errors name the instance, attribute, expectation and finding", "[binding]") {
+  SECTION("unknown entity, with a suggestion") {
+    auto r = bindText("#1=DRIL('d',10.,118.);\n");
+    REQUIRE(r->messages.size() == 1);
+    CHECK(r->messages[0] == "8:1: error: unknown entity 'DRIL' in schema 'shop'");
+    CHECK(r->diags.diags[0].notes[0].message == "did you mean 'drill'?");
+  }
+  SECTION("alias: accepted with one warning naming it") {
+    auto r = bindText("#1=BORER('d',10.,118.);\n#3=BORER('e',12.,118.);\n#2=STEP(#1,(1.),(),LENGTH_MEASURE(3.),$);\n");
+    REQUIRE(r->messages.size() == 1);
+    CHECK(r->messages[0] ==
+          "8:1: warning: 'BORER' is not an entity of schema 'shop'; read as its alias 'drill' (2 instances)");
+  }
+  SECTION("abstract entity") {
+    auto r = bindText("#1=TOOL('t',10.);\n");
+    CHECK(r->messages == std::vector<std::string>{
+                             "8:4: error: entity 'tool' is abstract and cannot be instantiated; use one of its "
+                             "subtypes: drill, mill, coated"});
+  }
+  SECTION("attribute count") {
+    auto r = bindText("#1=DRILL('d',10.);\n");
+    CHECK(r->messages == std::vector<std::string>{"8:4: error: 'drill' has 3 attributes, found 2"});
+    CHECK(r->diags.diags[0].notes[0].message == "attributes of drill in order: name, diameter, tip_angle");
+  }
+  SECTION("wrong simple type") {
+    auto r = bindText("#1=DRILL('d','ten',118.);\n");
+    CHECK(r->messages == std::vector<std::string>{
+                             "8:14: error: attribute 2 'diameter': expected REAL, found a string"});
+  }
+  SECTION("wrong enumeration value") {
+    auto r = bindText("#1=MILL('m',10.,4,.LEFT.);\n");
+    CHECK(r->messages == std::vector<std::string>{
+                             "8:19: error: attribute 4 'rotation': .LEFT. is not a value of 'hand' (.cw., .ccw.)"});
+  }
+  SECTION("reference to an incompatible entity") {
+    auto r = bindText("#1=DRILL('d',10.,118.);\n#2=STEP(#1,(1.),(),LENGTH_MEASURE(3.),$);\n#3=STEP(#2,(1.),(),LENGTH_MEASURE(3.),$);\n");
+    CHECK(r->messages == std::vector<std::string>{
+                             "10:9: error: attribute 1 'its_tool': expected a reference to tool, found #2 STEP, "
+                             "which is not a tool"});
+    CHECK(r->diags.diags[0].entityId == 3);
+  }
+  SECTION("$ in a mandatory attribute") {
+    auto r = bindText("#1=DRILL('d',$,118.);\n");
+    CHECK(r->messages == std::vector<std::string>{
+                             "8:14: error: attribute 2 'diameter': '$' (no value) where a value is required (a length_measure)"});
+  }
+  SECTION("* where the attribute is not derived, and a value where it is") {
+    auto r = bindText("#1=DRILL('d',*,118.);\n#2=SPECIAL_STEP(#1,(1.),(),LENGTH_MEASURE(3.),.T.);\n");
+    CHECK(r->messages == std::vector<std::string>{
+                             "8:14: error: attribute 2 'diameter': '*' but the attribute is not derived; expected a length_measure",
+                             "9:47: error: attribute 5 'flag': the attribute is derived in 'special_step' and must be "
+                             "written '*', found .T."});
+  }
+  SECTION("aggregate bounds and element types") {
+    auto r = bindText("#1=DRILL('d',10.,118.);\n#2=STEP(#1,(),(),LENGTH_MEASURE(3.),$);\n#3=STEP(#1,(1.,'x'),(),LENGTH_MEASURE(3.),$);\n");
+    CHECK(r->messages == std::vector<std::string>{
+                             "9:12: error: attribute 2 'passes': expected a LIST [1:3] OF length_measure, found 0 elements",
+                             "10:16: error: attribute 2 'passes'[2]: expected REAL, found a string"});
+  }
+  SECTION("select: typed member, wrong type name, entity member") {
+    auto r = bindText("#1=DRILL('d',10.,118.);\n#2=STEP(#1,(1.),(),COUNT_MEASURE(3),$);\n"
+                      "#3=STEP(#1,(1.),(),LABEL('x'),$);\n#4=STEP(#1,(1.),(),#1,$);\n#5=STEP(#1,(1.),(),#2,$);\n");
+    CHECK(r->messages == std::vector<std::string>{
+                             "10:20: error: attribute 4 'amount': type 'label' is not a member of SELECT type "
+                             "'measure_select' (types: length_measure, count_measure)",
+                             "12:20: error: attribute 4 'amount': expected a reference to an entity of SELECT type "
+                             "'measure_select' (tool), found #2 STEP"});
+  }
+  SECTION("select: an untyped value is read with a warning") {
+    auto r = bindText("#1=DRILL('d',10.,118.);\n#2=STEP(#1,(1.),(),3.,$);\n");
+    REQUIRE(r->messages.size() == 1);
+    CHECK(r->messages[0].find("9:20: warning: attribute 4 'amount': a value of SELECT type 'measure_select' should "
+                              "be typed") == 0);
+  }
+  SECTION("complex instances: ONEOF and missing supertype") {
+    auto r = bindText("#1=(DRILL(118.)MILL(4,.CW.)TOOL('x',10.));\n#2=(COATED('tin')DRILL(118.));\n"
+                      "#3=(COATED('tin')DRILL(118.)TOOL('y',8.));\n");
+    CHECK(r->messages == std::vector<std::string>{
+                             "8:1: error: 'drill' and 'mill' cannot be combined: they are ONEOF subtypes of 'tool'",
+                             "9:1: error: complex instance has 'coated' but not its supertype 'tool'; every "
+                             "supertype must have its record",
+                             "9:1: error: complex instance has 'drill' but not its supertype 'tool'; every "
+                             "supertype must have its record"});
+  }
+  SECTION("complex instance records carry their own attributes") {
+    auto r = bindText("#1=(COATED('tin')DRILL(118.,1.)TOOL('y',8.));\n");
+    CHECK(r->messages == std::vector<std::string>{
+                             "8:18: error: record 'drill' of a complex instance has 1 attribute, found 2"});
+  }
+}
+
+TEST_CASE("drift: $ for an empty aggregate or a name is a warning unless strict", "[binding]") {
+  const char *text = "#1=DRILL($,10.,118.);\n#2=STEP(#1,(1.),$,LENGTH_MEASURE(3.),$);\n";
+  auto lenient = bindText(text);
+  CHECK(lenient->messages == std::vector<std::string>{
+                                 "9:17: warning: '$' written for a mandatory aggregate; read as empty (1 place; "
+                                 "--strict makes each an error)",
+                                 "8:10: warning: '$' written for a mandatory string (a name, label or identifier); "
+                                 "read as '' (1 place; --strict makes each an error)"});
+  auto strict = bindText(text, true);
+  CHECK(strict->messages == std::vector<std::string>{
+                                "8:10: error: attribute 1 'name': '$' (no value) where a value is required (a label)",
+                                "9:17: error: attribute 3 'empty_ok': '$' (no value) where a value is required (a SET "
+                                "[0:?] OF tool)"});
+}
+
+TEST_CASE("integers where a REAL is expected are read with one warning", "[binding]") {
+  auto r = bindText("#1=DRILL('d',10,118);\n");
+  CHECK(r->messages == std::vector<std::string>{
+                           "8:14: warning: integer written where a REAL is expected; read as a real (2 places)"});
+}
+
+TEST_CASE("the alias table format is checked", "[binding]") {
+  binding::AliasTable t;
+  std::string error;
+  CHECK_FALSE(t.parse("entity ONLY_TWO\n", error));
+  CHECK(error == "line 1: expected 'entity ALIAS schema_name'");
+  CHECK(binding::AliasTable::builtin().entity("BIDIRECTIONAL_MILLING") == "bidirectional");
+  CHECK(binding::AliasTable::builtin().entity("CENTER_DRILL") == "centerdrill");
+}
