@@ -90,6 +90,12 @@ bool Model::isSubtypeOf(EntityId sub, EntityId super) const {
   return false;
 }
 
+const Expr *Model::whereExpression(const WhereRule &rule) const {
+  if (!rule.expr)
+    rule.expr = parseExpression(rule.text);
+  return rule.expr.get();
+}
+
 std::string Model::typeText(TypeId id) const {
   if (id == kNone)
     return "?";

@@ -10,6 +10,7 @@
 // redeclarations turning it into a derived slot (written `*` in Part 21).
 #pragma once
 
+#include "frontend/express/Expr.h"
 #include "support/Diagnostics.h"
 #include "support/SourceFile.h"
 
@@ -58,6 +59,15 @@ struct TypeExpr {
   DeclTypeId declared = kNone;
 };
 
+/// A domain rule of a WHERE clause.
+struct WhereRule {
+  std::string label;  ///< may be empty
+  std::string text;   ///< the expression as written
+  /// The parsed expression: set when read from EXPRESS; for built-in schemas
+  /// parsed on first use (Model::whereExpression), keeping start-up fast.
+  mutable std::shared_ptr<const Expr> expr;
+};
+
 /// A TYPE declaration.
 struct TypeDecl {
   std::string name;
@@ -70,7 +80,7 @@ struct TypeDecl {
   std::string basedOn;  ///< SELECT/ENUMERATION BASED_ON
   // ENUMERATION
   std::vector<std::string> enumValues;
-  std::vector<std::pair<std::string, std::string>> where;  ///< label, expression text
+  std::vector<WhereRule> where;
   SourceLoc loc;
 };
 
@@ -131,7 +141,7 @@ struct Entity {
   std::vector<DerivedAttribute> derived;
   std::vector<InverseAttribute> inverse;
   std::vector<std::vector<std::string>> unique;  ///< UNIQUE rules: labelled attribute lists
-  std::vector<std::pair<std::string, std::string>> where;  ///< label, expression text
+  std::vector<WhereRule> where;
   SourceLoc loc;
 
   // Filled by Model::resolve().
@@ -196,6 +206,9 @@ public:
   DeclTypeId findType(const Schema &schema, std::string_view name) const;
   /// True if `sub` is `super` or one of its subtypes (transitively).
   bool isSubtypeOf(EntityId sub, EntityId super) const;
+  /// The parsed form of a WHERE rule (parsing it now if needed); null if its
+  /// text does not parse.
+  const Expr *whereExpression(const WhereRule &rule) const;
   /// Writes a type expression as EXPRESS text ("LIST [1:?] OF cartesian_point").
   std::string typeText(TypeId id) const;
 

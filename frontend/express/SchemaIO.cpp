@@ -295,8 +295,8 @@ std::string serializeModel(const Model &m) {
       if (!t.enumValues.empty())
         out += " : " + joined(t.enumValues, ' ');
       out += "\n";
-      for (const auto &[label, text] : t.where)
-        out += " where " + (label.empty() ? "-" : label) + " " + escape(text) + "\n";
+      for (const WhereRule &w : t.where)
+        out += " where " + (w.label.empty() ? "-" : w.label) + " " + escape(w.text) + "\n";
     }
     for (EntityId id : s.entities) {
       const Entity &e = m.entity(id);
@@ -331,8 +331,8 @@ std::string serializeModel(const Model &m) {
                " " + i.entity + " " + i.attribute + "\n";
       for (const auto &u : e.unique)
         out += " unique " + joined(u, ',') + "\n";
-      for (const auto &[label, text] : e.where)
-        out += " where " + (label.empty() ? "-" : label) + " " + escape(text) + "\n";
+      for (const WhereRule &w : e.where)
+        out += " where " + (w.label.empty() ? "-" : w.label) + " " + escape(w.text) + "\n";
     }
     for (const std::string &f : s.functions)
       out += "function " + f + "\n";
@@ -451,7 +451,7 @@ bool deserializeModel(std::string_view text, Model &model, std::string &error) {
     } else if (member && kw == "where" && (entity != kNone || typeDecl != kNone)) {
       std::string_view label;
       t.next(label);
-      auto rule = std::make_pair(label == "-" ? std::string() : std::string(label), unescape(t.rest()));
+      WhereRule rule{label == "-" ? std::string() : std::string(label), unescape(t.rest()), nullptr};
       if (entity != kNone)
         model.mutableEntity(entity).where.push_back(std::move(rule));
       else

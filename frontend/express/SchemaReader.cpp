@@ -50,6 +50,132 @@ private:
   DiagnosticEngine &diags_;
 };
 
+// ---- expressions -----------------------------------------------------------
+
+Expr makeExpr(Expr::Kind kind, std::string text, std::vector<Expr> args = {}) {
+  Expr e;
+  e.kind = kind;
+  e.text = std::move(text);
+  e.args = std::move(args);
+  return e;
+}
+
+std::string upperText(antlr4::ParserRuleContext *ctx) {
+  std::string t = ctx->getText();
+  for (char &c : t)
+    if (c >= 'a' && c <= 'z')
+      c = static_cast<char>(c - 32);
+  return t;
+}
+
+Expr buildExpression(P::ExpressionContext *ctx);
+Expr buildSimple(P::Simple_expressionContext *ctx);
+
+Expr buildPrimary(P::PrimaryContext *ctx) {
+  Expr e;
+  if (auto *lit = ctx->literal()) {
+    if (lit->INTEGER_LITERAL())
+      return makeExpr(Expr::Integer, lit->getText());
+    if (lit->REAL_LITERAL())
+      return makeExpr(Expr::Real, lit->getText());
+    if (lit->BINARY_LITERAL())
+      return makeExpr(Expr::BinaryLiteral, lit->getText());
+    if (lit->logical_literal())
+      return makeExpr(Expr::Logical, upperText(lit));
+    return makeExpr(Expr::String, lit->getText());
+  }
+  auto *q = ctx->qualifiable_factor();
+  if (auto *b = q->built_in_constant()) {
+    e = makeExpr(Expr::Builtin, upperText(b));
+  } else if (auto *f = q->built_in_function()) {
+    e = makeExpr(Expr::Call, upperText(f));
+    if (auto *params = q->actual_parameter_list())
+      for (auto *p : params->parameter())
+        e.args.push_back(buildExpression(p->expression()));
+  } else if (auto *params = q->actual_parameter_list()) {
+    e = makeExpr(Expr::Call, lower(q->simple_id()->getText()));
+    for (auto *p : params->parameter())
+      e.args.push_back(buildExpression(p->expression()));
+  } else {
+    e = makeExpr(Expr::Name, lower(q->simple_id()->getText()));
+  }
+  for (auto *qual : ctx->qualifier()) {
+    if (auto *a = qual->attribute_qualifier()) {
+      e = makeExpr(Expr::Attribute, lower(a->attribute_ref()->getText()), {std::move(e)});
+    } else if (auto *g = qual->group_qualifier()) {
+      e = makeExpr(Expr::Group, lower(g->entity_ref()->getText()), {std::move(e)});
+    } else {
+      auto *ix = qual->index_qualifier();
+      std::vector<Expr> args{std::move(e)};
+      for (auto *n : ix->numeric_expression())
+        args.push_back(buildSimple(n->simple_expression()));
+      e = makeExpr(Expr::Index, "", std::move(args));
+    }
+  }
+  return e;
+}
+
+Expr buildSimpleFactor(P::Simple_factorContext *ctx) {
+  if (auto *agg = ctx->aggregate_initializer()) {
+    Expr e = makeExpr(Expr::Aggregate, "");
+    for (auto *el : agg->element()) {
+      Expr item = buildExpression(el->expression());
+      if (el->numeric_expression())
+        item = makeExpr(Expr::Binary, ":", {std::move(item), buildSimple(el->numeric_expression()->simple_expression())});
+      e.args.push_back(std::move(item));
+    }
+    return e;
+  }
+  if (auto *iv = ctx->interval()) {
+    std::vector<Expr> args;
+    for (auto *se : iv->simple_expression())
+      args.push_back(buildSimple(se));
+    return makeExpr(Expr::Interval, iv->interval_op(0)->getText() + " " + iv->interval_op(1)->getText(),
+                    std::move(args));
+  }
+  if (auto *qe = ctx->query_expression())
+    return makeExpr(Expr::Query, lower(qe->variable_id()->getText()),
+                    {buildSimple(qe->simple_expression()), buildExpression(qe->logical_expression()->expression())});
+  Expr inner = ctx->expression() ? buildExpression(ctx->expression()) : buildPrimary(ctx->primary());
+  if (auto *u = ctx->unary_op())
+    return makeExpr(Expr::Unary, upperText(u), {std::move(inner)});
+  return inner;
+}
+
+Expr buildFactor(P::FactorContext *ctx) {
+  auto parts = ctx->simple_factor();
+  Expr e = buildSimpleFactor(parts[0]);
+  if (parts.size() == 2)
+    e = makeExpr(Expr::Binary, "**", {std::move(e), buildSimpleFactor(parts[1])});
+  return e;
+}
+
+Expr buildTerm(P::TermContext *ctx) {
+  auto factors = ctx->factor();
+  auto ops = ctx->multiplication_like_op();
+  Expr e = buildFactor(factors[0]);
+  for (size_t i = 1; i < factors.size(); ++i)
+    e = makeExpr(Expr::Binary, upperText(ops[i - 1]), {std::move(e), buildFactor(factors[i])});
+  return e;
+}
+
+Expr buildSimple(P::Simple_expressionContext *ctx) {
+  auto terms = ctx->term();
+  auto ops = ctx->add_like_op();
+  Expr e = buildTerm(terms[0]);
+  for (size_t i = 1; i < terms.size(); ++i)
+    e = makeExpr(Expr::Binary, upperText(ops[i - 1]), {std::move(e), buildTerm(terms[i])});
+  return e;
+}
+
+Expr buildExpression(P::ExpressionContext *ctx) {
+  auto sides = ctx->simple_expression();
+  Expr e = buildSimple(sides[0]);
+  if (sides.size() == 2)
+    e = makeExpr(Expr::Binary, upperText(ctx->rel_op_extended()), {std::move(e), buildSimple(sides[1])});
+  return e;
+}
+
 class Builder {
 public:
   Builder(Model &model, const SourceFile &file, antlr4::CharStream &input)
@@ -273,8 +399,8 @@ void Builder::typeDecl(Schema &schema, P::Type_declContext *ctx) {
   }
   if (auto *w = ctx->where_clause())
     for (auto *r : w->domain_rule())
-      decl.where.emplace_back(r->rule_label_id() ? id(r->rule_label_id()->simple_id()) : "",
-                              text(r->expression()));
+      decl.where.push_back({r->rule_label_id() ? id(r->rule_label_id()->simple_id()) : "",
+                            text(r->expression()), std::make_shared<const Expr>(buildExpression(r->expression()))});
   schema.types.push_back(model_.addTypeDecl(std::move(decl)));
 }
 
@@ -360,8 +486,8 @@ void Builder::entityDecl(Schema &schema, P::Entity_declContext *ctx) {
     }
   if (auto *w = body->where_clause())
     for (auto *r : w->domain_rule())
-      e.where.emplace_back(r->rule_label_id() ? id(r->rule_label_id()->simple_id()) : "",
-                           text(r->expression()));
+      e.where.push_back({r->rule_label_id() ? id(r->rule_label_id()->simple_id()) : "",
+                         text(r->expression()), std::make_shared<const Expr>(buildExpression(r->expression()))});
   schema.entities.push_back(model_.addEntity(std::move(e)));
 }
 
@@ -425,6 +551,26 @@ void Builder::schema(P::Schema_declContext *ctx) {
 }
 
 } // namespace
+
+std::shared_ptr<const Expr> parseExpression(std::string_view text) {
+  antlr4::ANTLRInputStream input{std::string(text)};
+  g::ExpressLexer lexer(&input);
+  lexer.removeErrorListeners();
+  antlr4::CommonTokenStream tokens(&lexer);
+  g::ExpressParser parser(&tokens);
+  parser.removeErrorListeners();
+  parser.setErrorHandler(std::make_shared<antlr4::BailErrorStrategy>());
+  try {
+    auto *tree = parser.expression();
+    if (tokens.LA(1) != antlr4::Token::EOF)
+      return nullptr;
+    return std::make_shared<const Expr>(buildExpression(tree));
+  } catch (const antlr4::ParseCancellationException &) {
+    return nullptr;
+  } catch (const antlr4::RecognitionException &) {
+    return nullptr;
+  }
+}
 
 bool readExpress(std::unique_ptr<SourceFile> file, Model &model, DiagnosticEngine &diags) {
   const SourceFile &src = *file;

@@ -193,3 +193,51 @@ TEST_CASE("the built-in ARM matches the corpus ARM schema slot by slot", "[expre
   }
   CHECK(compared >= 490);
 }
+
+TEST_CASE("WHERE rules are kept in parsed form", "[express]") {
+  auto l = load(R"(SCHEMA s;
+ENTITY circle;
+  radius : REAL;
+  centre : LIST [2:3] OF REAL;
+WHERE
+  wr1 : radius > 0.0;
+  wr2 : SIZEOF(QUERY(c <* centre | c < -1.E3)) = 0;
+  wr3 : {0 < radius <= 10};
+  'S.CIRCLE' IN TYPEOF(SELF\circle) AND NOT (centre[1] = 2 ** 3);
+  wr5 : EXISTS(radius) OR (HIINDEX(centre) - 1 >= centre[2]) OR (centre = [1, 2:3]);
+END_ENTITY;
+END_SCHEMA;
+)");
+  REQUIRE(l->ok);
+  const Entity &e = l->model.entity(0);
+  REQUIRE(e.where.size() == 5);
+  CHECK(e.where[0].label == "wr1");
+  CHECK(e.where[3].label.empty());
+  std::vector<std::string> printed;
+  for (const WhereRule &w : e.where) {
+    REQUIRE(w.expr);
+    printed.push_back(printExpr(*w.expr));
+  }
+  CHECK(printed == std::vector<std::string>{
+                       "(> radius 0.0)",
+                       "(= (call SIZEOF (query c centre (< c (- 1.E3)))) 0)",
+                       "(interval < <= 0 radius 10)",
+                       // EXPRESS binds AND tighter than IN (AND is a multiplication
+                       // operator, IN a relational one): the standard's precedence.
+                       "(IN 'S.CIRCLE' (AND (call TYPEOF (\\ circle SELF)) (NOT (= ([] centre 1) (** 2 3)))))",
+                       "(OR (OR (call EXISTS radius) (>= (- (call HIINDEX centre) 1) ([] centre 2))) (= centre (aggregate 1 (: 2 3))))"});
+}
+
+TEST_CASE("built-in WHERE rules are parsed on first use", "[express]") {
+  const Model &m = builtinModel();
+  const Schema &s = m.schemas().front();
+  DeclTypeId month = m.findType(s, "month_in_year_number");
+  REQUIRE(month != kNone);
+  const TypeDecl &t = m.typeDecl(month);
+  REQUIRE(t.where.size() == 1);
+  const Expr *e = m.whereExpression(t.where[0]);
+  REQUIRE(e);
+  CHECK(printExpr(*e) == "(interval <= <= 1 SELF 12)");
+  CHECK(parseExpression("1 + ") == nullptr);
+  CHECK(parseExpression("a b") == nullptr);
+}

@@ -1,0 +1,32 @@
+#include "frontend/express/Expr.h"
+
+namespace stepnc::express {
+
+std::string printExpr(const Expr &e) {
+  auto list = [&](std::string head) {
+    for (const Expr &a : e.args)
+      head += " " + printExpr(a);
+    return "(" + head + ")";
+  };
+  switch (e.kind) {
+  case Expr::Integer:
+  case Expr::Real:
+  case Expr::String:
+  case Expr::BinaryLiteral:
+  case Expr::Logical:
+  case Expr::Name:
+  case Expr::Builtin: return e.text;
+  case Expr::Call: return list("call " + e.text);
+  case Expr::Unary:
+  case Expr::Binary: return list(e.text);
+  case Expr::Attribute: return list(". " + e.text);
+  case Expr::Group: return list("\\ " + e.text);
+  case Expr::Index: return list("[]");
+  case Expr::Aggregate: return list("aggregate");
+  case Expr::Interval: return list("interval " + e.text);
+  case Expr::Query: return list("query " + e.text);
+  }
+  return "?";
+}
+
+} // namespace stepnc::express
