@@ -79,7 +79,7 @@ cat "$BIG" >/dev/null
 say "machine"
 {
   echo "date: $(date -u +%Y-%m-%dT%H:%M:%SZ)"
-  echo "commit: $(git rev-parse --short HEAD 2>/dev/null || echo unknown)$(git diff --quiet HEAD -- frontend support 2>/dev/null || echo ' (frontend/ or support/ modified)')"
+  echo "commit: $(git rev-parse --short HEAD 2>/dev/null || echo unknown)$(git diff --quiet HEAD -- frontend/part21 support 2>/dev/null || echo ' + uncommitted changes in frontend/part21 or support')"
   echo "cpu: $(lscpu | sed -n 's/^Model name: *//p' | head -1), $(nproc) cores"
   echo "compiler: $(c++ --version | head -1)"
   echo "kernel: $(uname -r)"

@@ -222,11 +222,12 @@ bool Decoder::parseParam(unsigned depth) {
         ++p_;
       while (p_ < end_ && isKeywordChar(*p_))
         ++p_;
-      NameId name = file_.intern({n, static_cast<size_t>(p_ - n)});
+      const std::string_view typeName(n, static_cast<size_t>(p_ - n));
+      NameId name = file_.intern(typeName);
       if (!layout())
         return false;
       if (p_ >= end_ || *p_ != '(')
-        return fail(p_, "expected '(' after type name '" + std::string(n, offsetOf(p_) - offsetOf(n)) + "'");
+        return fail(p_, "expected '(' after type name '" + std::string(typeName) + "'");
       if (depth >= file_.options().maxNesting)
         return fail(p_, "parameters nested deeper than " +
                             std::to_string(file_.options().maxNesting) + " levels");
