@@ -17,6 +17,20 @@ bool OutputFile::open(const std::string &path, std::string &error) {
     file_ = stdout;
     return true;
   }
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
+    if (S_ISDIR(st.st_mode)) {
+      error = "cannot write '" + path + "': it is a directory";
+      return false;
+    }
+    file_ = std::fopen(path.c_str(), "wb");
+    if (!file_) {
+      error = "cannot write '" + path + "': " + std::strerror(errno);
+      return false;
+    }
+    direct_ = true;
+    return true;
+  }
   tempPath_ = path + ".tmp.XXXXXX";
   int fd = ::mkstemp(tempPath_.data());
   if (fd < 0) {
@@ -46,6 +60,14 @@ bool OutputFile::commit(std::string &error) {
   if (!file_) {
     error = "no output file is open";
     return false;
+  }
+  if (direct_) {
+    bool ok = std::fflush(file_) == 0 && !std::ferror(file_);
+    ok = (std::fclose(file_) == 0) && ok;
+    file_ = nullptr;
+    if (!ok)
+      error = "cannot write '" + path_ + "': " + std::strerror(errno);
+    return ok;
   }
   if (isStdout_) {
     bool ok = std::fflush(file_) == 0 && !std::ferror(file_);

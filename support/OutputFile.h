@@ -1,6 +1,8 @@
 // Atomic output files: a program or converted file is written to a temporary
 // file beside the target and renamed over it only when complete, so a failure
-// never leaves a partial file behind. "-" means standard output.
+// never leaves a partial file behind. "-" means standard output; a target that
+// exists and is not a regular file (a device such as /dev/null, a FIFO) is
+// written directly, since renaming over it would replace the device.
 #pragma once
 
 #include <cstdio>
@@ -33,6 +35,7 @@ private:
   std::string tempPath_;
   std::FILE *file_ = nullptr;
   bool isStdout_ = false;
+  bool direct_ = false;  ///< writing straight to a device or FIFO
 };
 
 } // namespace stepnc

@@ -16,20 +16,33 @@ using express::TypeId;
 using p21::Value;
 using p21::ValueKind;
 
+EntityId BoundFile::entity(size_t index) const {
+  const p21::NameId name = file_.entries()[index].name();
+  if (name == p21::kComplexInstance) {
+    auto it = complex_.find(static_cast<uint32_t>(index));
+    return it == complex_.end() ? kNone : it->second.mostSpecific;
+  }
+  return name < byName_.size() ? byName_[name] : kNone;
+}
+
 std::vector<EntityId> BoundFile::entitySet(size_t index) const {
-  for (const auto &[i, set] : complex_)
-    if (i == index)
-      return set;
-  if (entities_[index] == kNone)
-    return {};
-  return {entities_[index]};
+  if (file_.entries()[index].name() == p21::kComplexInstance) {
+    auto it = complex_.find(static_cast<uint32_t>(index));
+    return it == complex_.end() ? std::vector<EntityId>{} : it->second.members;
+  }
+  const EntityId e = entity(index);
+  return e == kNone ? std::vector<EntityId>{} : std::vector<EntityId>{e};
 }
 
 bool BoundFile::isA(size_t index, EntityId of) const {
-  const EntityId e = entities_[index];
-  if (e != kNone && file_.entries()[index].name != p21::kComplexInstance)
-    return model_.isSubtypeOf(e, of);
-  for (EntityId m : entitySet(index))
+  if (file_.entries()[index].name() != p21::kComplexInstance) {
+    const EntityId e = entity(index);
+    return e != kNone && model_.isSubtypeOf(e, of);
+  }
+  auto it = complex_.find(static_cast<uint32_t>(index));
+  if (it == complex_.end())
+    return false;
+  for (EntityId m : it->second.members)
     if (model_.isSubtypeOf(m, of))
       return true;
   return false;
@@ -86,7 +99,8 @@ private:
   };
 
   EntityId lookup(std::string_view upperName, uint64_t offset);
-  void checkInstance(size_t index);
+  void reportUnknown(size_t index, std::string_view name, uint64_t at);
+  void checkInstance(size_t index, const p21::ValueArena &values);
   void checkRecord(size_t index, const p21::Record &rec, EntityId entity, bool partial);
   void checkComplex(size_t index, const std::vector<EntityId> &set, uint64_t at);
   bool checkValue(const Value &v, TypeId type, const Context &ctx, bool optionalAllowed);
@@ -108,7 +122,8 @@ private:
   const AliasTable &aliases_;
   const BindOptions &options_;
   BoundFile &out_;
-  p21::ValueArena arena_;
+  const p21::ValueArena *arena_ = nullptr;  ///< the instance being checked
+  p21::ValueArena scratch_;                  ///< for decoding complex instances in pass 1
   std::map<DeclTypeId, SelectClosure> closures_;
   struct AliasUse {
     uint64_t first;
@@ -127,7 +142,7 @@ private:
   };
   Tally unsetAggregate_, unsetString_;
   void reportTally(const Tally &t, const std::string &what);
-  std::set<std::string> unknownReported_;
+  std::map<std::string, std::string> suggestions_;  ///< unknown name -> closest entity
 };
 
 Binder::Drift Binder::driftOf(TypeId type) const {
@@ -169,6 +184,29 @@ EntityId Binder::lookup(std::string_view upperName, uint64_t offset) {
   return kNone;
 }
 
+void Binder::reportUnknown(size_t index, std::string_view name, uint64_t at) {
+  // One suggestion per distinct unknown name.
+  auto [it, fresh] = suggestions_.try_emplace(std::string(name));
+  if (fresh) {
+    const std::string lowered = express::lower(name);
+    size_t bestDist = 4;
+    for (const auto &[candidate, ref] : schema_.scope) {
+      if (!ref.first)
+        continue;
+      size_t d = editDistance(lowered, candidate);
+      if (d < bestDist || (d == bestDist && candidate < it->second)) {
+        bestDist = d;
+        it->second = candidate;
+      }
+    }
+  }
+  const std::string &best = it->second;
+  auto d = diags_.error(file_.loc(at), "unknown entity '" + std::string(name) + "' in schema '" + schema_.name + "'");
+  d.entity(entry(index).id, std::string(name));
+  if (!best.empty())
+    d.note("did you mean '" + best + "'?");
+}
+
 std::string Binder::entityName(size_t index) const { return file_.describe(entry(index)); }
 
 InFlightDiagnostic Binder::error(const Context &ctx, const Value &v, const std::string &message) {
@@ -176,7 +214,7 @@ InFlightDiagnostic Binder::error(const Context &ctx, const Value &v, const std::
   std::string where;
   if (ctx.slot)
     where = "attribute " + std::to_string(ctx.position) + " '" + ctx.slot->name + "'" + ctx.path + ": ";
-  auto d = diags_.error(file_.loc(e.begin + v.offset), where + message);
+  auto d = diags_.error(file_.loc(e.begin() + v.offset), where + message);
   d.entity(e.id, entityName(ctx.entry));
   return d;
 }
@@ -290,7 +328,7 @@ bool Binder::checkSelect(const Value &v, DeclTypeId decl, const Context &ctx) {
                         (members.empty() ? std::string() : " (types: " + members + ")"));
       return false;
     }
-    const Value &inner = arena_.children(v)[0];
+    const Value &inner = arena_->children(v)[0];
     return checkValue(inner, model_.typeDecl(t).underlying, ctx, false);
   }
   // An untyped simple value: the standard wants it typed; accept it if some
@@ -304,7 +342,7 @@ bool Binder::checkSelect(const Value &v, DeclTypeId decl, const Context &ctx) {
     Binder probe(file_, model_, schema_, quiet, options_, out_);
     probe.arena_ = arena_;
     if (probe.checkValue(v, model_.typeDecl(m).underlying, ctx, false) && !quiet.hasErrors()) {
-      diags_.warning(file_.loc(entry(ctx.entry).begin + v.offset),
+      diags_.warning(file_.loc(entry(ctx.entry).begin() + v.offset),
                      "attribute " + std::to_string(ctx.position) + " '" + (ctx.slot ? ctx.slot->name : "") +
                          "': a value of SELECT type '" + td.name + "' should be typed, e.g. " +
                          express::lower(model_.typeDecl(m).name) + "(...); read as " + model_.typeDecl(m).name)
@@ -325,7 +363,7 @@ bool Binder::checkNamed(const Value &v, const TypeExpr &t, const Context &ctx) {
     int64_t i = file_.indexOf(v.ref);
     if (i < 0)
       return true;  // dangling: reported by the Part 21 check
-    if (out_.entity(static_cast<size_t>(i)) == kNone && out_.entitySet(static_cast<size_t>(i)).empty())
+    if (out_.entity(static_cast<size_t>(i)) == kNone)
       return true;  // the target's own entity is unknown: reported there
     if (!out_.isA(static_cast<size_t>(i), t.entity)) {
       error(ctx, v, "expected a reference to " + t.name + ", found " + describe(v) + ", which is not " + article(t.name));
@@ -362,7 +400,7 @@ bool Binder::checkNamed(const Value &v, const TypeExpr &t, const Context &ctx) {
       error(ctx, v, "expected " + article(td.name) + ", found " + describe(v));
       return false;
     }
-    return checkValue(arena_.children(v)[0], td.underlying, ctx, false);
+    return checkValue(arena_->children(v)[0], td.underlying, ctx, false);
   }
   return checkValue(v, td.underlying, ctx, false);
 }
@@ -377,7 +415,7 @@ bool Binder::checkValue(const Value &v, TypeId type, const Context &ctx, bool op
     if (drift != Drift::None) {
       Tally &t = drift == Drift::EmptyAggregate ? unsetAggregate_ : unsetString_;
       if (t.count++ == 0)
-        t.first = entry(ctx.entry).begin + v.offset;
+        t.first = entry(ctx.entry).begin() + v.offset;
       return true;
     }
     error(ctx, v, "'$' (no value) where a value is required (" + expected(type) + ")");
@@ -398,7 +436,7 @@ bool Binder::checkValue(const Value &v, TypeId type, const Context &ctx, bool op
       ok = v.kind == ValueKind::Real;
       if (v.kind == ValueKind::Integer) {
         if (intForReal_++ == 0)
-          firstIntForReal_ = entry(ctx.entry).begin + v.offset;
+          firstIntForReal_ = entry(ctx.entry).begin() + v.offset;
         ok = true;
       }
       if (t.simple == express::SimpleKind::Number && v.kind == ValueKind::Integer)
@@ -432,7 +470,7 @@ bool Binder::checkValue(const Value &v, TypeId type, const Context &ctx, bool op
                         (v.count == 1 ? " element" : " elements"));
       ok = false;
     }
-    auto children = arena_.children(v);
+    auto children = arena_->children(v);
     for (size_t i = 0; i < children.size(); ++i) {
       Context inner = ctx;
       inner.path += "[" + std::to_string(i + 1) + "]";
@@ -447,7 +485,7 @@ bool Binder::checkValue(const Value &v, TypeId type, const Context &ctx, bool op
 
 void Binder::checkRecord(size_t index, const p21::Record &rec, EntityId entity, bool partial) {
   const express::Entity &e = model_.entity(entity);
-  auto params = arena_.params(rec);
+  auto params = arena_->params(rec);
   std::vector<uint32_t> positions;
   if (partial) {
     positions = e.ownSlots;
@@ -462,7 +500,7 @@ void Binder::checkRecord(size_t index, const p21::Record &rec, EntityId entity, 
     for (uint32_t p : positions)
       names += (names.empty() ? "" : ", ") + e.slots[p].name;
     diags_
-        .error(file_.loc(en.begin + rec.offset),
+        .error(file_.loc(en.begin() + rec.offset),
                std::string(partial ? "record '" + e.name + "' of a complex instance" : "'" + e.name + "'") +
                    " has " + std::to_string(positions.size()) + " attribute" +
                    (positions.size() == 1 ? "" : "s") + ", found " + std::to_string(params.size()))
@@ -557,13 +595,12 @@ void Binder::checkComplex(size_t index, const std::vector<EntityId> &members, ui
   }
 }
 
-void Binder::checkInstance(size_t index) {
+void Binder::checkInstance(size_t index, const p21::ValueArena &values) {
   const p21::InstanceEntry &en = entry(index);
-  if (!file_.decodeInstance(index, arena_, nullptr))
-    return;  // syntax errors: reported by the Part 21 check
-  auto records = arena_.records();
-  if (en.name != p21::kComplexInstance) {
-    EntityId e = out_.entities_[index];
+  arena_ = &values;
+  auto records = values.records();
+  if (en.name() != p21::kComplexInstance) {
+    EntityId e = out_.entity(index);
     if (e == kNone)
       return;
     const express::Entity &ent = model_.entity(e);
@@ -571,7 +608,7 @@ void Binder::checkInstance(size_t index) {
       std::string subs;
       for (EntityId s : ent.subtypes)
         subs += (subs.empty() ? "" : ", ") + model_.entity(s).name;
-      diags_.error(file_.loc(en.begin + records[0].offset),
+      diags_.error(file_.loc(en.begin() + records[0].offset),
                    "entity '" + ent.name + "' is abstract and cannot be instantiated" +
                        (subs.empty() ? std::string() : "; use one of its subtypes: " + subs))
           .entity(en.id, entityName(index));
@@ -582,75 +619,73 @@ void Binder::checkInstance(size_t index) {
   }
   std::vector<EntityId> members;
   for (const p21::Record &r : records) {
-    EntityId e = lookup(file_.names().name(r.name), en.begin + r.offset);
+    EntityId e = lookup(file_.names().name(r.name), en.begin() + r.offset);
     if (e == kNone)
       return;  // reported in the first pass
     members.push_back(e);
   }
-  checkComplex(index, members, en.begin);
+  checkComplex(index, members, en.begin());
   for (size_t k = 0; k < records.size(); ++k)
     checkRecord(index, records[k], members[k], true);
 }
 
 void Binder::run() {
   const auto &entries = file_.entries();
-  out_.entities_.assign(entries.size(), kNone);
   // Pass 1: the entity of every instance, so references can be checked
-  // against their target's type in pass 2.
+  // against their target's type in pass 2. Simple instances are typed by
+  // name, once per distinct name.
+  constexpr EntityId kUnseen = kNone - 1;
+  out_.byName_.assign(file_.names().size(), kUnseen);
+  std::vector<bool> isAlias(file_.names().size(), false);
   for (size_t i = 0; i < entries.size(); ++i) {
     const p21::InstanceEntry &en = entries[i];
-    if (en.name != p21::kComplexInstance) {
-      std::string_view name = file_.names().name(en.name);
-      EntityId e = lookup(name, en.begin);
-      if (e == kNone) {
-        std::string lowered = express::lower(name);
-        std::string best;
-        size_t bestDist = 4;
-        for (const auto &[candidate, ref] : schema_.scope) {
-          if (!ref.first)
-            continue;
-          size_t d = editDistance(lowered, candidate);
-          if (d < bestDist || (d == bestDist && candidate < best)) {
-            bestDist = d;
-            best = candidate;
-          }
-        }
-        auto d = diags_.error(file_.loc(en.begin), "unknown entity '" + std::string(name) + "' in schema '" +
-                                                       schema_.name + "'");
-        d.entity(en.id, std::string(name));
-        if (!best.empty())
-          d.note("did you mean '" + best + "'?");
+    const p21::NameId nameId = en.name();
+    if (nameId != p21::kComplexInstance) {
+      EntityId &slot = out_.byName_[nameId];
+      const std::string_view name = file_.names().name(nameId);
+      if (slot == kUnseen) {
+        const size_t aliasesBefore = aliasUses_.size();
+        slot = lookup(name, en.begin());
+        isAlias[nameId] = aliasUses_.size() != aliasesBefore;
+      } else if (isAlias[nameId]) {
+        ++aliasUses_[std::string(name)].count;
       }
-      out_.entities_[i] = e;
+      if (slot == kNone)
+        reportUnknown(i, name, en.begin());
       continue;
     }
-    if (!file_.decodeInstance(i, arena_, nullptr))
+    if (!file_.decodeInstance(i, scratch_, nullptr))
       continue;
-    std::vector<EntityId> set;
-    for (const p21::Record &r : arena_.records()) {
-      EntityId e = lookup(file_.names().name(r.name), en.begin + r.offset);
+    BoundFile::Complex c;
+    for (const p21::Record &r : scratch_.records()) {
+      EntityId e = lookup(file_.names().name(r.name), en.begin() + r.offset);
       if (e == kNone) {
-        diags_.error(file_.loc(en.begin + r.offset), "unknown entity '" +
-                                                         std::string(file_.names().name(r.name)) +
-                                                         "' in schema '" + schema_.name + "'")
+        diags_.error(file_.loc(en.begin() + r.offset), "unknown entity '" +
+                                                           std::string(file_.names().name(r.name)) +
+                                                           "' in schema '" + schema_.name + "'")
             .entity(en.id, file_.describe(en));
         continue;
       }
-      set.push_back(e);
+      c.members.push_back(e);
     }
-    if (!set.empty()) {
+    if (!c.members.empty()) {
       // The most specific member stands for the instance.
-      EntityId most = set[0];
-      for (EntityId e : set)
-        if (model_.isSubtypeOf(e, most))
-          most = e;
-      out_.entities_[i] = most;
-      out_.complex_.emplace_back(static_cast<uint32_t>(i), std::move(set));
+      c.mostSpecific = c.members[0];
+      for (EntityId e : c.members)
+        if (model_.isSubtypeOf(e, c.mostSpecific))
+          c.mostSpecific = e;
+      out_.complex_.emplace(static_cast<uint32_t>(i), std::move(c));
     }
   }
-  // Pass 2: attributes.
-  for (size_t i = 0; i < entries.size() && !diags_.limitReached(); ++i)
-    checkInstance(i);
+  for (EntityId &e : out_.byName_)
+    if (e == kUnseen)
+      e = kNone;
+  // Pass 2: decode each instance once for the Part 21 reference check and the
+  // attribute checks together.
+  p21::checkInstances(file_, diags_, [this](size_t i, const p21::ValueArena &values) {
+    if (!diags_.limitReached())
+      checkInstance(i, values);
+  });
 
   for (const auto &[alias, use] : aliasUses_)
     diags_.warning(file_.loc(use.first), "'" + alias + "' is not an entity of schema '" + schema_.name +

@@ -15,12 +15,15 @@
 #include "frontend/part21/Part21File.h"
 
 #include <memory>
+#include <unordered_map>
 #include <vector>
 
 namespace stepnc::binding {
 
 /// The result of binding: the entity (or entities, for a complex instance) of
-/// every instance table entry.
+/// every instance table entry. Simple instances are typed through their
+/// entity name (one table entry per distinct name, not per instance), so
+/// binding a large file adds little memory.
 class BoundFile {
 public:
   BoundFile(const p21::Part21File &file, const express::Model &model, const express::Schema &schema)
@@ -30,9 +33,9 @@ public:
   const express::Model &model() const { return model_; }
   const express::Schema &schema() const { return schema_; }
 
-  /// Entity of entry `index` (the most specific, for a complex instance the
-  /// first record's), or express::kNone when unknown.
-  express::EntityId entity(size_t index) const { return entities_[index]; }
+  /// Entity of entry `index` (for a complex instance its most specific
+  /// record's), or express::kNone when unknown.
+  express::EntityId entity(size_t index) const;
   /// Every entity of entry `index` (one for a simple instance).
   std::vector<express::EntityId> entitySet(size_t index) const;
   /// True if the instance is `of` or a subtype of it.
@@ -40,12 +43,15 @@ public:
 
 private:
   friend class Binder;
+  struct Complex {
+    express::EntityId mostSpecific = express::kNone;
+    std::vector<express::EntityId> members;
+  };
   const p21::Part21File &file_;
   const express::Model &model_;
   const express::Schema &schema_;
-  std::vector<express::EntityId> entities_;
-  /// For complex instances: entry index -> all record entities.
-  std::vector<std::pair<uint32_t, std::vector<express::EntityId>>> complex_;
+  std::vector<express::EntityId> byName_;  ///< NameId -> entity (kNone: unknown)
+  std::unordered_map<uint32_t, Complex> complex_;  ///< entry index -> its records' entities
 };
 
 struct BindOptions {
@@ -57,7 +63,9 @@ struct BindOptions {
 };
 
 /// Binds and checks every instance of `file` against `schema` (which must
-/// belong to the resolved `model`). Diagnostics go to `diags`.
+/// belong to the resolved `model`). Each instance is decoded once, for the
+/// Part 21 reference check (p21::checkInstances) and the schema check
+/// together, so callers do not run checkInstances themselves.
 std::unique_ptr<BoundFile> bind(const p21::Part21File &file, const express::Model &model,
                                 const express::Schema &schema, DiagnosticEngine &diags,
                                 const BindOptions &options = {});

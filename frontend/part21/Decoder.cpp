@@ -145,14 +145,12 @@ bool Decoder::fail(const char *at, std::string message) {
     auto d = diags_->error(file_.loc(static_cast<uint64_t>(at - file_.source().begin())),
                            std::move(message));
     if (id_ != 0)
-      d.entity(id_, entityName_);
+      d.entity(id_, std::string(entityName_));
   }
   return false;
 }
 
-bool Decoder::layout() {
-  if (p_ < end_ && !isSpace(*p_) && *p_ != '/')
-    return true;
+bool Decoder::skipLayoutSlow() {
   if (skipLayout(p_, end_) == Layout::UnterminatedComment)
     return fail(p_, "unterminated comment: '/*' has no matching '*/'");
   return true;
@@ -516,7 +514,7 @@ bool Decoder::parseEnum(Value &v) {
   return true;
 }
 
-bool Decoder::parseRecordBody(Record &out) {
+bool Decoder::parseRecordBody(Record &out, NameId known) {
   const char *n = p_;
   if (p_ >= end_ || !isKeywordStart(*p_))
     return fail(p_, "expected an entity name");
@@ -524,7 +522,8 @@ bool Decoder::parseRecordBody(Record &out) {
     ++p_;
   while (p_ < end_ && isKeywordChar(*p_))
     ++p_;
-  out.name = file_.intern({n, static_cast<size_t>(p_ - n)});
+  // The instance table already interned a simple instance's name.
+  out.name = known != kNoName ? known : file_.intern({n, static_cast<size_t>(p_ - n)});
   out.offset = offsetOf(n);
   if (!layout())
     return false;
@@ -572,7 +571,7 @@ const char *Decoder::parseSingleParam(const char *p, const char *end, Value &out
   return p_;
 }
 
-bool Decoder::parseInstance(const char *p, const char *end) {
+bool Decoder::parseInstance(const char *p, const char *end, NameId known) {
   p_ = p + 1;  // '#'
   end_ = end;
   scratch_.clear();
@@ -604,24 +603,21 @@ bool Decoder::parseInstance(const char *p, const char *end) {
       return fail(open, "complex instance with no entity records");
   } else {
     Record rec;
-    if (!parseRecordBody(rec))
+    if (!parseRecordBody(rec, known))
       return false;
     arena_.mutableRecords().push_back(rec);
   }
-  if (!layout())
-    return false;
-  // An instance whose ';' is missing ends at its ')': the scanner reported it.
-  if (p_ < end_ && *p_ != ';')
-    return fail(p_, "expected ';' at end of instance");
+  // What follows the closing ')' is the scanner's business: it ended the
+  // instance there and reported a missing ';' already.
   return true;
 }
 
 // --- Part21File members that need the decoder ---------------------------------
 
 std::string_view Part21File::entityName(const InstanceEntry &e) const {
-  if (e.name == kComplexInstance)
+  if (e.name() == kComplexInstance)
     return "(complex)";
-  return names_.name(e.name);
+  return names_.name(e.name());
 }
 
 const HeaderEntity *Part21File::headerEntity(std::string_view name) const {
@@ -646,8 +642,8 @@ std::vector<std::string> Part21File::schemaNames() const {
 }
 
 std::string Part21File::describe(const InstanceEntry &e) const {
-  if (e.name != kComplexInstance)
-    return std::string(names_.name(e.name));
+  if (e.name() != kComplexInstance)
+    return std::string(names_.name(e.name()));
   ValueArena arena;
   if (!decodeInstance(static_cast<size_t>(&e - entries_.data()), arena, nullptr))
     return "(complex)";
@@ -663,47 +659,61 @@ std::string Part21File::describe(const InstanceEntry &e) const {
 bool Part21File::decodeInstance(size_t index, ValueArena &arena, DiagnosticEngine *diags) const {
   const InstanceEntry &e = entries_[index];
   arena.clear();
-  const char *begin = source_->begin() + e.begin;
+  const char *begin = source_->begin() + e.begin();
   Decoder dec(*this, arena, diags, begin, e.id, "instance");
-  if (diags && e.name != kComplexInstance)
-    dec.setEntityName(std::string(names_.name(e.name)));
-  return dec.parseInstance(begin, begin + e.length);
+  const NameId name = e.name();
+  if (diags && name != kComplexInstance)
+    dec.setEntityName(names_.name(name));
+  return dec.parseInstance(begin, source_->end(), name);
 }
 
-size_t checkInstances(const Part21File &file, DiagnosticEngine &diags) {
-  ValueArena arena;
-  size_t clean = 0;
-  const auto &entries = file.entries();
-  auto checkRef = [&](const Value &v, uint64_t base, const InstanceEntry *from) {
-    if (file.isDefined(v.ref))
-      return;
-    auto d = diags.error(file.loc(base + v.offset),
-                         "reference to " + hashId(v.ref) + ", which is not defined");
-    if (from)
-      d.entity(from->id, std::string(file.entityName(*from)));
-    d.note("no instance " + hashId(v.ref) + " in the DATA sections or the REFERENCE section");
-  };
-  // Anchors first (they precede the DATA sections in a file): top-level references and references inside lists.
+namespace {
+
+void reportUndefined(const Part21File &file, const Value &v, uint64_t base, const InstanceEntry *from,
+                     DiagnosticEngine &diags) {
+  auto d = diags.error(file.loc(base + v.offset), "reference to " + hashId(v.ref) + ", which is not defined");
+  if (from)
+    d.entity(from->id, std::string(file.entityName(*from)));
+  d.note("no instance " + hashId(v.ref) + " in the DATA sections or the REFERENCE section");
+}
+
+} // namespace
+
+void checkReferences(const Part21File &file, size_t index, const ValueArena &values, DiagnosticEngine &diags) {
+  const InstanceEntry &e = file.entries()[index];
+  for (const Value &v : values.values())
+    if (v.kind == ValueKind::Reference && !file.isDefined(v.ref))
+      reportUndefined(file, v, e.begin(), &e, diags);
+}
+
+void checkAnchorReferences(const Part21File &file, DiagnosticEngine &diags) {
   const ValueArena &meta = file.metadata();
   for (const Anchor &a : file.anchors()) {
     std::vector<const Value *> stack{&a.value};
     while (!stack.empty()) {
       const Value *v = stack.back();
       stack.pop_back();
-      if (v->kind == ValueKind::Reference)
-        checkRef(*v, 0, nullptr);
+      if (v->kind == ValueKind::Reference && !file.isDefined(v->ref))
+        reportUndefined(file, *v, 0, nullptr, diags);
       else if (v->kind == ValueKind::List || v->kind == ValueKind::Typed)
         for (const Value &c : meta.children(*v))
           stack.push_back(&c);
     }
   }
-  for (size_t i = 0; i < entries.size() && !diags.limitReached(); ++i) {
+}
+
+size_t checkInstances(const Part21File &file, DiagnosticEngine &diags, const InstanceVisitor &visit) {
+  // Anchors first: they precede the DATA sections in a file.
+  checkAnchorReferences(file, diags);
+  ValueArena arena;
+  size_t clean = 0;
+  for (size_t i = 0; i < file.entries().size() && !diags.limitReached(); ++i) {
     if (!file.decodeInstance(i, arena, &diags))
       continue;
     ++clean;
-    for (const Value &v : arena.values())
-      if (v.kind == ValueKind::Reference)
-        checkRef(v, entries[i].begin, &entries[i]);
+    checkReferences(file, i, arena, diags);
+    if (visit)
+      visit(i, arena);
   }
   return clean;
 }

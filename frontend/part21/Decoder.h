@@ -2,6 +2,7 @@
 // other layers call Part21File::decodeInstance).
 #pragma once
 
+#include "frontend/part21/Lexing.h"
 #include "frontend/part21/Part21File.h"
 
 #include <string>
@@ -23,16 +24,24 @@ public:
   const char *parseParamList(const char *p, const char *end, std::vector<Value> &out);
   /// One parameter at `p`.
   const char *parseSingleParam(const char *p, const char *end, Value &out);
-  /// A whole data instance `#id = ... ;` starting at its '#'.
-  bool parseInstance(const char *p, const char *end);
+  /// A whole data instance `#id = ... ;` starting at its '#'; `known` is its
+  /// entity name from the instance table (kComplexInstance for complex ones).
+  bool parseInstance(const char *p, const char *end, NameId known);
 
-  void setEntityName(std::string name) { entityName_ = std::move(name); }
+  /// Names the instance in diagnostics (kept as a view: no copy unless reported).
+  void setEntityName(std::string_view name) { entityName_ = name; }
 
 private:
-  bool layout();
+  /// Skips white space and comments; the common case (none) stays inline.
+  bool layout() {
+    if (p_ < end_ && !lex::isSpace(*p_) && *p_ != '/')
+      return true;
+    return skipLayoutSlow();
+  }
+  bool skipLayoutSlow();
   bool parseParam(unsigned depth);
   bool parseListInto(unsigned depth, Value &list);
-  bool parseRecordBody(Record &out);
+  bool parseRecordBody(Record &out, NameId known = kNoName);
   bool parseString(Value &v);
   bool parseNumber(Value &v);
   bool parseBinary(Value &v);
@@ -46,7 +55,7 @@ private:
   const char *base_;
   InstanceId id_;
   const char *context_;
-  std::string entityName_;
+  std::string_view entityName_;
   const char *p_ = nullptr;
   const char *end_ = nullptr;
   std::vector<Value> &scratch_;

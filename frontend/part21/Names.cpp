@@ -1,20 +1,29 @@
 #include "frontend/part21/Names.h"
 
-namespace stepnc::p21 {
+#include <cstring>
 
-namespace {
-inline char upper(char c) { return (c >= 'a' && c <= 'z') ? static_cast<char>(c - 32) : c; }
-} // namespace
+namespace stepnc::p21 {
 
 NameTable::NameTable() : slots_(256, kNoName) {}
 
+// Eight bytes at a time with a multiply-xorshift mix: names are short (10-40
+// bytes), so this is a handful of multiplies per lookup.
 uint64_t NameTable::hash(std::string_view s) {
-  uint64_t h = 1469598103934665603ull;  // FNV-1a
-  for (char c : s) {
-    h ^= static_cast<unsigned char>(c);
-    h *= 1099511628211ull;
+  uint64_t h = 0x9E3779B97F4A7C15ull ^ s.size();
+  const char *p = s.data();
+  size_t n = s.size();
+  while (n >= 8) {
+    uint64_t w;
+    std::memcpy(&w, p, 8);
+    h = (h ^ w) * 0xBF58476D1CE4E5B9ull;
+    h ^= h >> 31;
+    p += 8;
+    n -= 8;
   }
-  return h;
+  uint64_t tail = 0;
+  std::memcpy(&tail, p, n);
+  h = (h ^ tail) * 0x94D049BB133111EBull;
+  return h ^ (h >> 29);
 }
 
 NameId NameTable::find(std::string_view name) const {
@@ -29,16 +38,18 @@ NameId NameTable::find(std::string_view name) const {
 }
 
 NameId NameTable::intern(std::string_view name) {
-  bool hasLower = false;
   for (char c : name)
-    hasLower |= (c >= 'a' && c <= 'z');
-  std::string upperCopy;
-  if (hasLower) {
-    upperCopy.reserve(name.size());
-    for (char c : name)
-      upperCopy.push_back(upper(c));
-    name = upperCopy;
-  }
+    if (c >= 'a' && c <= 'z') {
+      std::string upper(name);
+      for (char &u : upper)
+        if (u >= 'a' && u <= 'z')
+          u = static_cast<char>(u - 32);
+      return internUpper(upper);
+    }
+  return internUpper(name);
+}
+
+NameId NameTable::internUpper(std::string_view name) {
   const size_t mask = slots_.size() - 1;
   size_t i = hash(name) & mask;
   for (;; i = (i + 1) & mask) {

@@ -11,13 +11,15 @@ namespace stepnc::p21 {
 using NameId = uint32_t;
 inline constexpr NameId kNoName = UINT32_MAX;
 
-/// Maps names to dense ids with an open-addressing hash table. Lookups take the
-/// name as written; names are stored upper-cased.
+/// Maps names to dense ids with an open-addressing hash table. Names are
+/// stored upper-cased.
 class NameTable {
 public:
   NameTable();
   /// Returns the id of `name` (upper-cased), adding it if new.
   NameId intern(std::string_view name);
+  /// As intern(), for a name the caller knows to have no lower-case letters.
+  NameId internUpper(std::string_view name);
   /// Returns the id of `name` or kNoName; `name` must already be upper case.
   NameId find(std::string_view name) const;
   std::string_view name(NameId id) const { return names_[id]; }

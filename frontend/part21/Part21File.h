@@ -15,6 +15,7 @@
 #include "support/SourceFile.h"
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -25,12 +26,70 @@ namespace stepnc::p21 {
 /// Marks an instance-table entry whose instance is complex: `#1=(A()B());`.
 inline constexpr NameId kComplexInstance = UINT32_MAX - 1;
 
-/// One `#id=...;` in the instance table (24 bytes).
+/// One `#id=...;` in the instance table: 16 bytes, its id, the offset of its
+/// '#' (40 bits: files up to 1 TiB) and its entity name (24 bits).
 struct InstanceEntry {
+  static constexpr uint64_t kMaxBegin = (uint64_t{1} << 40) - 1;
+  static constexpr uint32_t kComplexCode = (1u << 24) - 1;
+  static constexpr uint32_t kMaxNames = kComplexCode;
+
   InstanceId id = 0;
-  uint64_t begin = 0;   ///< offset of '#'
-  uint32_t length = 0;  ///< bytes up to and including ';'
-  NameId name = kNoName;  ///< entity name, or kComplexInstance
+  uint64_t packed = 0;
+
+  InstanceEntry() = default;
+  InstanceEntry(InstanceId instanceId, uint64_t beginOffset, NameId entityName)
+      : id(instanceId),
+        packed(beginOffset | (uint64_t{entityName == kComplexInstance ? kComplexCode : entityName} << 40)) {}
+
+  /// Offset of the instance's '#' in the file.
+  uint64_t begin() const { return packed & kMaxBegin; }
+  /// Entity name, or kComplexInstance.
+  NameId name() const {
+    const auto n = static_cast<uint32_t>(packed >> 40);
+    return n == kComplexCode ? kComplexInstance : n;
+  }
+};
+static_assert(sizeof(InstanceEntry) == 16);
+
+/// Maps instance ids to instance-table entries. For ids up to a few times the
+/// number of instances (the usual case) it is a bitmap of the ids present with
+/// a rank count per 64 ids (about 0.2 bytes per id); when the entries are in
+/// ascending id order, as writers emit them, the rank is the entry index and
+/// nothing else is stored. Otherwise a rank -> entry table is added, and very
+/// sparse ids fall back to sorted pairs.
+class IdIndex {
+public:
+  /// Builds the index; calls `duplicate(first, second)` (entry indexes) for
+  /// each repeated id.
+  void build(const std::vector<InstanceEntry> &entries,
+             const std::function<void(uint32_t first, uint32_t second)> &duplicate);
+  /// Entry index of `id`, or -1.
+  int64_t find(InstanceId id) const {
+    if (!sparse_.empty() || bits_.empty())
+      return findSparse(id);
+    if (id > maxId_)
+      return -1;
+    const uint64_t word = bits_[static_cast<size_t>(id >> 6)];
+    const uint64_t bit = uint64_t{1} << (id & 63);
+    if (!(word & bit))
+      return -1;
+    const uint32_t rank = ranks_[static_cast<size_t>(id >> 6)] +
+                          static_cast<uint32_t>(__builtin_popcountll(word & (bit - 1)));
+    return order_.empty() ? rank : order_[rank];
+  }
+  /// Bytes used, for reports.
+  size_t bytes() const {
+    return bits_.size() * 8 + ranks_.size() * 4 + order_.size() * 4 + sparse_.size() * 16;
+  }
+
+private:
+  int64_t findSparse(InstanceId id) const;
+
+  InstanceId maxId_ = 0;
+  std::vector<uint64_t> bits_;
+  std::vector<uint32_t> ranks_;
+  std::vector<uint32_t> order_;
+  std::vector<std::pair<InstanceId, uint32_t>> sparse_;
 };
 
 /// A header entity such as FILE_NAME(...) with its decoded parameters.
@@ -76,6 +135,7 @@ public:
   /// Interns a name; decoding adds the names of typed parameters and complex
   /// records to the table, which is why this is const.
   NameId intern(std::string_view name) const { return names_.intern(name); }
+  NameId internUpper(std::string_view name) const { return names_.internUpper(name); }
 
   const std::vector<HeaderEntity> &header() const { return header_; }
   /// The header entity named `name` (upper case), if present.
@@ -92,7 +152,7 @@ public:
   /// Every instance in file order.
   const std::vector<InstanceEntry> &entries() const { return entries_; }
   /// Index into entries() of instance `id`, or -1.
-  int64_t indexOf(InstanceId id) const;
+  int64_t indexOf(InstanceId id) const { return index_.find(id); }
   const InstanceEntry *find(InstanceId id) const {
     int64_t i = indexOf(id);
     return i < 0 ? nullptr : &entries_[static_cast<size_t>(i)];
@@ -127,9 +187,7 @@ private:
   std::vector<Anchor> anchors_;
   std::vector<ExternalReference> references_;
   std::vector<InstanceEntry> entries_;
-  // id -> entry index: dense table when ids are compact, sorted pairs otherwise.
-  std::vector<uint32_t> denseIndex_;
-  std::vector<std::pair<InstanceId, uint32_t>> sparseIndex_;
+  IdIndex index_;
 };
 
 /// Reads the structure of a Part 21 file and builds its instance table.
@@ -139,9 +197,19 @@ private:
 std::unique_ptr<Part21File> readPart21(const SourceFile &source, DiagnosticEngine &diags,
                                        const ReadOptions &options = {});
 
+/// Reports references of instance `index` (decoded in `values`) to ids that are
+/// not defined. Used by checkInstances and by the writer.
+void checkReferences(const Part21File &file, size_t index, const ValueArena &values, DiagnosticEngine &diags);
+/// Reports references in the ANCHOR section to ids that are not defined.
+void checkAnchorReferences(const Part21File &file, DiagnosticEngine &diags);
+
+/// Called with each instance that decoded cleanly (entry index, its values).
+using InstanceVisitor = std::function<void(size_t index, const ValueArena &values)>;
+
 /// Decodes every instance and checks every reference (in the DATA and ANCHOR
-/// sections) against the instance table. Returns the number of instances that
-/// decoded cleanly.
-size_t checkInstances(const Part21File &file, DiagnosticEngine &diags);
+/// sections) against the instance table; `visit`, if given, sees each cleanly
+/// decoded instance, so later checks need not decode it again. Returns the
+/// number of instances that decoded cleanly.
+size_t checkInstances(const Part21File &file, DiagnosticEngine &diags, const InstanceVisitor &visit = {});
 
 } // namespace stepnc::p21

@@ -14,6 +14,10 @@
 
 #include <algorithm>
 #include <cstring>
+#include <sys/mman.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace stepnc::p21 {
 
@@ -65,6 +69,7 @@ private:
 
   void parseHeader(const char *sectionStart);
   void checkHeader(const char *sectionStart);
+  void reserveEntries();
   void parseData(const char *sectionStart);
   void parseAnchor();
   void parseReference();
@@ -135,6 +140,10 @@ void Reader::skipStatement() {
 }
 
 void Reader::run() {
+  if (static_cast<uint64_t>(end_ - base_) > InstanceEntry::kMaxBegin) {
+    diags_.error(loc(base_), "files larger than 1 TiB are not supported");
+    return;
+  }
   if (!layout())
     return;
   if (p_ == end_) {
@@ -256,6 +265,25 @@ void Reader::checkHeader(const char *sectionStart) {
       diags_.warning(loc(sectionStart), std::string("header has no ") + required + " entity");
 }
 
+// Reserves the instance table for the rest of the file (instances are rarely
+// shorter than 32 bytes), so it is never copied while growing; pages never
+// written cost no memory. Huge pages cut the page faults of filling it.
+void Reader::reserveEntries() {
+  auto &entries = file_.entries_;
+  const size_t estimate = entries.size() + static_cast<size_t>(end_ - p_) / 32 + 16;
+  if (estimate <= entries.capacity())
+    return;
+  entries.reserve(estimate);
+  const size_t bytes = entries.capacity() * sizeof(InstanceEntry);
+  if (bytes >= (size_t{4} << 20)) {
+    const auto page = uintptr_t{2} << 20;
+    const auto from = (reinterpret_cast<uintptr_t>(entries.data()) + page - 1) & ~(page - 1);
+    const auto to = (reinterpret_cast<uintptr_t>(entries.data()) + bytes) & ~(page - 1);
+    if (to > from)
+      ::madvise(reinterpret_cast<void *>(from), to - from, MADV_HUGEPAGE);
+  }
+}
+
 void Reader::parseData(const char *sectionStart) {
   DataSection section;
   section.begin = off(sectionStart);
@@ -276,6 +304,7 @@ void Reader::parseData(const char *sectionStart) {
   } else if (!expectSemicolon("'DATA'")) {
     skipStatement();
   }
+  reserveEntries();
   section.firstEntry = static_cast<uint32_t>(file_.entries_.size());
   for (;;) {
     if (!layout() || fatal_)
@@ -336,18 +365,26 @@ bool Reader::scanInstance() {
     const char *n = p_;
     if (*p_ == '!')
       ++p_;
-    bool lower = false;
-    while (p_ < end_ && isKeywordChar(*p_)) {
-      lower |= (*p_ >= 'a' && *p_ <= 'z');
-      ++p_;
+    uint8_t classes = 0;
+    while (p_ < end_ && isKeywordChar(*p_))
+      classes |= classOf(*p_++);
+    const std::string_view text(n, static_cast<size_t>(p_ - n));
+    if (classes & kLower) {
+      if (!warnedLowercase_) {
+        warnedLowercase_ = true;
+        diags_.warning(loc(n), "entity name '" + std::string(text) +
+                                   "' has lower-case letters; Part 21 keywords are upper case "
+                                   "(read as upper case; further cases not reported)");
+      }
+      name = file_.names_.intern(text);
+    } else {
+      name = file_.names_.internUpper(text);
     }
-    if (lower && !warnedLowercase_) {
-      warnedLowercase_ = true;
-      diags_.warning(loc(n), "entity name '" + std::string(n, p_) +
-                                 "' has lower-case letters; Part 21 keywords are upper case "
-                                 "(read as upper case; further cases not reported)");
+    if (name >= InstanceEntry::kMaxNames) {
+      diags_.error(loc(n), "more than 16 million distinct entity names");
+      fatal_ = true;
+      return false;
     }
-    name = file_.names_.intern({n, static_cast<size_t>(p_ - n)});
   } else {
     if (p_ < end_ && static_cast<unsigned char>(*p_) >= 0x80)
       diags_.error(loc(p_), "non-ASCII byte outside a string");
@@ -358,13 +395,7 @@ bool Reader::scanInstance() {
   const char *stop = scanBody(p_, start);
   if (!stop)
     return false;
-  const uint64_t length = static_cast<uint64_t>(stop - start);
-  if (length > UINT32_MAX) {
-    diags_.error(loc(start), "instance " + hashId(id) + " is longer than 4 GiB");
-    p_ = stop;
-    return true;
-  }
-  file_.entries_.push_back({id, off(start), static_cast<uint32_t>(length), name});
+  file_.entries_.emplace_back(id, off(start), name);
   p_ = stop;
   return true;
 }
@@ -372,11 +403,40 @@ bool Reader::scanInstance() {
 // Finds the end of an instance body starting at `q` (just after the name, or
 // at '(' for a complex instance). Returns the position after the ';', or after
 // the closing ')' when the ';' is missing (reported), or null at end of file.
+// Skips bytes the body scanner need not look at. SSE2 compares 16 bytes at a
+// time against the six bytes that matter; loads never pass `end`, so this is
+// also clean under AddressSanitizer on heap-backed sources.
+inline const char *skipPlain(const char *q, const char *end) {
+#if defined(__SSE2__)
+  const __m128i quote = _mm_set1_epi8('\'');
+  const __m128i semi = _mm_set1_epi8(';');
+  const __m128i slash = _mm_set1_epi8('/');
+  const __m128i open = _mm_set1_epi8('(');
+  const __m128i close = _mm_set1_epi8(')');
+  const __m128i nul = _mm_setzero_si128();
+  while (end - q >= 16) {
+    const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i *>(q));
+    const __m128i hit = _mm_or_si128(
+        _mm_or_si128(_mm_or_si128(_mm_cmpeq_epi8(v, quote), _mm_cmpeq_epi8(v, semi)),
+                     _mm_or_si128(_mm_cmpeq_epi8(v, slash), _mm_cmpeq_epi8(v, open))),
+        _mm_or_si128(_mm_cmpeq_epi8(v, close), _mm_cmpeq_epi8(v, nul)));
+    const int mask = _mm_movemask_epi8(hit);
+    if (mask)
+      return q + __builtin_ctz(static_cast<unsigned>(mask));
+    q += 16;
+  }
+#else
+  (void)end;
+#endif
+  while (kBody.cls[static_cast<uint8_t>(*q)] == kPlain)
+    ++q;
+  return q;
+}
+
 const char *Reader::scanBody(const char *q, const char *instanceStart) {
   int depth = 0;
   for (;;) {
-    while (kBody.cls[static_cast<uint8_t>(*q)] == kPlain)
-      ++q;
+    q = skipPlain(q, end_);
     switch (kBody.cls[static_cast<uint8_t>(*q)]) {
     case kSemicolon:
       return q + 1;
@@ -541,57 +601,76 @@ void Reader::skipSignature(const char *sectionStart) {
   fatal_ = true;
 }
 
-void Part21File::buildIndex(DiagnosticEngine &diags) {
-  const auto n = entries_.size();
-  InstanceId maxId = 0;
-  for (const InstanceEntry &e : entries_)
-    maxId = std::max(maxId, e.id);
-  auto reportDuplicate = [&](uint32_t first, uint32_t second) {
-    const InstanceEntry &a = entries_[first];
-    const InstanceEntry &b = entries_[second];
-    diags.error(loc(b.begin), "duplicate instance id " + hashId(b.id))
-        .entity(b.id, std::string(entityName(b)))
-        .note(loc(a.begin), hashId(a.id) + " first defined here");
-  };
-  // Dense table when ids are compact enough (the usual case), else sorted pairs.
-  if (maxId <= 4 * static_cast<uint64_t>(n) + 1024) {
-    denseIndex_.assign(static_cast<size_t>(maxId) + 1, UINT32_MAX);
-    for (uint32_t i = 0; i < n; ++i) {
-      uint32_t &slot = denseIndex_[static_cast<size_t>(entries_[i].id)];
-      if (slot != UINT32_MAX)
-        reportDuplicate(slot, i);
-      else
-        slot = i;
-    }
-  } else {
-    sparseIndex_.reserve(n);
+void IdIndex::build(const std::vector<InstanceEntry> &entries,
+                    const std::function<void(uint32_t, uint32_t)> &duplicate) {
+  *this = IdIndex();
+  const size_t n = entries.size();
+  bool ascending = true;
+  for (size_t i = 0; i < n; ++i) {
+    maxId_ = std::max(maxId_, entries[i].id);
+    if (i > 0 && entries[i].id <= entries[i - 1].id)
+      ascending = false;
+  }
+  if (maxId_ > 64 * static_cast<uint64_t>(n) + 65536) {
+    // Very sparse ids: sorted (id, entry) pairs.
+    sparse_.reserve(n);
     for (uint32_t i = 0; i < n; ++i)
-      sparseIndex_.emplace_back(entries_[i].id, i);
-    std::sort(sparseIndex_.begin(), sparseIndex_.end());
-    std::vector<std::pair<InstanceId, uint32_t>> unique;
-    unique.reserve(n);
-    for (const auto &p : sparseIndex_) {
-      if (!unique.empty() && unique.back().first == p.first)
-        reportDuplicate(unique.back().second, p.second);
-      else
-        unique.push_back(p);
+      sparse_.emplace_back(entries[i].id, i);
+    std::stable_sort(sparse_.begin(), sparse_.end(),
+                     [](const auto &a, const auto &b) { return a.first < b.first; });
+    size_t out = 0;
+    for (size_t i = 0; i < sparse_.size(); ++i) {
+      if (out > 0 && sparse_[out - 1].first == sparse_[i].first) {
+        duplicate(sparse_[out - 1].second, sparse_[i].second);
+        continue;
+      }
+      sparse_[out++] = sparse_[i];
     }
-    sparseIndex_.swap(unique);
+    sparse_.resize(out);
+    return;
+  }
+  const size_t words = static_cast<size_t>(maxId_ >> 6) + 1;
+  bits_.assign(words, 0);
+  for (const InstanceEntry &e : entries)
+    bits_[static_cast<size_t>(e.id >> 6)] |= uint64_t{1} << (e.id & 63);
+  ranks_.resize(words);
+  uint32_t rank = 0;
+  for (size_t w = 0; w < words; ++w) {
+    ranks_[w] = rank;
+    rank += static_cast<uint32_t>(__builtin_popcountll(bits_[w]));
+  }
+  if (ascending)
+    return;  // entry index == rank
+  order_.assign(rank, UINT32_MAX);
+  for (uint32_t i = 0; i < n; ++i) {
+    const InstanceId id = entries[i].id;
+    const uint64_t word = bits_[static_cast<size_t>(id >> 6)];
+    const uint64_t bit = uint64_t{1} << (id & 63);
+    const uint32_t r = ranks_[static_cast<size_t>(id >> 6)] +
+                       static_cast<uint32_t>(__builtin_popcountll(word & (bit - 1)));
+    if (order_[r] != UINT32_MAX)
+      duplicate(order_[r], i);
+    else
+      order_[r] = i;
   }
 }
 
-int64_t Part21File::indexOf(InstanceId id) const {
-  if (!denseIndex_.empty() || sparseIndex_.empty()) {
-    if (id >= denseIndex_.size())
-      return -1;
-    uint32_t i = denseIndex_[static_cast<size_t>(id)];
-    return i == UINT32_MAX ? -1 : static_cast<int64_t>(i);
-  }
-  auto it = std::lower_bound(sparseIndex_.begin(), sparseIndex_.end(),
-                             std::make_pair(id, uint32_t{0}));
-  if (it == sparseIndex_.end() || it->first != id)
+int64_t IdIndex::findSparse(InstanceId id) const {
+  auto it = std::lower_bound(sparse_.begin(), sparse_.end(), id,
+                             [](const auto &p, InstanceId v) { return p.first < v; });
+  if (it == sparse_.end() || it->first != id)
     return -1;
   return it->second;
+}
+
+void Part21File::buildIndex(DiagnosticEngine &diags) {
+  index_.build(entries_, [&](uint32_t first, uint32_t second) {
+    const InstanceEntry &a = entries_[first];
+    const InstanceEntry &b = entries_[second];
+    diags.error(loc(b.begin()), "duplicate instance id " + hashId(b.id))
+        .entity(b.id, std::string(entityName(b)))
+        .note(loc(a.begin()), hashId(a.id) + " first defined here");
+  });
 }
 
 bool Part21File::isDefined(InstanceId id) const {

@@ -82,16 +82,16 @@ void appendString(std::string &out, std::string_view s) {
 
 void appendReal(std::string &out, double value) {
   // Shortest exact digits; unlike formatShortest, -0 stays -0 so that the
-  // graph reads back bit for bit.
+  // graph reads back bit for bit. Part 21 wants a decimal point and 'E'.
   char digits[64];
   auto r = std::to_chars(digits, digits + sizeof digits, value);
-  std::string s(digits, r.ptr);
-  size_t e = s.find('e');
-  std::string mantissa = s.substr(0, e);
-  if (mantissa.find('.') == std::string::npos)
-    mantissa += '.';
+  const std::string_view s(digits, static_cast<size_t>(r.ptr - digits));
+  const size_t e = s.find('e');
+  const std::string_view mantissa = s.substr(0, e);
   out += mantissa;
-  if (e != std::string::npos) {
+  if (mantissa.find('.') == std::string_view::npos)
+    out += '.';
+  if (e != std::string_view::npos) {
     out += 'E';
     out += s.substr(e + 1);
   }
@@ -150,8 +150,8 @@ void appendRecord(std::string &out, const Record &r, const ValueArena &arena, co
   out.push_back(')');
 }
 
-bool writePart21(const Part21File &file, OutputFile &out, DiagnosticEngine &diags) {
-  return writePart21(file, [&out](std::string_view chunk) { out.write(chunk); }, diags);
+bool writePart21(const Part21File &file, OutputFile &out, DiagnosticEngine &diags, const WriteOptions &options) {
+  return writePart21(file, [&out](std::string_view chunk) { out.write(chunk); }, diags, options);
 }
 
 std::string writePart21ToString(const Part21File &file, DiagnosticEngine &diags, bool *ok) {
@@ -162,7 +162,11 @@ std::string writePart21ToString(const Part21File &file, DiagnosticEngine &diags,
   return text;
 }
 
-bool writePart21(const Part21File &file, const ByteSink &sink, DiagnosticEngine &diags) {
+bool writePart21(const Part21File &file, const ByteSink &sink, DiagnosticEngine &diags,
+                 const WriteOptions &options) {
+  const unsigned errorsBefore = diags.errorCount();
+  if (options.checkReferences)
+    checkAnchorReferences(file, diags);
   const NameTable &names = file.names();
   const ValueArena &meta = file.metadata();
   std::string buf;
@@ -221,18 +225,23 @@ bool writePart21(const Part21File &file, const ByteSink &sink, DiagnosticEngine 
     buf += ";\n";
     order.resize(section.endEntry - section.firstEntry);
     std::iota(order.begin(), order.end(), section.firstEntry);
-    std::stable_sort(order.begin(), order.end(),
-                     [&](uint32_t x, uint32_t y) { return entries[x].id < entries[y].id; });
+    // Writers usually emit ascending ids already; sort only when they did not.
+    if (!std::is_sorted(order.begin(), order.end(),
+                        [&](uint32_t x, uint32_t y) { return entries[x].id < entries[y].id; }))
+      std::stable_sort(order.begin(), order.end(),
+                       [&](uint32_t x, uint32_t y) { return entries[x].id < entries[y].id; });
     for (uint32_t i : order) {
       if (!file.decodeInstance(i, arena, &diags)) {
         ok = false;
         continue;
       }
+      if (options.checkReferences)
+        checkReferences(file, i, arena, diags);
       buf.push_back('#');
       buf += std::to_string(entries[i].id);
       buf.push_back('=');
       const auto records = arena.records();
-      if (entries[i].name == kComplexInstance) {
+      if (entries[i].name() == kComplexInstance) {
         buf.push_back('(');
         for (const Record &r : records)
           appendRecord(buf, r, arena, names);
@@ -247,7 +256,7 @@ bool writePart21(const Part21File &file, const ByteSink &sink, DiagnosticEngine 
   }
   buf += "END-ISO-10303-21;\n";
   flush(true);
-  return ok;
+  return ok && diags.errorCount() == errorsBefore;
 }
 
 // --- graph comparison ----------------------------------------------------------

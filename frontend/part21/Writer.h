@@ -28,10 +28,18 @@ void appendReal(std::string &out, double value);
 /// Receives the written text in chunks of about 64 KiB.
 using ByteSink = std::function<void(std::string_view)>;
 
+struct WriteOptions {
+  /// Also report references to undefined ids (and fail on them), so a caller
+  /// that writes what it reads needs to decode each instance only once.
+  bool checkReferences = false;
+};
+
 /// Writes `file` in canonical form. Instances that fail to decode are reported
 /// and make the call fail; the caller then discards the output.
-bool writePart21(const Part21File &file, const ByteSink &sink, DiagnosticEngine &diags);
-bool writePart21(const Part21File &file, OutputFile &out, DiagnosticEngine &diags);
+bool writePart21(const Part21File &file, const ByteSink &sink, DiagnosticEngine &diags,
+                 const WriteOptions &options = {});
+bool writePart21(const Part21File &file, OutputFile &out, DiagnosticEngine &diags,
+                 const WriteOptions &options = {});
 /// Convenience for small files and tests: the canonical text as a string.
 std::string writePart21ToString(const Part21File &file, DiagnosticEngine &diags, bool *ok = nullptr);
 

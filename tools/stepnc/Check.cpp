@@ -43,12 +43,14 @@ void printStats(const p21::Part21File &file) {
 /// Returns the schema checked against (null if none).
 const express::Schema *checkFile(const p21::Part21File &file, const SchemaSelection &schemas,
                                  DiagnosticEngine &diags) {
-  if (!diags.limitReached())
-    p21::checkInstances(file, diags);
+  if (diags.limitReached())
+    return nullptr;
   const express::Model *model = nullptr;
-  const express::Schema *schema = diags.limitReached() ? nullptr : schemas.select(file, diags, model);
+  const express::Schema *schema = schemas.select(file, diags, model);
   if (schema)
-    binding::bind(file, *model, *schema, diags);
+    binding::bind(file, *model, *schema, diags);  // includes the Part 21 reference check
+  else
+    p21::checkInstances(file, diags);
   return schema;
 }
 

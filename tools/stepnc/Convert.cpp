@@ -43,20 +43,22 @@ int runConvert(const ConvertOptions &opts) {
   DiagnosticSession session(opts.diag);
   DiagnosticEngine &diags = session.engine();
   auto file = p21::readPart21(*source, diags);
-  if (!diags.limitReached())
-    p21::checkInstances(*file, diags);
-  if (diags.hasErrors()) {
+  auto nothingWritten = [&] {
     std::cerr << "stepnc: " << opts.input << " has errors; nothing written\n";
     return kExitDiagnostics;
-  }
+  };
+  if (diags.hasErrors())
+    return nothingWritten();
   OutputFile out;
   std::string error;
   if (!out.open(opts.output, error)) {
     printToolError(error);
     return kExitUsage;
   }
-  if (!p21::writePart21(*file, out, diags))
-    return kExitDiagnostics;  // `out` discards the temporary file
+  // One pass: decode, check references and write; on any error `out`
+  // discards the temporary file.
+  if (!p21::writePart21(*file, out, diags, {.checkReferences = true}))
+    return nothingWritten();
   if (!out.commit(error)) {
     printToolError(error);
     return kExitUsage;

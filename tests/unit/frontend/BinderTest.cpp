@@ -76,7 +76,6 @@ std::unique_ptr<Result> bindText(std::string_view data, bool strict = false) {
                                                   std::string(data) + "ENDSEC;\nEND-ISO-10303-21;\n");
   DiagnosticEngine engine(r->diags);
   r->file = p21::readPart21(*r->source, engine);
-  p21::checkInstances(*r->file, engine);
   binding::BindOptions opts;
   opts.aliases = &fixture().aliases;
   opts.strict = strict;

@@ -106,14 +106,14 @@ TEST_CASE("every parameter kind decodes", "[part21]") {
   CHECK(arena.children(p[14])[0].real == 2.5);
   // Offsets point at each value in the source.
   const auto &e = l->file->entries()[0];
-  CHECK(l->source->text().substr(e.begin + p[6].offset, 3) == "'s'");
+  CHECK(l->source->text().substr(e.begin() + p[6].offset, 3) == "'s'");
 }
 
 TEST_CASE("complex instances decode into their records", "[part21]") {
   auto l = load(withData("#20=(NAMED_UNIT(*)PLANE_ANGLE_UNIT()SI_UNIT($,.RADIAN.));\n"));
   REQUIRE(l->messages().empty());
   const auto &e = l->file->entries()[0];
-  CHECK(e.name == kComplexInstance);
+  CHECK(e.name() == kComplexInstance);
   CHECK(l->file->describe(e) == "NAMED_UNIT+PLANE_ANGLE_UNIT+SI_UNIT");
   ValueArena arena;
   REQUIRE(l->file->decodeInstance(0, arena, nullptr));

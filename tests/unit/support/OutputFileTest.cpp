@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <sys/stat.h>
 
 using namespace stepnc;
 namespace fs = std::filesystem;
@@ -65,4 +66,20 @@ TEST_CASE("opening in a missing directory reports the path", "[support]") {
   std::string error;
   CHECK_FALSE(out.open("/nonexistent-dir-for-stepnc/x.stp", error));
   CHECK(error.find("/nonexistent-dir-for-stepnc/x.stp") != std::string::npos);
+}
+
+TEST_CASE("a device target is written in place, never replaced", "[support]") {
+  std::string error;
+  OutputFile out;
+  REQUIRE(out.open("/dev/null", error));
+  out.write("discarded\n");
+  REQUIRE(out.commit(error));
+  struct stat st {};
+  REQUIRE(::stat("/dev/null", &st) == 0);
+  CHECK(S_ISCHR(st.st_mode));
+  fs::path dir = scratchDir();
+  OutputFile toDir;
+  CHECK_FALSE(toDir.open(dir.string(), error));
+  CHECK(error.find("is a directory") != std::string::npos);
+  fs::remove_all(dir);
 }
