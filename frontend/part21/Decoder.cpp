@@ -145,7 +145,7 @@ bool Decoder::fail(const char *at, std::string message) {
     auto d = diags_->error(file_.loc(static_cast<uint64_t>(at - file_.source().begin())),
                            std::move(message));
     if (id_ != 0)
-      d.entity(id_, std::string(entityName_));
+      d.entity(id_, entityName_ == kNoName ? std::string() : std::string(file_.names().name(entityName_)));
   }
   return false;
 }
@@ -663,7 +663,7 @@ bool Part21File::decodeInstance(size_t index, ValueArena &arena, DiagnosticEngin
   Decoder dec(*this, arena, diags, begin, e.id, "instance");
   const NameId name = e.name();
   if (diags && name != kComplexInstance)
-    dec.setEntityName(names_.name(name));
+    dec.setEntityName(name);
   return dec.parseInstance(begin, source_->end(), name);
 }
 

@@ -28,8 +28,9 @@ public:
   /// entity name from the instance table (kComplexInstance for complex ones).
   bool parseInstance(const char *p, const char *end, NameId known);
 
-  /// Names the instance in diagnostics (kept as a view: no copy unless reported).
-  void setEntityName(std::string_view name) { entityName_ = name; }
+  /// Names the instance in diagnostics. An id, not a view: decoding may add
+  /// names to the table, which may move the stored strings.
+  void setEntityName(NameId name) { entityName_ = name; }
 
 private:
   /// Skips white space and comments; the common case (none) stays inline.
@@ -55,7 +56,7 @@ private:
   const char *base_;
   InstanceId id_;
   const char *context_;
-  std::string_view entityName_;
+  NameId entityName_ = kNoName;
   const char *p_ = nullptr;
   const char *end_ = nullptr;
   std::vector<Value> &scratch_;

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <deque>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -12,7 +13,8 @@ using NameId = uint32_t;
 inline constexpr NameId kNoName = UINT32_MAX;
 
 /// Maps names to dense ids with an open-addressing hash table. Names are
-/// stored upper-cased.
+/// stored upper-cased, in a deque so that the views name() returns stay valid
+/// while new names are added (decoding interns typed-parameter names).
 class NameTable {
 public:
   NameTable();
@@ -29,7 +31,7 @@ private:
   void grow();
   static uint64_t hash(std::string_view upper);
 
-  std::vector<std::string> names_;
+  std::deque<std::string> names_;
   std::vector<NameId> slots_;  // kNoName = empty
 };
 

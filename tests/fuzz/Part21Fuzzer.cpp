@@ -5,7 +5,7 @@
 //   1. read it (readPart21 + checkInstances, at most kMaxErrors errors) and
 //      render every diagnostic through the text printer (with and without
 //      source lines) and the JSON printer; the JSON must be well-formed UTF-8
-//      JSON;
+//      JSON, and every diagnostic must point inside the input;
 //   2. if the input read without errors:
 //      - it must contain "END-ISO-10303-21" (a file cut short is an error), and
 //        cutting it anywhere before the first "END-ISO-10303-21" must give
@@ -77,7 +77,7 @@ std::string textOf(const std::vector<Diagnostic> &diags) {
 /// Oracle checks listed (comma-separated tags) in $STEPNC_FUZZ_KNOWN are not
 /// enforced, so a long run can get past a known, reported bug. Tags: json,
 /// json-utf8, end-keyword, truncation, self-compare, write, reread,
-/// new-warnings, graph, idempotence, and utf8-lax (see hasLaxUtf8).
+/// new-warnings, graph, idempotence, loc, and utf8-lax (see hasLaxUtf8).
 bool suppressed(std::string_view tag) {
   static const std::string known = [] {
     const char *env = std::getenv("STEPNC_FUZZ_KNOWN");
@@ -326,6 +326,17 @@ void renderDiagnostics(const std::vector<Diagnostic> &diags) {
                   "\n--- text output ---\n" + clip(text.str()));
 }
 
+/// Every located diagnostic (and note) must point into `source`.
+void checkLocations(const std::vector<Diagnostic> &diags, const SourceFile &source) {
+  for (const Diagnostic &d : diags) {
+    if (d.loc.valid() && (d.loc.file != &source || d.loc.offset > source.text().size()))
+      violation("loc", "a diagnostic points outside its source file",
+                "offset " + std::to_string(d.loc.offset) + " of " +
+                    std::to_string(source.text().size()) + " bytes: " + d.message);
+    checkLocations(d.notes, source);
+  }
+}
+
 /// What `stepnc check --stats` asks of every file, errors or not.
 void exerciseQueries(const p21::Part21File &file) {
   size_t total = 0;
@@ -357,6 +368,7 @@ bool writeCanonical(const p21::Part21File &file, const char *which, std::string 
 
 void checkInput(std::string_view input) {
   Parsed first("fuzz-input.p21", input);
+  checkLocations(first.collected.diags, *first.source);
   renderDiagnostics(first.collected.diags);
   exerciseQueries(*first.file);
   if (first.diags.hasErrors())
