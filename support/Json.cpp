@@ -1,27 +1,12 @@
 #include "support/Json.h"
 
 #include "support/Format.h"
+#include "support/Utf8.h"
 
 #include <ostream>
 #include <string>
 
 namespace stepnc::json {
-
-namespace {
-
-// Length of the valid UTF-8 sequence starting at s[i], or 0.
-size_t validUtf8(std::string_view s, size_t i) {
-  const auto c = static_cast<unsigned char>(s[i]);
-  size_t n = c >= 0xF0 ? 4 : c >= 0xE0 ? 3 : c >= 0xC2 ? 2 : 0;
-  if (n == 0 || c > 0xF4 || i + n > s.size())
-    return 0;
-  for (size_t k = 1; k < n; ++k)
-    if ((static_cast<unsigned char>(s[i + k]) & 0xC0) != 0x80)
-      return 0;
-  return n;
-}
-
-} // namespace
 
 void appendQuoted(std::string &out, std::string_view s) {
   static const char *hex = "0123456789abcdef";
@@ -30,7 +15,7 @@ void appendQuoted(std::string &out, std::string_view s) {
     const auto c = static_cast<unsigned char>(s[i]);
     if (c >= 0x80) {
       // JSON must be valid UTF-8: bytes that are not become U+FFFD.
-      size_t n = validUtf8(s, i);
+      size_t n = utf8::sequenceLength(s, i);
       if (n == 0) {
         out += "\\ufffd";
         ++i;

@@ -252,6 +252,20 @@ struct Reader {
   }
 };
 
+// An optional `redeclares=entity.attribute` token.
+void readRedeclaration(Tokens &t, std::string &entity, std::string &attribute) {
+  Tokens save = t;
+  std::string_view maybe;
+  if (t.next(maybe) && maybe.starts_with("redeclares=")) {
+    std::string_view target = maybe.substr(11);
+    size_t dot = target.find('.');
+    entity = std::string(target.substr(0, dot));
+    attribute = std::string(target.substr(dot + 1));
+  } else {
+    t = save;
+  }
+}
+
 std::vector<std::string> split(std::string_view s, char sep) {
   std::vector<std::string> out;
   if (s.empty())
@@ -470,16 +484,7 @@ bool deserializeModel(std::string_view text, Model &model, std::string &error) {
           return failAt("incomplete attribute");
         a.name = std::string(name);
         a.optional = opt == "optional";
-        Tokens save = t;
-        std::string_view maybe;
-        if (t.next(maybe) && maybe.starts_with("redeclares=")) {
-          std::string_view target = maybe.substr(11);
-          size_t dot = target.find('.');
-          a.redeclaresEntity = std::string(target.substr(0, dot));
-          a.redeclaresAttribute = std::string(target.substr(dot + 1));
-        } else {
-          t = save;
-        }
+        readRedeclaration(t, a.redeclaresEntity, a.redeclaresAttribute);
         if (!r.type(t, a.type))
           return failAt(r.error);
         e.attributes.push_back(std::move(a));
@@ -489,16 +494,7 @@ bool deserializeModel(std::string_view text, Model &model, std::string &error) {
         if (!t.next(name))
           return failAt("incomplete derived attribute");
         d.name = std::string(name);
-        Tokens save = t;
-        std::string_view maybe;
-        if (t.next(maybe) && maybe.starts_with("redeclares=")) {
-          std::string_view target = maybe.substr(11);
-          size_t dot = target.find('.');
-          d.redeclaresEntity = std::string(target.substr(0, dot));
-          d.redeclaresAttribute = std::string(target.substr(dot + 1));
-        } else {
-          t = save;
-        }
+        readRedeclaration(t, d.redeclaresEntity, d.redeclaresAttribute);
         if (!r.type(t, d.type))
           return failAt(r.error);
         std::string_view assign;

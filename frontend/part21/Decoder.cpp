@@ -7,6 +7,7 @@
 // ISO 10303-21 §6.4.3: '' and \\, \S\ with the \P?\ code page, \X\hh, \X2\ and
 // \X4\ runs; line breaks inside strings are layout and are dropped.
 #include "support/Format.h"
+#include "support/Utf8.h"
 #include "frontend/part21/Decoder.h"
 
 #include "frontend/part21/Lexing.h"
@@ -38,24 +39,6 @@ const char *valueKindName(ValueKind k) {
 
 namespace {
 
-void appendUtf8(std::string &out, uint32_t cp) {
-  if (cp < 0x80) {
-    out.push_back(static_cast<char>(cp));
-  } else if (cp < 0x800) {
-    out.push_back(static_cast<char>(0xC0 | (cp >> 6)));
-    out.push_back(static_cast<char>(0x80 | (cp & 0x3F)));
-  } else if (cp < 0x10000) {
-    out.push_back(static_cast<char>(0xE0 | (cp >> 12)));
-    out.push_back(static_cast<char>(0x80 | ((cp >> 6) & 0x3F)));
-    out.push_back(static_cast<char>(0x80 | (cp & 0x3F)));
-  } else {
-    out.push_back(static_cast<char>(0xF0 | (cp >> 18)));
-    out.push_back(static_cast<char>(0x80 | ((cp >> 12) & 0x3F)));
-    out.push_back(static_cast<char>(0x80 | ((cp >> 6) & 0x3F)));
-    out.push_back(static_cast<char>(0x80 | (cp & 0x3F)));
-  }
-}
-
 unsigned hexValue(char c) {
   if (c >= '0' && c <= '9')
     return static_cast<unsigned>(c - '0');
@@ -67,7 +50,7 @@ unsigned hexValue(char c) {
 // Converts one byte of ISO 8859-`part` (1..9) to UTF-8; false if unmapped.
 bool appendIso8859(std::string &out, unsigned part, unsigned char byte) {
   if (part == 1 || byte < 0xA0) {
-    appendUtf8(out, byte);
+    utf8::append(out, byte);
     return true;
   }
   std::string from = "ISO-8859-" + std::to_string(part);
@@ -94,38 +77,6 @@ std::string describeByte(char c) {
   char buf[16];
   std::snprintf(buf, sizeof buf, "byte 0x%02X", u);
   return buf;
-}
-
-// Length of the well-formed UTF-8 sequence at p, or 0: no overlong forms, no
-// surrogates, nothing above U+10FFFF (Unicode 15, table 3-7), so that every
-// accepted string re-encodes to the same characters.
-size_t utf8Length(const unsigned char *p, const unsigned char *end) {
-  const unsigned char c = p[0];
-  size_t n;
-  unsigned char lo = 0x80, hi = 0xBF;  // bounds of the second byte
-  if (c >= 0xC2 && c <= 0xDF) {
-    n = 2;
-  } else if (c >= 0xE0 && c <= 0xEF) {
-    n = 3;
-    if (c == 0xE0)
-      lo = 0xA0;
-    else if (c == 0xED)
-      hi = 0x9F;
-  } else if (c >= 0xF0 && c <= 0xF4) {
-    n = 4;
-    if (c == 0xF0)
-      lo = 0x90;
-    else if (c == 0xF4)
-      hi = 0x8F;
-  } else {
-    return 0;
-  }
-  if (static_cast<size_t>(end - p) < n || p[1] < lo || p[1] > hi)
-    return 0;
-  for (size_t i = 2; i < n; ++i)
-    if ((p[i] & 0xC0) != 0x80)
-      return 0;
-  return n;
 }
 
 } // namespace
@@ -347,7 +298,7 @@ bool Decoder::parseString(Value &v) {
         page = static_cast<unsigned>(q[2] - 'A' + 1);
         q += 4;
       } else if (need(5) && q[1] == 'X' && q[2] == '\\' && isHexDigit(q[3]) && isHexDigit(q[4])) {
-        appendUtf8(decoded_, hexValue(q[3]) * 16 + hexValue(q[4]));
+        utf8::append(decoded_, hexValue(q[3]) * 16 + hexValue(q[4]));
         q += 5;
       } else if (need(4) && q[1] == 'X' && (q[2] == '2' || q[2] == '4') && q[3] == '\\') {
         const unsigned width = q[2] == '2' ? 4 : 8;
@@ -379,7 +330,7 @@ bool Decoder::parseString(Value &v) {
           }
           if (cp > 0x10FFFF || (cp >= 0xD800 && cp < 0xE000))
             return fail(esc, "invalid character code in \\X4\\ escape");
-          appendUtf8(decoded_, cp);
+          utf8::append(decoded_, cp);
         }
         if (pendingHigh)
           return fail(esc, "unpaired UTF-16 surrogate in \\X2\\ escape");
@@ -391,8 +342,7 @@ bool Decoder::parseString(Value &v) {
       continue;
     }
     if (c >= 0x80) {
-      size_t n = utf8Length(reinterpret_cast<const unsigned char *>(q),
-                            reinterpret_cast<const unsigned char *>(end_));
+      size_t n = utf8::sequenceLength(std::string_view(q, static_cast<size_t>(end_ - q)), 0);
       if (n == 0)
         return fail(q, "byte in string is neither ASCII nor UTF-8; encode it with \\X\\ or \\X2\\");
       decoded_.append(q, n);

@@ -1,6 +1,7 @@
 #include "frontend/part21/Writer.h"
 
 #include "support/Format.h"
+#include "support/Utf8.h"
 
 #include <algorithm>
 #include <charconv>
@@ -10,22 +11,6 @@
 namespace stepnc::p21 {
 
 namespace {
-
-// Decodes one UTF-8 sequence (input was validated by the decoder, but Part 28
-// and generated strings come here too, so be defensive: bad bytes map to U+FFFD).
-uint32_t nextCodePoint(std::string_view s, size_t &i) {
-  const auto c = static_cast<unsigned char>(s[i]);
-  size_t n = c < 0x80 ? 1 : c >= 0xF0 ? 4 : c >= 0xE0 ? 3 : c >= 0xC0 ? 2 : 0;
-  if (n == 0 || i + n > s.size()) {
-    ++i;
-    return 0xFFFD;
-  }
-  uint32_t cp = n == 1 ? c : n == 2 ? (c & 0x1F) : n == 3 ? (c & 0x0F) : (c & 0x07);
-  for (size_t k = 1; k < n; ++k)
-    cp = (cp << 6) | (static_cast<unsigned char>(s[i + k]) & 0x3F);
-  i += n;
-  return cp;
-}
 
 void appendHex(std::string &out, uint32_t v, int digits) {
   static const char *hex = "0123456789ABCDEF";
@@ -51,7 +36,7 @@ void appendString(std::string &out, std::string_view s) {
       continue;
     }
     size_t j = i;
-    uint32_t cp = nextCodePoint(s, j);
+    uint32_t cp = utf8::next(s, j);
     if (cp <= 0xFF) {
       out += "\\X\\";
       appendHex(out, cp, 2);
@@ -64,7 +49,7 @@ void appendString(std::string &out, std::string_view s) {
     size_t k = i;
     while (k < s.size() && static_cast<unsigned char>(s[k]) >= 0x80) {
       size_t next = k;
-      uint32_t v = nextCodePoint(s, next);
+      uint32_t v = utf8::next(s, next);
       if (v <= 0xFF)
         break;
       wide |= v > 0xFFFF;
