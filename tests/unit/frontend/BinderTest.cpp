@@ -1,4 +1,5 @@
 #include "frontend/binding/Binder.h"
+#include "frontend/binding/Instance.h"
 #include "frontend/express/SchemaReader.h"
 
 #include <catch2/catch.hpp>
@@ -220,4 +221,35 @@ TEST_CASE("the alias table format is checked", "[binding]") {
   CHECK(error == "line 1: expected 'entity ALIAS schema_name'");
   CHECK(binding::AliasTable::builtin().entity("BIDIRECTIONAL_MILLING") == "bidirectional");
   CHECK(binding::AliasTable::builtin().entity("CENTER_DRILL") == "centerdrill");
+}
+
+TEST_CASE("instances give typed access to attributes by name", "[binding]") {
+  auto r = bindText("#1=DRILL('d 10',10,118.);\n#2=STEP(#1,(1.,2.5),(),LENGTH_MEASURE(3.),.T.);\n"
+                    "#3=(COATED('tin')DRILL(130.)TOOL('c',8.));\n");
+  binding::Instance step(*r->bound, 1);
+  REQUIRE(step);
+  CHECK(step.entityName() == "step");
+  CHECK(step.id() == 2);
+  CHECK(step.isA("step"));
+  CHECK_FALSE(step.isA("tool"));
+  CHECK(step.real("amount") == 3.0);  // typed value unwrapped
+  CHECK(step.boolean("flag") == true);
+  CHECK(step.reals("passes") == std::vector<double>{1.0, 2.5});
+  CHECK(step.refs("empty_ok").empty());
+  CHECK(step.real("no_such_attribute") == std::nullopt);
+  binding::Instance tool = step.ref("its_tool");
+  REQUIRE(tool);
+  CHECK(tool.isA("tool"));
+  CHECK(tool.string("name") == "d 10");
+  CHECK(tool.real("diameter") == 10.0);  // integer read as a real
+  CHECK(tool.integer("diameter") == 10);
+  binding::Instance coated(*r->bound, 2);
+  CHECK(coated.isA("drill"));
+  CHECK(coated.isA("coated"));
+  CHECK(coated.string("coating") == "tin");
+  CHECK(coated.real("tip_angle") == 130.0);
+  CHECK(coated.real("diameter") == 8.0);
+  LineCol lc = r->source->lineCol(step.attrLoc("passes").offset);
+  CHECK(lc.line == 9);
+  CHECK(lc.col == 12);
 }
