@@ -418,6 +418,14 @@ bool Binder::checkValue(const Value &v, TypeId type, const Context &ctx, bool op
         t.first = entry(ctx.entry).begin() + v.offset;
       return true;
     }
+    if (options_.unsetMandatoryIsWarning && ctx.path.empty()) {
+      const p21::InstanceEntry &e = entry(ctx.entry);
+      diags_.warning(file_.loc(e.begin() + v.offset),
+                     "attribute " + std::to_string(ctx.position) + " '" + (ctx.slot ? ctx.slot->name : "") +
+                         "': '$' (no value) where a value is required (" + expected(type) + "); read as absent")
+          .entity(e.id, entityName(ctx.entry));
+      return true;
+    }
     error(ctx, v, "'$' (no value) where a value is required (" + expected(type) + ")");
     return false;
   }

@@ -60,6 +60,11 @@ struct BindOptions {
   /// mandatory aggregate that may be empty (read as empty) or for a mandatory
   /// string such as a name or label (read as '').
   bool strict = false;
+  /// Report `$` in any other mandatory attribute as a warning ("read as
+  /// absent") instead of an error. Compiling uses this: lowering then reports
+  /// an error only where it needs the value, so a file whose drift does not
+  /// touch what is machined still compiles. `stepnc check` keeps it off.
+  bool unsetMandatoryIsWarning = false;
 };
 
 /// Binds and checks every instance of `file` against `schema` (which must

@@ -5,7 +5,8 @@
 //   1. read it (readPart21 + checkInstances, at most kMaxErrors errors) and
 //      render every diagnostic through the text printer (with and without
 //      source lines) and the JSON printer; the JSON must be well-formed UTF-8
-//      JSON, and every diagnostic must point inside the input;
+//      JSON, and every diagnostic must point inside the input; also run the
+//      --verify-diagnostics expectation parser over the input;
 //   2. if the input read without errors:
 //      - it must contain "END-ISO-10303-21" (a file cut short is an error), and
 //        cutting it anywhere before the first "END-ISO-10303-21" must give
@@ -24,6 +25,7 @@
 #include "frontend/part21/Writer.h"
 #include "support/Diagnostics.h"
 #include "support/SourceFile.h"
+#include "support/VerifyDiagnostics.h"
 
 #include <cctype>
 #include <cstdint>
@@ -88,8 +90,8 @@ bool suppressed(std::string_view tag) {
 
 /// True if `input` has a 3- or 4-byte UTF-8 lead byte followed by a byte that
 /// makes the sequence overlong, a surrogate or beyond U+10FFFF, which the
-/// decoder accepts (regressions/utf8-*.p21). With "utf8-lax" in
-/// $STEPNC_FUZZ_KNOWN such inputs skip the write/read checks.
+/// decoder used to accept (regressions/utf8-*.p21, fixed in afd253d). With
+/// "utf8-lax" in $STEPNC_FUZZ_KNOWN such inputs skip the write/read checks.
 bool hasLaxUtf8(std::string_view input) {
   for (size_t i = 0; i + 1 < input.size(); ++i) {
     const auto c = static_cast<unsigned char>(input[i]);
@@ -370,6 +372,12 @@ void checkInput(std::string_view input) {
   Parsed first("fuzz-input.p21", input);
   checkLocations(first.collected.diags, *first.source);
   renderDiagnostics(first.collected.diags);
+  {
+    // `stepnc check --verify-diagnostics` parses expectations out of the
+    // input's comments: only robustness is checked here.
+    std::ostringstream mismatches;
+    (void)verifyDiagnostics(*first.source, first.collected.diags, mismatches);
+  }
   exerciseQueries(*first.file);
   if (first.diags.hasErrors())
     return;

@@ -54,7 +54,10 @@ if [[ -d $corpus_src ]]; then
 else
   echo "run-fuzz.sh: no sample corpus at $corpus_src; using the hand-made seeds only" >&2
 fi
-for f in "$here"/seeds/* "$here"/regressions/*.p21; do
+# The project's own Part 21 files: hand-made seeds, regressions, the error
+# tests (with --verify-diagnostics annotations), test inputs and the example.
+for f in "$here"/seeds/* "$here"/regressions/*.p21 "$root"/tests/frontend/part21/errors/*.p21 \
+         "$root"/tests/Inputs/*.stp "$root"/examples/*.stp; do
   [[ -f $f ]] && copy_seed "$f" "$(basename "$(dirname "$f")")"
 done
 echo "run-fuzz.sh: $(ls "$seeds" | wc -l) seed files in $seeds" >&2

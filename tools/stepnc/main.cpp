@@ -8,6 +8,7 @@ namespace stepnc::tool {
 void registerCheck(CLI::App &app, std::function<void(int)> setResult);
 void registerConvert(CLI::App &app, std::function<void(int)> setResult);
 void registerSchema(CLI::App &app, std::function<void(int)> setResult);
+void registerCompile(CLI::App &app, std::function<void(int)> setResult);
 } // namespace stepnc::tool
 
 int main(int argc, char **argv) {
@@ -20,6 +21,7 @@ int main(int argc, char **argv) {
   app.footer("Exit status: 0 success, 1 the input has errors, 2 usage or I/O error.");
   int result = kExitOk;
   auto setResult = [&result](int r) { result = r; };
+  registerCompile(app, setResult);
   registerCheck(app, setResult);
   registerConvert(app, setResult);
   registerSchema(app, setResult);

@@ -1,0 +1,297 @@
+// Lowering of geometry: points, directions, placements, planes, toleranced
+// lengths, profiles, travel paths and curves.
+#include "frontend/lowering/Lowerer.h"
+
+#include <cmath>
+
+namespace stepnc::lowering {
+
+std::optional<Vec3> Lowerer::point(const Instance &p) {
+  if (!p || !p.isA("cartesian_point")) {
+    if (p)
+      unsupported(p, "a point was expected");
+    return std::nullopt;
+  }
+  const std::vector<double> c = p.reals("coordinates");
+  if (c.empty() || c.size() > 3) {
+    missing(p, "coordinates", "must have 1 to 3 values");
+    return std::nullopt;
+  }
+  return Vec3(c[0], c.size() > 1 ? c[1] : 0.0, c.size() > 2 ? c[2] : 0.0);
+}
+
+std::optional<Vec3> Lowerer::direction(const Instance &d) {
+  if (!d || !d.isA("direction")) {
+    if (d)
+      unsupported(d, "a direction was expected");
+    return std::nullopt;
+  }
+  const std::vector<double> r = d.reals("direction_ratios");
+  Vec3 v(r.size() > 0 ? r[0] : 0.0, r.size() > 1 ? r[1] : 0.0, r.size() > 2 ? r[2] : 0.0);
+  if (r.size() < 2 || v.norm() < 1e-12) {
+    missing(d, "direction_ratios", "must be a non-zero vector");
+    return std::nullopt;
+  }
+  return v.normalized();
+}
+
+std::optional<Placement> Lowerer::placement(const Instance &a) {
+  if (!a)
+    return std::nullopt;
+  if (!a.isA("axis2_placement_3d")) {
+    unsupported(a, "an axis2_placement_3d was expected");
+    return std::nullopt;
+  }
+  Placement p;
+  if (auto at = point(a.ref("location")))
+    p.at = *at;
+  else {
+    missing(a, "location");
+    return std::nullopt;
+  }
+  if (Instance axis = a.ref("axis"))
+    if (auto v = direction(axis))
+      p.axis = *v;
+  Vec3 ref = Vec3::UnitX();
+  if (Instance r = a.ref("ref_direction"))
+    if (auto v = direction(r))
+      ref = *v;
+  // ISO 10303-42: the x axis is the ref direction projected normal to z; when
+  // it is (nearly) parallel to z, the standard's default takes over.
+  Vec3 x = ref - ref.dot(p.axis) * p.axis;
+  if (x.norm() < 1e-9) {
+    const Vec3 fallback = std::abs(p.axis.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+    x = fallback - fallback.dot(p.axis) * p.axis;
+  }
+  p.ref = x.normalized();
+  return p;
+}
+
+void Lowerer::setPlacement(Node &node, const Placement &p) {
+  node.set("at", Value::point(p.at));
+  node.set("axis", Value::direction(p.axis));
+  node.set("ref", Value::direction(p.ref));
+}
+
+std::optional<double> Lowerer::planeHeight(const Instance &plane, std::string_view role) {
+  if (!plane)
+    return std::nullopt;
+  if (!plane.isA("plane")) {
+    unsupported(plane, std::string(role) + " must be a PLANE");
+    return std::nullopt;
+  }
+  std::optional<Placement> p = placement(plane.ref("position"));
+  if (!p)
+    return std::nullopt;
+  if (std::abs(std::abs(p->axis.z()) - 1.0) > 1e-9) {
+    unsupported(plane, std::string(role) + " not normal to the z axis");
+    return std::nullopt;
+  }
+  return p->at.z();
+}
+
+std::optional<double> Lowerer::toleranced(const Instance &owner, std::string_view attribute) {
+  if (Instance t = owner.ref(attribute)) {
+    if (t.isA("toleranced_length_measure"))
+      return t.real("theoretical_size");
+    if (t.isA("numeric_parameter"))
+      return t.real("its_parameter_value");
+    unsupported(t, "a length was expected");
+    return std::nullopt;
+  }
+  return owner.real(attribute);
+}
+
+std::optional<Node> Lowerer::profile(const Instance &p) {
+  if (!p)
+    return std::nullopt;
+  auto withPlacement = [&](Node &n) {
+    if (Instance a = p.ref("placement"))
+      if (auto pl = placement(a))
+        setPlacement(n, *pl);
+  };
+  auto length = [&](Node &n, std::string_view irName, std::string_view attribute, bool required) {
+    if (auto v = toleranced(p, attribute))
+      n.set(std::string(irName), Value::length(*v));
+    else if (required)
+      missing(p, attribute);
+  };
+  auto angle = [&](Node &n, std::string_view irName, std::string_view attribute, bool required) {
+    if (auto v = p.real(attribute))
+      n.set(std::string(irName), Value::angle(*v));
+    else if (required)
+      missing(p, attribute);
+  };
+  Node n;
+  if (p.isA("rectangular_closed_profile")) {
+    n.kind = "rectangular_profile";
+    length(n, "width", "profile_width", true);
+    length(n, "length", "profile_length", true);
+    withPlacement(n);
+  } else if (p.isA("circular_closed_profile")) {
+    n.kind = "circular_profile";
+    length(n, "diameter", "diameter", true);
+    withPlacement(n);
+  } else if (p.isA("linear_profile")) {
+    n.kind = "linear_profile";
+    length(n, "length", "profile_length", true);
+  } else if (p.isA("square_u_profile")) {
+    n.kind = "square_u_profile";
+    length(n, "width", "width", true);
+    length(n, "first_radius", "first_radius", false);
+    angle(n, "first_angle", "first_angle", false);
+    length(n, "second_radius", "second_radius", false);
+    angle(n, "second_angle", "second_angle", false);
+  } else if (p.isA("rounded_u_profile")) {
+    n.kind = "rounded_u_profile";
+    length(n, "width", "width", true);
+  } else if (p.isA("vee_profile")) {
+    n.kind = "vee_profile";
+    length(n, "profile_radius", "profile_radius", false);
+    angle(n, "profile_angle", "profile_angle", true);
+    angle(n, "tilt_angle", "tilt_angle", true);
+  } else if (p.isA("partial_circular_profile")) {
+    n.kind = "partial_circular_profile";
+    length(n, "radius", "radius", true);
+    angle(n, "sweep_angle", "sweep_angle", true);
+  } else if (p.isA("general_closed_profile") || p.isA("general_profile")) {
+    n.kind = "general_profile";
+    const bool closed = p.isA("general_closed_profile");
+    n.set("closed", Value::boolean(closed));
+    if (auto c = curve(p.ref(closed ? "closed_profile_shape" : "its_profile")))
+      n.add(std::move(*c));
+    else
+      missing(p, closed ? "closed_profile_shape" : "its_profile");
+  } else {
+    unsupported(p, "profile");
+    return std::nullopt;
+  }
+  stamp(n, p, "");
+  return n;
+}
+
+std::optional<Node> Lowerer::path(const Instance &t) {
+  if (!t)
+    return std::nullopt;
+  Node n("path");
+  stamp(n, t, "");
+  Placement pl;
+  if (Instance a = t.ref("placement"))
+    if (auto p = placement(a))
+      pl = *p;
+  if (t.isA("linear_path")) {
+    Node line("line");
+    stamp(line, t, "");
+    line.set("at", Value::point(pl.at));
+    if (auto d = direction(t.ref("its_direction")))
+      line.set("dir", Value::direction(*d));
+    else
+      missing(t, "its_direction");
+    if (auto len = toleranced(t, "distance"))
+      line.set("length", Value::length(*len));
+    else
+      missing(t, "distance");
+    n.add(std::move(line));
+    return n;
+  }
+  if (t.isA("general_path")) {
+    if (auto c = curve(t.ref("swept_path")))
+      n.add(std::move(*c));
+    else
+      missing(t, "swept_path");
+    return n;
+  }
+  unsupported(t, "travel path");
+  return std::nullopt;
+}
+
+std::optional<Node> Lowerer::curve(const Instance &c) {
+  if (!c)
+    return std::nullopt;
+  Node n;
+  if (c.isA("polyline")) {
+    n.kind = "polyline";
+    for (const Instance &p : c.refs("points"))
+      if (auto v = point(p)) {
+        Node pt("point");
+        stamp(pt, p, "");
+        pt.set("at", Value::point(*v));
+        n.add(std::move(pt));
+      }
+  } else if (c.isA("line")) {
+    n.kind = "line";
+    if (auto at = point(c.ref("pnt")))
+      n.set("at", Value::point(*at));
+    else
+      missing(c, "pnt");
+    Instance vec = c.ref("dir");
+    if (auto d = vec ? direction(vec.ref("orientation")) : std::nullopt) {
+      n.set("dir", Value::direction(*d));
+      if (auto m = vec.real("magnitude"))
+        n.set("length", Value::length(*m));
+    } else {
+      missing(c, "dir");
+    }
+  } else if (c.isA("circle") || c.isA("helix")) {
+    n.kind = c.isA("circle") ? "circle" : "helix";
+    if (auto p = placement(c.ref("position")))
+      setPlacement(n, *p);
+    else
+      missing(c, "position");
+    if (auto r = c.real("radius"))
+      n.set("radius", Value::length(*r));
+    else
+      missing(c, "radius");
+    if (n.kind == "helix") {
+      if (auto pitch = c.real("pitch"))
+        n.set("pitch", Value::length(*pitch));
+      else
+        missing(c, "pitch");
+    }
+  } else if (c.isA("trimmed_curve")) {
+    n.kind = "trimmed_curve";
+    // Each trim is a point and/or a parameter; keep what is given.
+    for (std::string_view which : {"trim_1", "trim_2"}) {
+      const std::string side = which == "trim_1" ? "from" : "to";
+      const p21::Value *set = c.attr(which);
+      if (!set || set->kind != p21::ValueKind::List)
+        continue;
+      for (const p21::Value &v : c.values().children(*set)) {
+        if (v.kind == p21::ValueKind::Reference) {
+          if (auto pt = point(c.follow(v)))
+            n.set(side + "_point", Value::point(*pt));
+        } else if (v.kind == p21::ValueKind::Typed && v.count == 1) {
+          const p21::Value &inner = c.values().children(v)[0];
+          if (inner.kind == p21::ValueKind::Real || inner.kind == p21::ValueKind::Integer)
+            n.set(side + "_param", Value::ratio(inner.kind == p21::ValueKind::Real ? inner.real
+                                                                                 : static_cast<double>(inner.integer)));
+        }
+      }
+    }
+    n.set("sense", Value::boolean(c.boolean("sense_agreement").value_or(true)));
+    if (auto basis = curve(c.ref("basis_curve")))
+      n.add(std::move(*basis));
+    else
+      missing(c, "basis_curve");
+  } else if (c.isA("composite_curve")) {
+    n.kind = "composite_curve";
+    for (const Instance &s : c.refs("segments")) {
+      Node seg("segment");
+      stamp(seg, s, "");
+      seg.set("transition", Value::word(s.enumeration("transition").value_or("continuous")));
+      seg.set("same_sense", Value::boolean(s.boolean("same_sense").value_or(true)));
+      if (auto parent = curve(s.ref("parent_curve")))
+        seg.add(std::move(*parent));
+      else
+        missing(s, "parent_curve");
+      n.add(std::move(seg));
+    }
+  } else {
+    unsupported(c, "curve");
+    return std::nullopt;
+  }
+  stamp(n, c, "");
+  return n;
+}
+
+} // namespace stepnc::lowering

@@ -1,0 +1,316 @@
+// Lowering of operations (ISO 14649-10/11): milling and drilling-type
+// operations with their technology, machine functions, strategies and
+// approach/retract, explicit toolpaths; and the tools they use (ISO 14649-111).
+#include "frontend/lowering/Lowerer.h"
+
+#include <utility>
+
+namespace stepnc::lowering {
+
+namespace {
+
+// ARM entity -> IR operation kind. Order matters only for readability: each
+// entity is concrete, so exactly one matches.
+constexpr std::string_view kOperations[] = {
+    "plane_rough_milling", "plane_finish_milling", "bottom_and_side_rough_milling",
+    "bottom_and_side_finish_milling", "side_rough_milling", "side_finish_milling", "freeform_operation",
+    "drilling", "center_drilling", "counter_sinking", "multistep_drilling", "reaming", "boring", "tapping",
+    "thread_drilling"};
+
+// ARM tool body entity -> IR tool type; most specific first.
+constexpr std::pair<std::string_view, std::string_view> kToolBodies[] = {
+    {"ball_endmill", "ball_endmill"},     {"bullnose_endmill", "bullnose_endmill"},
+    {"tapered_endmill", "tapered_endmill"}, {"endmill", "endmill"},
+    {"facemill", "facemill"},             {"side_mill", "side_mill"},
+    {"t_slot_mill", "t_slot_mill"},       {"tapered_drill", "tapered_drill"},
+    {"twist_drill", "twist_drill"},       {"spot_drill", "spot_drill"},
+    {"centerdrill", "center_drill"},      {"tapered_reamer", "tapered_reamer"},
+    {"reamer", "reamer"},                 {"tap", "tap"},
+    {"boring_tool", "boring_tool"},       {"countersink", "countersink"},
+    {"counterbore", "counterbore"}};
+
+constexpr std::pair<std::string_view, std::string_view> kStrategies[] = {
+    {"unidirectional", "unidirectional"},       {"bidirectional", "bidirectional"},
+    {"contour_parallel", "contour_parallel"},   {"contour_spiral", "contour_spiral"},
+    {"contour_bidirectional", "contour_bidirectional"}, {"bidirectional_contour", "bidirectional_contour"},
+    {"center_milling", "center_milling"},       {"explicit_strategy", "explicit"}};
+
+} // namespace
+
+std::optional<std::string> Lowerer::tool(const Instance &t) {
+  if (!t)
+    return std::nullopt;
+  if (auto it = lowered_.find(t.index()); it != lowered_.end())
+    return it->second;
+  if (!t.isA("cutting_tool")) {
+    unsupported(t, "tool");
+    return std::nullopt;
+  }
+  Node n("tool");
+  stamp(n, t);
+  n.symbol = symbolFor('%', t.string("its_id"), "tool");
+  Instance body = t.ref("its_tool_body");
+  std::string_view type = "cutting_tool";
+  for (const auto &[entity, word] : kToolBodies)
+    if (body.isA(entity)) {
+      type = word;
+      break;
+    }
+  if (body && type == "cutting_tool")
+    unsupported(body, "tool body");
+  n.set("type", Value::word(std::string(type)));
+  if (body) {
+    if (Instance dim = body.ref("dimension")) {
+      auto length = [&](std::string_view irName, std::string_view attribute) {
+        if (auto v = dim.real(attribute))
+          n.set(std::string(irName), Value::length(*v));
+      };
+      length("diameter", "diameter");
+      length("corner_radius", "edge_radius");
+      if (auto a = dim.real("tool_tip_half_angle"))
+        n.set("tip_half_angle", Value::angle(*a));
+      if (auto a = dim.real("tool_circumference_angle"))
+        n.set("circumference_angle", Value::angle(*a));
+      length("cutting_edge_length", "cutting_edge_length");
+      length("edge_center_vertical", "edge_center_vertical");
+      length("edge_center_horizontal", "edge_center_horizontal");
+    } else {
+      missing(body, "dimension");
+    }
+    if (auto teeth = body.integer("number_of_teeth"))
+      n.set("flutes", Value::integer(*teeth));
+    if (auto hand = body.enumeration("hand_of_cut"))
+      n.set("hand", Value::word(*hand));
+    if (auto coolant = body.boolean("coolant_through_tool"))
+      n.set("coolant_through", Value::boolean(*coolant));
+    if (auto taper = body.real("taper_angle"))
+      n.set("taper_angle", Value::angle(*taper));
+  } else {
+    missing(t, "its_tool_body");
+  }
+  if (auto overall = t.real("overall_assembly_length"))
+    n.set("overall_length", Value::length(*overall));
+  std::vector<Instance> edges = t.refs("its_cutting_edge");
+  if (!edges.empty())
+    if (auto offset = edges[0].real("tool_offset_length"))
+      n.set("offset_length", Value::length(*offset));
+  const std::string symbol = n.symbol;
+  lowered_[t.index()] = symbol;
+  module_->root.add(std::move(n));
+  return symbol;
+}
+
+namespace {
+
+Node technology(const Lowerer &l, const Instance &tech) {
+  Node n("technology");
+  if (auto f = tech.real("feedrate"))
+    n.set("feed", Value::feed(l.feedMmPerMin(*f)));
+  if (auto fz = tech.real("feedrate_per_tooth"))
+    n.set("feed_per_tooth", Value::length(*fz));
+  if (auto vc = tech.real("cutspeed"))
+    n.set("cutting_speed", Value::feed(l.feedMmPerMin(*vc)));
+  if (auto s = tech.real("spindle"))
+    n.set("spindle", Value::spindle(l.spindleRevPerMin(*s)));
+  n.set("feed_reference", Value::word(tech.enumeration("feedrate_reference").value_or("tcp")));
+  if (auto b = tech.boolean("synchronize_spindle_with_feed"))
+    n.set("sync_spindle_feed", Value::boolean(*b));
+  if (auto b = tech.boolean("inhibit_feedrate_override"))
+    n.set("inhibit_feed_override", Value::boolean(*b));
+  if (auto b = tech.boolean("inhibit_spindle_override"))
+    n.set("inhibit_spindle_override", Value::boolean(*b));
+  return n;
+}
+
+Node machineFunctions(const Instance &mf) {
+  Node n("machine_functions");
+  for (auto [ir, arm] : {std::pair<const char *, const char *>{"coolant", "coolant"},
+                         {"mist", "mist"},
+                         {"through_spindle_coolant", "through_spindle_coolant"},
+                         {"chip_removal", "chip_removal"}})
+    if (auto b = mf.boolean(arm))
+      n.set(ir, Value::boolean(*b));
+  if (auto p = mf.real("coolant_pressure"))
+    n.set("coolant_pressure", Value::ratio(*p));
+  if (auto p = mf.real("through_pressure"))
+    n.set("through_pressure", Value::ratio(*p));
+  return n;
+}
+
+} // namespace
+
+std::optional<Node> Lowerer::operation(const Instance &op) {
+  Node n;
+  for (std::string_view kind : kOperations)
+    if (op.isA(kind)) {
+      n.kind = std::string(kind);
+      break;
+    }
+  if (n.kind.empty()) {
+    unsupported(op, "operation");
+    return std::nullopt;
+  }
+  stamp(n, op);
+  if (auto sym = tool(op.ref("its_tool")))
+    n.set("tool", Value::ref(*sym));
+  else
+    missing(op, "its_tool");
+  auto length = [&](std::string_view irName, std::string_view attribute) {
+    if (auto v = op.real(attribute))
+      n.set(std::string(irName), Value::length(*v));
+  };
+  length("retract_plane", "retract_plane");
+  if (Instance sp = op.ref("start_point"))
+    if (auto p = point(sp))
+      n.set("start_point", Value::point(*p));
+  length("overcut", "overcut_length");
+  length("axial_depth", "axial_cutting_depth");
+  length("radial_depth", "radial_cutting_depth");
+  length("allowance_side", "allowance_side");
+  length("allowance_bottom", "allowance_bottom");
+  // Drilling-type operations.
+  length("cutting_depth", "cutting_depth");
+  length("previous_diameter", "previous_diameter");
+  if (auto t = op.real("dwell_time_bottom"))
+    n.set("dwell_bottom", Value::time(*t));
+  if (auto r = op.real("feed_on_retract"))
+    n.set("feed_on_retract", Value::ratio(*r));
+  if (auto b = op.boolean("spindle_stop_at_bottom"))
+    n.set("spindle_stop_bottom", Value::boolean(*b));
+  length("depth_of_testcut", "depth_of_testcut");
+  if (Instance wp = op.ref("waiting_position"))
+    if (auto p = point(wp))
+      n.set("waiting_position", Value::point(*p));
+  length("retract_distance", "retract_distance");
+  length("first_depth", "first_depth");
+  length("depth_increment", "depth_of_step");
+  if (auto t = op.real("dwell_time_step"))
+    n.set("dwell_step", Value::time(*t));
+  if (auto b = op.boolean("compensation_chuck"))
+    n.set("compensation_chuck", Value::boolean(*b));
+  if (auto b = op.boolean("helical_movement_on_forward"))
+    n.set("helical_movement", Value::boolean(*b));
+
+  if (Instance tech = op.ref("its_technology"))
+    n.add(technology(*this, tech));
+  else
+    missing(op, "its_technology");
+  if (Instance mf = op.ref("its_machine_functions"))
+    n.add(machineFunctions(mf));
+  if (Instance strategy = op.ref("its_machining_strategy")) {
+    if (strategy.isA("drilling_type_strategy")) {
+      Node d("drilling_strategy");
+      stamp(d, strategy, "");
+      for (auto [ir, arm] : {std::pair<const char *, const char *>{"reduced_cut_at_start", "reduced_cut_at_start"},
+                             {"reduced_feed_at_start", "reduced_feed_at_start"},
+                             {"reduced_cut_at_end", "reduced_cut_at_end"},
+                             {"reduced_feed_at_end", "reduced_feed_at_end"}})
+        if (auto r = strategy.real(arm))
+          d.set(ir, Value::ratio(*r));
+      if (auto v = strategy.real("depth_of_start"))
+        d.set("depth_of_start", Value::length(*v));
+      if (auto v = strategy.real("depth_of_end"))
+        d.set("depth_of_end", Value::length(*v));
+      n.add(std::move(d));
+    } else {
+      std::string_view type;
+      for (const auto &[entity, word] : kStrategies)
+        if (strategy.isA(entity)) {
+          type = word;
+          break;
+        }
+      if (type.empty()) {
+        unsupported(strategy, "machining strategy");
+      } else {
+        Node s("strategy");
+        stamp(s, strategy, "");
+        s.set("type", Value::word(std::string(type)));
+        if (auto o = strategy.real("overlap"))
+          s.set("overlap", Value::ratio(*o));
+        if (auto b = strategy.boolean("allow_multiple_passes"))
+          s.set("multiple_passes", Value::boolean(*b));
+        if (Instance fd = strategy.ref("feed_direction"))
+          if (auto d = direction(fd))
+            s.set("feed_dir", Value::direction(*d));
+        if (auto w = strategy.enumeration("stepover_direction"))
+          s.set("stepover_dir", Value::word(*w));
+        if (auto w = strategy.enumeration("its_stroke_connection_strategy"))
+          s.set("stroke_connection", Value::word(*w == "straghtline" ? "straightline" : *w));  // the ARM's spelling
+        if (auto w = strategy.enumeration("rotation_direction"))
+          s.set("rotation", Value::word(*w));
+        if (auto w = strategy.enumeration("cutmode"))
+          s.set("cutmode", Value::word(*w));
+        if (auto b = strategy.boolean("spiral_cutmode_change"))
+          s.set("spiral_cutmode_change", Value::boolean(*b));
+        n.add(std::move(s));
+      }
+    }
+  }
+  for (std::string_view which : {"approach", "retract"}) {
+    Instance ar = op.ref(which);
+    if (!ar)
+      continue;
+    Node a{std::string(which)};
+    stamp(a, ar, "");
+    std::string_view type;
+    for (std::string_view t : {"plunge_toolaxis", "plunge_ramp", "plunge_helix", "plunge_zigzag", "along_path"})
+      if (ar.isA(t))
+        type = t;
+    if (ar.isA("ap_retract_angle"))
+      type = "retract_angle";
+    if (ar.isA("ap_retract_tangent"))
+      type = "retract_tangent";
+    if (type.empty()) {
+      unsupported(ar, "approach or retract strategy");
+      continue;
+    }
+    a.set("type", Value::word(std::string(type)));
+    if (Instance o = ar.ref("tool_orientation"))
+      if (auto d = direction(o))
+        a.set("tool_orientation", Value::direction(*d));
+    if (auto v = ar.real("angle"))
+      a.set("angle", Value::angle(*v));
+    if (auto v = ar.real("radius"))
+      a.set("radius", Value::length(*v));
+    if (auto v = ar.real("width"))
+      a.set("width", Value::length(*v));
+    if (auto v = ar.real("travel_length"))
+      a.set("travel_length", Value::length(*v));
+    n.add(std::move(a));
+  }
+  if (Instance list = op.ref("its_toolpath"))
+    toolpaths(list, n);
+  return n;
+}
+
+void Lowerer::toolpaths(const Instance &list, Node &parent) {
+  for (const Instance &tp : list.refs("its_list")) {
+    if (!tp.isA("cutter_location_trajectory")) {
+      unsupported(tp, "toolpath");
+      continue;
+    }
+    Node n("toolpath");
+    stamp(n, tp, "");
+    n.set("role", Value::word(tp.enumeration("its_type").value_or("trajectory_path")));
+    n.set("required", Value::boolean(tp.boolean("its_priority").value_or(true)));
+    if (auto r = tp.real("its_speed"))
+      n.set("speed_ratio", Value::ratio(*r));
+    else if (tp.attr("its_speed") && !tp.attr("its_speed")->isUnset())
+      unsupported(tp, "toolpath speed profile other than a ratio");
+    if (auto dir = tp.boolean("its_direction"))
+      n.set("reversed", Value::boolean(!*dir));
+    if (Instance tech = tp.ref("its_technology"))
+      n.add(technology(*this, tech));
+    if (Instance mf = tp.ref("its_machine_functions"))
+      n.add(machineFunctions(mf));
+    if (tp.ref("its_toolaxis") || tp.ref("surface_normal"))
+      unsupported(tp, "tool axis or surface normal curves (5-axis)");
+    if (auto c = curve(tp.ref("basiccurve")))
+      n.add(std::move(*c));
+    else
+      missing(tp, "basiccurve");
+    parent.add(std::move(n));
+  }
+}
+
+} // namespace stepnc::lowering

@@ -1,0 +1,298 @@
+// Lowering of the program structure: project, workpieces, setups, workplans,
+// workingsteps and NC functions, plus the helpers every lowering file uses.
+#include "frontend/lowering/Lowerer.h"
+
+#include "support/Format.h"
+
+namespace stepnc::lowering {
+
+// --- helpers -----------------------------------------------------------------
+
+void Lowerer::unsupported(const Instance &inst, std::string_view what) {
+  if (!reported_.insert(inst.index()).second)
+    return;
+  std::string entity(inst.entityName().empty() ? std::string_view("(unknown)") : inst.entityName());
+  for (char &c : entity)
+    if (c >= 'a' && c <= 'z')
+      c = static_cast<char>(c - 32);
+  diags_.error(inst.loc(), "not supported: " + entity + " at " + hashId(inst.id()) +
+                               (what.empty() ? std::string() : " (" + std::string(what) + ")"))
+      .entity(inst.id(), entity);
+}
+
+void Lowerer::missing(const Instance &inst, std::string_view attribute, std::string_view why) {
+  std::string entity(inst.entityName());
+  std::string message = "'";
+  message += attribute;
+  message += "' of ";
+  message += entity;
+  message += ' ';
+  message += hashId(inst.id());
+  message += ' ';
+  message += why.empty() ? std::string_view("is needed to lower it") : why;
+  diags_.error(inst.attrLoc(attribute), std::move(message)).entity(inst.id(), entity);
+}
+
+std::string Lowerer::symbolFor(char sigil, const std::optional<std::string> &label, std::string_view fallback) {
+  std::string base;
+  if (label) {
+    bool underscore = false;
+    for (unsigned char c : *label) {
+      if ((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9')) {
+        base.push_back(static_cast<char>(c));
+        underscore = false;
+      } else if (c >= 'A' && c <= 'Z') {
+        base.push_back(static_cast<char>(c + 32));
+        underscore = false;
+      } else if (!underscore && !base.empty()) {
+        base.push_back('_');
+        underscore = true;
+      }
+    }
+    while (!base.empty() && base.back() == '_')
+      base.pop_back();
+  }
+  if (base.empty())
+    base = std::string(fallback);
+  if (base[0] >= '0' && base[0] <= '9')
+    base = std::string(fallback) + "_" + base;
+  std::string symbol = std::string(1, sigil) + base;
+  for (int n = 2; symbols_.count(symbol); ++n)
+    symbol = std::string(1, sigil) + base + "_" + std::to_string(n);
+  symbols_.insert(symbol);
+  return symbol;
+}
+
+void Lowerer::stamp(Node &node, const Instance &inst, std::string_view labelAttribute) {
+  node.origin.entityId = inst.id();
+  node.origin.loc = inst.loc();
+  if (!labelAttribute.empty())
+    if (std::optional<std::string> label = inst.string(labelAttribute))
+      node.label = *label;
+}
+
+Node *Lowerer::findResource(const std::string &symbol) {
+  for (Node &c : module_->root.children)
+    if (c.symbol == symbol)
+      return &c;
+  return nullptr;
+}
+
+// --- resources ---------------------------------------------------------------
+
+std::optional<std::string> Lowerer::workpiece(const Instance &wp) {
+  if (!wp)
+    return std::nullopt;
+  if (auto it = lowered_.find(wp.index()); it != lowered_.end())
+    return it->second;
+  Node node("workpiece");
+  stamp(node, wp);
+  node.symbol = symbolFor('%', wp.string("its_id"), "workpiece");
+  if (Instance material = wp.ref("its_material")) {
+    if (auto id = material.string("material_identifier"))
+      node.set("material", Value::string(*id));
+    if (auto standard = material.string("standard_identifier"))
+      node.set("material_standard", Value::string(*standard));
+  }
+  if (auto tol = wp.real("global_tolerance"))
+    node.set("global_tolerance", Value::length(*tol));
+  // The raw piece: the bounding geometry, here or on the raw-piece workpiece.
+  Instance bounding = wp.ref("its_bounding_geometry");
+  if (!bounding)
+    if (Instance raw = wp.ref("its_rawpiece"))
+      bounding = raw.ref("its_bounding_geometry");
+  if (bounding) {
+    if (bounding.isA("block")) {
+      Node raw("rawpiece");
+      stamp(raw, bounding, "");
+      raw.set("shape", Value::word("block"));
+      auto x = bounding.real("x"), y = bounding.real("y"), z = bounding.real("z");
+      if (x && y && z)
+        raw.set("size", Value::point(Vec3(*x, *y, *z)));
+      else
+        missing(bounding, !x ? "x" : !y ? "y" : "z");
+      if (auto p = placement(bounding.ref("position")))
+        setPlacement(raw, *p);
+      node.add(std::move(raw));
+    } else {
+      unsupported(bounding, "raw piece shape");
+    }
+  }
+  for (const Instance &clamp : wp.refs("clamping_positions"))
+    if (auto p = point(clamp)) {
+      Node c("clamp");
+      stamp(c, clamp, "");
+      c.set("at", Value::point(*p));
+      node.add(std::move(c));
+    }
+  const std::string symbol = node.symbol;
+  lowered_[wp.index()] = symbol;
+  module_->root.add(std::move(node));
+  return symbol;
+}
+
+std::optional<std::string> Lowerer::setup(const Instance &s) {
+  if (!s)
+    return std::nullopt;
+  if (auto it = lowered_.find(s.index()); it != lowered_.end())
+    return it->second;
+  Node node("setup");
+  stamp(node, s);
+  node.symbol = symbolFor('%', s.string("its_id"), "setup");
+  Placement origin;
+  if (Instance o = s.ref("its_origin"))
+    if (auto p = placement(o))
+      origin = *p;
+  setPlacement(node, origin);
+  if (auto h = planeHeight(s.ref("its_secplane"), "security plane"))
+    node.set("secplane", Value::length(*h));
+  else
+    missing(s, "its_secplane");
+  for (const Instance &ws : s.refs("its_workpiece_setup")) {
+    Node w("workpiece_setup");
+    stamp(w, ws, "");
+    if (auto wp = workpiece(ws.ref("its_workpiece")))
+      w.set("workpiece", Value::ref(*wp));
+    else
+      missing(ws, "its_workpiece");
+    if (auto p = placement(ws.ref("its_origin")))
+      setPlacement(w, *p);
+    else
+      setPlacement(w, Placement());
+    node.add(std::move(w));
+  }
+  const std::string symbol = node.symbol;
+  lowered_[s.index()] = symbol;
+  module_->root.add(std::move(node));
+  return symbol;
+}
+
+// --- executables -------------------------------------------------------------
+
+std::optional<Node> Lowerer::workingstep(const Instance &ws) {
+  Node node("workingstep");
+  stamp(node, ws);
+  node.symbol = symbolFor('@', ws.string("its_id"), "ws");
+  if (auto f = feature(ws.ref("its_feature")))
+    node.set("feature", Value::ref(*f));
+  else
+    missing(ws, "its_feature");
+  if (auto h = planeHeight(ws.ref("its_secplane"), "security plane"))
+    node.set("secplane", Value::length(*h));
+  else
+    missing(ws, "its_secplane");
+  if (Instance op = ws.ref("its_operation")) {
+    if (auto lowered = operation(op))
+      node.add(std::move(*lowered));
+  } else {
+    missing(ws, "its_operation");
+  }
+  return node;
+}
+
+std::optional<Node> Lowerer::workplan(const Instance &wp) {
+  if (!workplansOnStack_.insert(wp.index()).second) {
+    diags_.error(wp.loc(), "workplan " + hashId(wp.id()) + " contains itself").entity(wp.id(), "WORKPLAN");
+    return std::nullopt;
+  }
+  Node node("workplan");
+  stamp(node, wp);
+  node.symbol = symbolFor('@', wp.string("its_id"), "workplan");
+  if (Instance s = wp.ref("its_setup"))
+    if (auto sym = setup(s))
+      node.set("setup", Value::ref(*sym));
+  for (const Instance &exe : wp.refs("its_elements"))
+    executable(exe, node);
+  workplansOnStack_.erase(wp.index());
+  return node;
+}
+
+bool Lowerer::executable(const Instance &exe, Node &parent) {
+  if (exe.isA("machining_workingstep")) {
+    if (auto ws = workingstep(exe))
+      parent.add(std::move(*ws));
+    return true;
+  }
+  if (exe.isA("workplan")) {
+    if (auto wp = workplan(exe))
+      parent.add(std::move(*wp));
+    return true;
+  }
+  for (std::string_view simple : {"program_stop", "optional_stop"})
+    if (exe.isA(simple)) {
+      Node n{std::string(simple)};
+      stamp(n, exe);
+      parent.add(std::move(n));
+      return true;
+    }
+  if (exe.isA("rapid_movement")) {
+    Node n("rapid_movement");
+    stamp(n, exe);
+    n.symbol = symbolFor('@', exe.string("its_id"), "rapid");
+    if (auto h = planeHeight(exe.ref("its_secplane"), "security plane"))
+      n.set("secplane", Value::length(*h));
+    else
+      missing(exe, "its_secplane");
+    if (Instance list = exe.ref("its_toolpath"))
+      toolpaths(list, n);
+    parent.add(std::move(n));
+    return true;
+  }
+  if (exe.isA("display_message")) {
+    Node n("display_message");
+    stamp(n, exe);
+    n.set("message", Value::string(exe.string("its_text").value_or("")));
+    parent.add(std::move(n));
+    return true;
+  }
+  unsupported(exe, "executable");
+  return false;
+}
+
+std::unique_ptr<ir::Module> Lowerer::run() {
+  const auto &entries = bound_.file().entries();
+  std::vector<Instance> projects;
+  for (size_t i = 0; i < entries.size(); ++i) {
+    Instance inst(bound_, i);
+    if (inst.isA("project"))
+      projects.push_back(std::move(inst));
+  }
+  if (projects.empty()) {
+    diags_.error(bound_.file().loc(0), "no PROJECT instance: there is no workplan to lower");
+    return nullptr;
+  }
+  if (projects.size() > 1)
+    diags_.error(projects[1].loc(), "a second PROJECT instance; only one workplan can be lowered")
+        .entity(projects[1].id(), "PROJECT")
+        .note(projects[0].loc(), "the first PROJECT is here");
+  const Instance &project = projects[0];
+  module_ = std::make_unique<ir::Module>();
+  module_->sourceName = std::string(bound_.file().source().name());
+  stamp(module_->root, project);
+  for (const Instance &wp : project.refs("its_workpieces"))
+    workpiece(wp);
+  Instance main = project.ref("main_workplan");
+  if (!main) {
+    missing(project, "main_workplan");
+    return std::move(module_);
+  }
+  std::optional<Node> plan = workplan(main);
+  // Resources first, in a fixed order: workpieces, tools, setups; then the plan.
+  std::vector<Node> ordered;
+  for (std::string_view kind : {"workpiece", "tool", "setup"})
+    for (Node &c : module_->root.children)
+      if (c.kind == kind)
+        ordered.push_back(std::move(c));
+  module_->root.children = std::move(ordered);
+  if (plan)
+    module_->root.add(std::move(*plan));
+  return std::move(module_);
+}
+
+std::unique_ptr<ir::Module> lowerToFeatureIR(const binding::BoundFile &bound, DiagnosticEngine &diags,
+                                             const LowerOptions &options) {
+  Lowerer lowerer(bound, diags, options);
+  return lowerer.run();
+}
+
+} // namespace stepnc::lowering

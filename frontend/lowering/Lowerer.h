@@ -1,0 +1,99 @@
+// The lowering context shared by the lowering files (internal to
+// frontend/lowering): symbols, resources lowered once, unit conversion and
+// the helpers every construct uses.
+#pragma once
+
+#include "frontend/binding/Instance.h"
+#include "frontend/lowering/Lowering.h"
+#include "ir/Node.h"
+
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+
+namespace stepnc::lowering {
+
+using binding::Instance;
+using ir::Node;
+using ir::Value;
+using ir::Vec3;
+
+/// A rigid placement read from an axis2_placement_3d.
+struct Placement {
+  Vec3 at = Vec3::Zero();
+  Vec3 axis = Vec3::UnitZ();
+  Vec3 ref = Vec3::UnitX();
+};
+
+class Lowerer {
+public:
+  Lowerer(const binding::BoundFile &bound, DiagnosticEngine &diags, const LowerOptions &options)
+      : bound_(bound), diags_(diags), options_(options) {}
+
+  std::unique_ptr<ir::Module> run();
+
+  // --- shared helpers (Lowerer.cpp) ---------------------------------------
+  /// Reports `not supported: <entity> at #id` (once per instance).
+  void unsupported(const Instance &inst, std::string_view what = {});
+  /// Reports a missing or invalid attribute that lowering needs.
+  void missing(const Instance &inst, std::string_view attribute, std::string_view why = {});
+  /// A fresh symbol with `sigil`, from a STEP-NC id string or a fallback.
+  std::string symbolFor(char sigil, const std::optional<std::string> &label, std::string_view fallback);
+  /// Sets origin and label from an instance.
+  void stamp(Node &node, const Instance &inst, std::string_view labelAttribute = "its_id");
+
+  // Unit conversion.
+  double feedMmPerMin(double speedMeasure) const { return speedMeasure * options_.units.speedToMmPerMin; }
+  double spindleRevPerMin(double rotSpeed) const { return rotSpeed * options_.units.rotSpeedToRevPerMin; }
+
+  // --- geometry (LowerGeometry.cpp) ----------------------------------------
+  std::optional<Vec3> point(const Instance &cartesianPoint);
+  std::optional<Vec3> direction(const Instance &dir);
+  /// axis2_placement_3d, with the standard's defaults and orthonormalised axes.
+  std::optional<Placement> placement(const Instance &axis2);
+  void setPlacement(Node &node, const Placement &p);
+  /// The offset of a plane (elementary_surface) along z: its location's z.
+  std::optional<double> planeHeight(const Instance &plane, std::string_view role);
+  /// A toleranced_length_measure (or a plain length) as mm.
+  std::optional<double> toleranced(const Instance &owner, std::string_view attribute);
+  /// A profile (closed or open) as a profile node; null node kind on failure.
+  std::optional<Node> profile(const Instance &profile);
+  /// A travel path (linear_path, circular_path, general path) as a path node.
+  std::optional<Node> path(const Instance &travel);
+  /// Any bounded curve (polyline, trimmed curve, composite curve, circle,
+  /// line, helix, B-spline) as a curve node.
+  std::optional<Node> curve(const Instance &curve);
+
+  // --- features (LowerFeatures.cpp) ------------------------------------------
+  /// The feature's symbol, lowering it under its workpiece the first time.
+  std::optional<std::string> feature(const Instance &feature);
+
+  // --- operations (LowerOperations.cpp) --------------------------------------
+  std::optional<Node> operation(const Instance &op);
+  std::optional<std::string> tool(const Instance &tool);
+  /// Adds the toolpaths of a toolpath_list as children of `parent`.
+  void toolpaths(const Instance &list, Node &parent);
+
+  const binding::BoundFile &bound() const { return bound_; }
+  DiagnosticEngine &diags() { return diags_; }
+
+private:
+  std::optional<std::string> workpiece(const Instance &wp);
+  std::optional<std::string> setup(const Instance &setup);
+  bool executable(const Instance &exe, Node &parent);
+  std::optional<Node> workingstep(const Instance &ws);
+  std::optional<Node> workplan(const Instance &wp);
+  Node *findResource(const std::string &symbol);
+
+  const binding::BoundFile &bound_;
+  DiagnosticEngine &diags_;
+  const LowerOptions &options_;
+  std::unique_ptr<ir::Module> module_;
+  std::set<std::string> symbols_;
+  std::map<size_t, std::string> lowered_;  ///< instance index -> symbol of its resource node
+  std::set<size_t> reported_;              ///< instances already reported unsupported
+  std::set<size_t> workplansOnStack_;      ///< cycle guard for nested workplans
+};
+
+} // namespace stepnc::lowering

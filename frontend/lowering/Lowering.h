@@ -1,0 +1,36 @@
+// Lowering: from a bound STEP-NC file (ISO 14649 ARM) to the feature IR.
+//
+// Lowering reads instances by attribute name (binding::Instance), converts to
+// the IR's units once (mm, deg, mm/min, rev/min, s) and builds one `project`
+// node: workpieces with their features, tools, setups, and the main workplan
+// with its executables. Resources used by several workingsteps are lowered
+// once. A construct that is not handled yet is reported as
+// `not supported: <entity> at #id`, never dropped silently.
+#pragma once
+
+#include "frontend/binding/Binder.h"
+#include "ir/Node.h"
+
+#include <memory>
+
+namespace stepnc::lowering {
+
+/// How ISO 14649 quantities whose unit the ARM leaves implicit are read.
+struct UnitConventions {
+  /// speed_measure (feedrate, cutting speed) to mm/min: 60000 reads m/s.
+  double speedToMmPerMin = 60000.0;
+  /// rot_speed_measure (spindle) to rev/min: 60 reads rev/s.
+  double rotSpeedToRevPerMin = 60.0;
+};
+
+struct LowerOptions {
+  UnitConventions units;
+};
+
+/// Lowers the file's project. Returns null (after reporting) when there is no
+/// project to lower; otherwise a module, possibly incomplete when errors were
+/// reported.
+std::unique_ptr<ir::Module> lowerToFeatureIR(const binding::BoundFile &bound, DiagnosticEngine &diags,
+                                             const LowerOptions &options = {});
+
+} // namespace stepnc::lowering

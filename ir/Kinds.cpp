@@ -1,0 +1,303 @@
+// The feature-IR kind table. Attribute names follow ISO 14649 where it has a
+// name for the quantity, shortened where the standard's is long; units are
+// those of the value type (mm, deg, mm/min, rev/min, s). Placements are three
+// attributes: `at` (origin), `axis` (local z), `ref` (local x).
+#include "ir/Kinds.h"
+
+namespace stepnc::ir {
+
+namespace {
+
+using T = ValueType;
+
+// Attribute groups shared by several kinds.
+std::vector<AttrSpec> placement(bool required) {
+  return {{"at", T::Point, required}, {"axis", T::Direction, required}, {"ref", T::Direction, required}};
+}
+
+template <class... Groups>
+std::vector<AttrSpec> join(Groups &&...groups) {
+  std::vector<AttrSpec> out;
+  (out.insert(out.end(), groups.begin(), groups.end()), ...);
+  return out;
+}
+
+const std::vector<AttrSpec> kFeatureCommon = join(placement(true), std::vector<AttrSpec>{{"depth", T::Length, true}});
+
+const std::vector<AttrSpec> kOperationCommon = {
+    {"tool", T::Ref, true},
+    {"retract_plane", T::Length},
+    {"start_point", T::Point},
+    {"overcut", T::Length},
+};
+
+const std::vector<AttrSpec> kMillingStrategyCommon = {
+    {"overlap", T::Ratio},
+    {"multiple_passes", T::Flag},
+};
+
+const std::vector<AttrSpec> kDrillingOperation = {
+    {"cutting_depth", T::Length},
+    {"previous_diameter", T::Length},
+    {"dwell_bottom", T::Time},
+    {"feed_on_retract", T::Ratio},
+};
+
+std::vector<KindSpec> makeTable() {
+  std::vector<KindSpec> t;
+  auto add = [&](KindSpec k) { t.push_back(std::move(k)); };
+
+  // Program structure.
+  add({"project", "root", Sigil::None, true, {}, "workpiece tool setup workplan"});
+  add({"workpiece", "resource", Sigil::Resource, true,
+       {{"material", T::Text}, {"material_standard", T::Text}, {"global_tolerance", T::Length}},
+       "rawpiece clamp feature"});
+  add({"rawpiece", "resource", Sigil::None, false,
+       join(std::vector<AttrSpec>{{"shape", T::Word, true, "block cylinder"},
+                                  {"size", T::Point},
+                                  {"diameter", T::Length},
+                                  {"height", T::Length}},
+            placement(true)),
+       {}});
+  add({"clamp", "resource", Sigil::None, false, {{"at", T::Point, true}}, {}});
+  add({"setup", "resource", Sigil::Resource, true,
+       join(placement(true), std::vector<AttrSpec>{{"secplane", T::Length, true}}), "workpiece_setup"});
+  add({"workpiece_setup", "resource", Sigil::None, false,
+       join(std::vector<AttrSpec>{{"workpiece", T::Ref, true}}, placement(true)), {}});
+  add({"tool", "resource", Sigil::Resource, true,
+       {{"type", T::Word, true,
+         "endmill facemill ball_endmill bullnose_endmill tapered_endmill side_mill t_slot_mill "
+         "twist_drill center_drill spot_drill tapered_drill reamer tapered_reamer tap "
+         "boring_tool countersink counterbore cutting_tool"},
+        {"diameter", T::Length},
+        {"corner_radius", T::Length},
+        {"tip_half_angle", T::Angle},
+        {"circumference_angle", T::Angle},
+        {"cutting_edge_length", T::Length},
+        {"edge_center_vertical", T::Length},
+        {"edge_center_horizontal", T::Length},
+        {"overall_length", T::Length},
+        {"flutes", T::Count},
+        {"hand", T::Word, false, "left right neutral"},
+        {"coolant_through", T::Flag},
+        {"offset_length", T::Length},
+        {"taper_angle", T::Angle},
+        {"thread_pitch", T::Length}},
+       {}});
+
+  // Executables.
+  add({"workplan", "executable", Sigil::Executable, true, {{"setup", T::Ref}}, "executable"});
+  add({"workingstep", "executable", Sigil::Executable, true,
+       {{"feature", T::Ref, true}, {"secplane", T::Length, true}}, "operation"});
+  add({"program_stop", "executable", Sigil::None, true, {}, {}});
+  add({"optional_stop", "executable", Sigil::None, true, {}, {}});
+  add({"display_message", "executable", Sigil::None, true, {{"message", T::Text, true}}, {}});
+  // A rapid movement is a workingstep of its own (ISO 14649-10), with explicit toolpaths.
+  add({"rapid_movement", "executable", Sigil::Executable, true, {{"secplane", T::Length, true}}, "toolpath"});
+
+  // Features (children of their workpiece).
+  add({"planar_face", "feature", Sigil::Resource, true,
+       join(kFeatureCommon, std::vector<AttrSpec>{{"travel", T::Length, true},
+                                                  {"travel_dir", T::Direction, true},
+                                                  {"width", T::Length, true},
+                                                  {"width_dir", T::Direction, true}}),
+       "profile boss"});
+  for (std::string_view pocket : {"closed_pocket", "open_pocket"})
+    add({pocket, "feature", Sigil::Resource, true,
+         join(kFeatureCommon, std::vector<AttrSpec>{{"slope", T::Angle},
+                                                    {"bottom", T::Word, true, "planar radiused through general"},
+                                                    {"bottom_radius", T::Length},
+                                                    {"planar_radius", T::Length},
+                                                    {"orthogonal_radius", T::Length}}),
+         "profile boss"});
+  add({"round_hole", "feature", Sigil::Resource, true,
+       join(kFeatureCommon,
+            std::vector<AttrSpec>{{"diameter", T::Length, true},
+                                  {"final_diameter", T::Length},
+                                  {"taper_angle", T::Angle},
+                                  {"bottom", T::Word, true, "through flat flat_with_radius conical spherical"},
+                                  {"bottom_radius", T::Length},
+                                  {"tip_angle", T::Angle},
+                                  {"tip_radius", T::Length}}),
+       {}});
+  add({"slot", "feature", Sigil::Resource, true,
+       join(kFeatureCommon, std::vector<AttrSpec>{{"end_1", T::Word, true, "open radiused flat woodruff loop"},
+                                                  {"end_2", T::Word, true, "open radiused flat woodruff loop"},
+                                                  {"end_radius", T::Length}}),
+       "path profile"});
+  add({"step", "feature", Sigil::Resource, true, kFeatureCommon, "path profile"});
+  add({"general_outside_profile", "feature", Sigil::Resource, true, kFeatureCommon, "path profile"});
+  add({"boss", "feature", Sigil::Resource, true, join(kFeatureCommon, std::vector<AttrSpec>{{"slope", T::Angle}}),
+       "profile"});
+
+  // Profiles (cross sections and outlines, in the feature's frame).
+  add({"rectangular_profile", "profile", Sigil::None, false,
+       join(std::vector<AttrSpec>{{"width", T::Length, true}, {"length", T::Length, true}}, placement(false)), {}});
+  add({"circular_profile", "profile", Sigil::None, false,
+       join(std::vector<AttrSpec>{{"diameter", T::Length, true}}, placement(false)), {}});
+  add({"linear_profile", "profile", Sigil::None, false, {{"length", T::Length, true}}, {}});
+  add({"square_u_profile", "profile", Sigil::None, false,
+       {{"width", T::Length, true},
+        {"first_radius", T::Length},
+        {"first_angle", T::Angle},
+        {"second_radius", T::Length},
+        {"second_angle", T::Angle}},
+       {}});
+  add({"rounded_u_profile", "profile", Sigil::None, false, {{"width", T::Length, true}}, {}});
+  add({"vee_profile", "profile", Sigil::None, false,
+       {{"profile_radius", T::Length}, {"profile_angle", T::Angle, true}, {"tilt_angle", T::Angle, true}}, {}});
+  add({"partial_circular_profile", "profile", Sigil::None, false,
+       {{"radius", T::Length, true}, {"sweep_angle", T::Angle, true}}, {}});
+  add({"general_profile", "profile", Sigil::None, false, {{"closed", T::Flag, true}}, "curve"});
+
+  // Paths and curves (feature travel paths, general profiles, toolpaths).
+  add({"path", "path", Sigil::None, false, {}, "curve"});
+  add({"line", "curve", Sigil::None, false, {{"at", T::Point, true}, {"dir", T::Direction, true}, {"length", T::Length}}, {}});
+  add({"polyline", "curve", Sigil::None, false, {}, "point"});
+  add({"point", "point", Sigil::None, false, {{"at", T::Point, true}}, {}});
+  add({"circle", "curve", Sigil::None, false,
+       join(placement(true), std::vector<AttrSpec>{{"radius", T::Length, true}}), {}});
+  add({"helix", "curve", Sigil::None, false,
+       join(placement(true), std::vector<AttrSpec>{{"radius", T::Length, true}, {"pitch", T::Length, true}}), {}});
+  add({"trimmed_curve", "curve", Sigil::None, false,
+       {{"from_param", T::Ratio},
+        {"to_param", T::Ratio},
+        {"from_point", T::Point},
+        {"to_point", T::Point},
+        {"sense", T::Flag, true}},
+       "curve"});
+  add({"composite_curve", "curve", Sigil::None, false, {{"self_intersect", T::Flag}}, "segment"});
+  add({"segment", "segment", Sigil::None, false,
+       {{"transition", T::Word, true, "discontinuous continuous cont_same_gradient cont_same_gradient_same_curvature"},
+        {"same_sense", T::Flag, true}},
+       "curve"});
+  add({"b_spline_curve", "curve", Sigil::None, false, {{"degree", T::Count, true}, {"closed", T::Flag}}, "point"});
+
+  // Operations (the child of a workingstep).
+  const char *millingChildren = "technology machine_functions strategy approach retract toolpath";
+  for (std::string_view op : {"plane_rough_milling", "plane_finish_milling"})
+    add({op, "operation", Sigil::None, true,
+         join(kOperationCommon, std::vector<AttrSpec>{{"axial_depth", T::Length}, {"allowance_bottom", T::Length}}),
+         millingChildren});
+  for (std::string_view op : {"bottom_and_side_rough_milling", "bottom_and_side_finish_milling"})
+    add({op, "operation", Sigil::None, true,
+         join(kOperationCommon, std::vector<AttrSpec>{{"axial_depth", T::Length},
+                                                      {"radial_depth", T::Length},
+                                                      {"allowance_side", T::Length},
+                                                      {"allowance_bottom", T::Length}}),
+         millingChildren});
+  for (std::string_view op : {"side_rough_milling", "side_finish_milling"})
+    add({op, "operation", Sigil::None, true,
+         join(kOperationCommon, std::vector<AttrSpec>{{"axial_depth", T::Length},
+                                                      {"radial_depth", T::Length},
+                                                      {"allowance_side", T::Length}}),
+         millingChildren});
+  add({"freeform_operation", "operation", Sigil::None, true, kOperationCommon, millingChildren});
+  const char *drillingChildren = "technology machine_functions drilling_strategy approach retract toolpath";
+  for (std::string_view op : {"drilling", "center_drilling", "counter_sinking", "reaming", "boring"})
+    add({op, "operation", Sigil::None, true,
+         join(kOperationCommon, kDrillingOperation,
+              std::vector<AttrSpec>{{"spindle_stop_bottom", T::Flag}, {"depth_of_testcut", T::Length},
+                                    {"waiting_position", T::Point}}),
+         drillingChildren});
+  add({"multistep_drilling", "operation", Sigil::None, true,
+       join(kOperationCommon, kDrillingOperation,
+            std::vector<AttrSpec>{{"retract_distance", T::Length},
+                                  {"first_depth", T::Length},
+                                  {"depth_increment", T::Length},
+                                  {"dwell_step", T::Time}}),
+       drillingChildren});
+  for (std::string_view op : {"tapping", "thread_drilling"})
+    add({op, "operation", Sigil::None, true,
+         join(kOperationCommon, kDrillingOperation,
+              std::vector<AttrSpec>{{"compensation_chuck", T::Flag}, {"helical_movement", T::Flag}}),
+         drillingChildren});
+
+  // Technology, machine functions, strategies.
+  add({"technology", "technology", Sigil::None, false,
+       {{"feed", T::Feed},
+        {"feed_per_tooth", T::Length},
+        {"cutting_speed", T::Feed},
+        {"spindle", T::Spindle},
+        {"feed_reference", T::Word, true, "tcp ccp"},
+        {"sync_spindle_feed", T::Flag},
+        {"inhibit_feed_override", T::Flag},
+        {"inhibit_spindle_override", T::Flag}},
+       {}});
+  add({"machine_functions", "technology", Sigil::None, false,
+       {{"coolant", T::Flag}, {"coolant_pressure", T::Ratio}, {"mist", T::Flag},
+        {"through_spindle_coolant", T::Flag}, {"through_pressure", T::Ratio}, {"chip_removal", T::Flag}},
+       {}});
+  add({"strategy", "strategy", Sigil::None, false,
+       join(std::vector<AttrSpec>{{"type", T::Word, true,
+                                   "unidirectional bidirectional contour_parallel contour_spiral "
+                                   "contour_bidirectional bidirectional_contour center_milling explicit"}},
+            kMillingStrategyCommon,
+            std::vector<AttrSpec>{{"feed_dir", T::Direction},
+                                  {"stepover_dir", T::Word, false, "left right"},
+                                  {"stroke_connection", T::Word, false, "straightline loop_back degouge lift_shift_plunge"},
+                                  {"rotation", T::Word, false, "cw ccw"},
+                                  {"cutmode", T::Word, false, "climb conventional"},
+                                  {"spiral_cutmode_change", T::Flag}}),
+       {}});
+  add({"drilling_strategy", "strategy", Sigil::None, false,
+       {{"reduced_cut_at_start", T::Ratio}, {"reduced_feed_at_start", T::Ratio}, {"depth_of_start", T::Length},
+        {"reduced_cut_at_end", T::Ratio}, {"reduced_feed_at_end", T::Ratio}, {"depth_of_end", T::Length}},
+       {}});
+  for (std::string_view ar : {"approach", "retract"})
+    add({ar, "strategy", Sigil::None, false,
+         {{"type", T::Word, true,
+           "plunge_toolaxis plunge_ramp plunge_helix plunge_zigzag retract_angle retract_tangent along_path"},
+          {"tool_orientation", T::Direction},
+          {"angle", T::Angle},
+          {"radius", T::Length},
+          {"width", T::Length},
+          {"travel_length", T::Length}},
+         {}});
+
+  // Explicit toolpaths (freeform operations).
+  add({"toolpath", "toolpath", Sigil::None, false,
+       {{"role", T::Word, true, "approach lift connect non_contact contact trajectory_path"},
+        {"required", T::Flag, true},
+        {"speed_ratio", T::Ratio},
+        {"reversed", T::Flag}},
+       "curve technology machine_functions"});
+  return t;
+}
+
+} // namespace
+
+const std::vector<KindSpec> &allKinds() {
+  static const std::vector<KindSpec> table = makeTable();
+  return table;
+}
+
+const KindSpec *findKind(std::string_view kind) {
+  for (const KindSpec &k : allKinds())
+    if (k.kind == kind)
+      return &k;
+  return nullptr;
+}
+
+bool childAllowed(const KindSpec &parent, const KindSpec &child) {
+  std::string_view list = parent.children;
+  while (!list.empty()) {
+    size_t sp = list.find(' ');
+    std::string_view w = list.substr(0, sp);
+    if (w == child.kind || w == child.category)
+      return true;
+    if (sp == std::string_view::npos)
+      break;
+    list = list.substr(sp + 1);
+  }
+  return false;
+}
+
+const AttrSpec *findAttr(const KindSpec &kind, std::string_view name) {
+  for (const AttrSpec &a : kind.attrs)
+    if (a.name == name)
+      return &a;
+  return nullptr;
+}
+
+} // namespace stepnc::ir

@@ -1,0 +1,163 @@
+#include "ir/Node.h"
+
+namespace stepnc::ir {
+
+const char *valueTypeName(ValueType t) {
+  switch (t) {
+  case ValueType::Length: return "length";
+  case ValueType::Angle: return "angle";
+  case ValueType::Feed: return "feed";
+  case ValueType::Spindle: return "spindle speed";
+  case ValueType::Time: return "time";
+  case ValueType::Ratio: return "ratio";
+  case ValueType::Count: return "count";
+  case ValueType::Flag: return "flag";
+  case ValueType::Word: return "word";
+  case ValueType::Text: return "text";
+  case ValueType::Ref: return "reference";
+  case ValueType::Point: return "point";
+  case ValueType::Direction: return "direction";
+  }
+  return "value";
+}
+
+Value Value::makeNumber(ValueType t, double v) {
+  Value out;
+  out.type = t;
+  out.number = v;
+  return out;
+}
+Value Value::integer(int64_t n) {
+  Value out;
+  out.type = ValueType::Count;
+  out.count = n;
+  return out;
+}
+Value Value::boolean(bool b) {
+  Value out;
+  out.type = ValueType::Flag;
+  out.flag = b;
+  return out;
+}
+Value Value::word(std::string w) {
+  Value out;
+  out.type = ValueType::Word;
+  out.text = std::move(w);
+  return out;
+}
+Value Value::string(std::string s) {
+  Value out;
+  out.type = ValueType::Text;
+  out.text = std::move(s);
+  return out;
+}
+Value Value::ref(std::string symbol) {
+  Value out;
+  out.type = ValueType::Ref;
+  out.text = std::move(symbol);
+  return out;
+}
+Value Value::point(const Vec3 &p) {
+  Value out;
+  out.type = ValueType::Point;
+  out.vec = p;
+  return out;
+}
+Value Value::direction(const Vec3 &d) {
+  Value out;
+  out.type = ValueType::Direction;
+  out.vec = d;
+  return out;
+}
+
+bool Value::operator==(const Value &o) const {
+  return type == o.type && number == o.number && count == o.count && flag == o.flag && text == o.text &&
+         vec == o.vec;
+}
+
+Node &Node::set(std::string name, Value v) {
+  for (Attr &a : attrs)
+    if (a.name == name) {
+      a.value = std::move(v);
+      return *this;
+    }
+  attrs.push_back({std::move(name), std::move(v)});
+  return *this;
+}
+
+const Value *Node::get(std::string_view name) const {
+  for (const Attr &a : attrs)
+    if (a.name == name)
+      return &a.value;
+  return nullptr;
+}
+
+std::optional<double> Node::number(std::string_view name) const {
+  const Value *v = get(name);
+  if (!v)
+    return std::nullopt;
+  switch (v->type) {
+  case ValueType::Length:
+  case ValueType::Angle:
+  case ValueType::Feed:
+  case ValueType::Spindle:
+  case ValueType::Time:
+  case ValueType::Ratio: return v->number;
+  case ValueType::Count: return static_cast<double>(v->count);
+  default: return std::nullopt;
+  }
+}
+
+std::optional<int64_t> Node::count(std::string_view name) const {
+  const Value *v = get(name);
+  return v && v->type == ValueType::Count ? std::optional<int64_t>(v->count) : std::nullopt;
+}
+
+std::optional<bool> Node::flag(std::string_view name) const {
+  const Value *v = get(name);
+  return v && v->type == ValueType::Flag ? std::optional<bool>(v->flag) : std::nullopt;
+}
+
+std::optional<std::string> Node::text(std::string_view name) const {
+  const Value *v = get(name);
+  if (!v || (v->type != ValueType::Word && v->type != ValueType::Text && v->type != ValueType::Ref))
+    return std::nullopt;
+  return v->text;
+}
+
+std::optional<Vec3> Node::vec(std::string_view name) const {
+  const Value *v = get(name);
+  if (!v || (v->type != ValueType::Point && v->type != ValueType::Direction))
+    return std::nullopt;
+  return v->vec;
+}
+
+std::vector<const Node *> Node::childrenOf(std::string_view k) const {
+  std::vector<const Node *> out;
+  for (const Node &c : children)
+    if (c.kind == k)
+      out.push_back(&c);
+  return out;
+}
+
+const Node *Node::child(std::string_view k) const {
+  for (const Node &c : children)
+    if (c.kind == k)
+      return &c;
+  return nullptr;
+}
+
+bool equal(const Node &a, const Node &b) {
+  if (a.kind != b.kind || a.symbol != b.symbol || a.label != b.label || a.attrs.size() != b.attrs.size() ||
+      a.children.size() != b.children.size())
+    return false;
+  for (size_t i = 0; i < a.attrs.size(); ++i)
+    if (a.attrs[i].name != b.attrs[i].name || !(a.attrs[i].value == b.attrs[i].value))
+      return false;
+  for (size_t i = 0; i < a.children.size(); ++i)
+    if (!equal(a.children[i], b.children[i]))
+      return false;
+  return true;
+}
+
+} // namespace stepnc::ir

@@ -1,0 +1,128 @@
+// The process IR: a tree of nodes with typed, unit-carrying attributes.
+//
+// Every level of the IR (feature, toolpath, motion) is made of the same Node:
+// a kind ("workingstep", "closed_pocket", "tool", ...), an optional symbol
+// (`%pocket1` for resources, `@ws_rough_pocket1` for executables), an optional
+// label (the STEP-NC id string), attributes in the order the kind's spec gives
+// them, and children. What a kind may hold is declared once, in the kind table
+// (ir/Kinds.cpp): the printer, the parser and the verifier all read it, so a
+// new kind (a turning feature, an additive operation) is one table entry.
+//
+// Units are part of the value type and fixed: lengths in mm, angles in
+// degrees, feeds in mm/min, spindle speeds in rev/min, times in s. Lowering
+// converts once; nothing downstream converts again.
+#pragma once
+
+#include "support/SourceFile.h"
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace stepnc::ir {
+
+using Vec3 = Eigen::Vector3d;
+
+enum class ValueType : uint8_t {
+  Length,     ///< mm
+  Angle,      ///< degrees
+  Feed,       ///< mm/min
+  Spindle,    ///< rev/min; negative = clockwise seen from the spindle (M3)
+  Time,       ///< s
+  Ratio,      ///< plain number, 0.5 = 50 %
+  Count,      ///< integer
+  Flag,       ///< true / false
+  Word,       ///< an identifier from a fixed set (cutmode=climb)
+  Text,       ///< a quoted string
+  Ref,        ///< a symbol: %resource or @executable
+  Point,      ///< (x,y,z) mm
+  Direction,  ///< (x,y,z) unit vector
+};
+
+const char *valueTypeName(ValueType t);
+
+struct Value {
+  ValueType type = ValueType::Length;
+  double number = 0;   ///< Length, Angle, Feed, Spindle, Time, Ratio
+  int64_t count = 0;   ///< Count
+  bool flag = false;   ///< Flag
+  std::string text;    ///< Word, Text, Ref (with its sigil)
+  Vec3 vec = Vec3::Zero();  ///< Point, Direction
+
+  static Value length(double mm) { return makeNumber(ValueType::Length, mm); }
+  static Value angle(double deg) { return makeNumber(ValueType::Angle, deg); }
+  static Value feed(double mmPerMin) { return makeNumber(ValueType::Feed, mmPerMin); }
+  static Value spindle(double revPerMin) { return makeNumber(ValueType::Spindle, revPerMin); }
+  static Value time(double s) { return makeNumber(ValueType::Time, s); }
+  static Value ratio(double r) { return makeNumber(ValueType::Ratio, r); }
+  static Value integer(int64_t n);
+  static Value boolean(bool b);
+  static Value word(std::string w);
+  static Value string(std::string s);
+  static Value ref(std::string symbol);
+  static Value point(const Vec3 &p);
+  static Value direction(const Vec3 &d);
+
+  bool operator==(const Value &o) const;
+
+private:
+  static Value makeNumber(ValueType t, double v);
+};
+
+struct Attr {
+  std::string name;
+  Value value;
+};
+
+/// Where a node came from: the STEP-NC instance and its place in the file.
+struct Origin {
+  uint64_t entityId = 0;
+  SourceLoc loc;
+};
+
+struct Node {
+  std::string kind;
+  std::string symbol;  ///< with its sigil ('%' or '@'), or empty
+  std::string label;   ///< the STEP-NC id string, or empty
+  std::vector<Attr> attrs;
+  std::vector<Node> children;
+  Origin origin;
+  /// Facts derived by passes, printed as a trailing comment, never parsed as data.
+  std::string comment;
+
+  explicit Node(std::string k = {}) : kind(std::move(k)) {}
+
+  /// Adds or replaces an attribute.
+  Node &set(std::string name, Value v);
+  const Value *get(std::string_view name) const;
+  bool has(std::string_view name) const { return get(name) != nullptr; }
+  /// Typed reads; empty when absent (the verifier checks types against the kind table).
+  std::optional<double> number(std::string_view name) const;
+  std::optional<int64_t> count(std::string_view name) const;
+  std::optional<bool> flag(std::string_view name) const;
+  std::optional<std::string> text(std::string_view name) const;  ///< Word, Text or Ref
+  std::optional<Vec3> vec(std::string_view name) const;
+
+  Node &add(Node child) {
+    children.push_back(std::move(child));
+    return children.back();
+  }
+  /// Children of one kind, in order.
+  std::vector<const Node *> childrenOf(std::string_view kind) const;
+  const Node *child(std::string_view kind) const;
+};
+
+/// A whole program: the root node (`project`) and the file it came from.
+struct Module {
+  Node root{"project"};
+  std::string sourceName;
+};
+
+/// Structural equality (kinds, symbols, labels, attributes, children; not origins).
+bool equal(const Node &a, const Node &b);
+
+} // namespace stepnc::ir

@@ -1,0 +1,291 @@
+// Verifies a module in two walks over the tree: the first collects the symbols
+// (reporting duplicates), the second checks each node against its kind's spec,
+// its values, its references (which need every symbol) and its children. The
+// few rules the kind table cannot express (which kind a reference must name,
+// which children an operation has at most one of) are tables here.
+#include "ir/Verifier.h"
+
+#include "ir/Printer.h"
+#include "support/Format.h"
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+
+namespace stepnc::ir {
+
+namespace {
+
+/// A reference attribute whose target must be a node of a given kind or category.
+struct RefRule {
+  std::string_view owner;   ///< kind or category of the node holding the attribute
+  std::string_view attr;
+  std::string_view target;  ///< kind or category of the node referred to
+};
+
+constexpr RefRule kRefRules[] = {
+    {"operation", "tool", "tool"},
+    {"workingstep", "feature", "feature"},
+    {"workpiece_setup", "workpiece", "workpiece"},
+    {"workplan", "setup", "setup"},
+};
+
+/// Children an operation has at most one of; the kinds of one entry count together.
+constexpr std::string_view kAtMostOnePerOperation[] = {
+    "technology", "machine_functions", "strategy drilling_strategy", "approach", "retract",
+};
+
+constexpr double kUnitTolerance = 1e-6;
+
+bool isA(const KindSpec &k, std::string_view kindOrCategory) {
+  return k.kind == kindOrCategory || k.category == kindOrCategory;
+}
+
+/// True if `word` is one of the space-separated words of `list`.
+bool inList(std::string_view list, std::string_view word) {
+  while (!list.empty()) {
+    const size_t space = list.find(' ');
+    if (list.substr(0, space) == word)
+      return true;
+    list = space == std::string_view::npos ? std::string_view() : list.substr(space + 1);
+  }
+  return false;
+}
+
+/// "a, b or c" from the space-separated "a b c".
+std::string joinWords(std::string_view list) {
+  std::string out;
+  for (size_t space; (space = list.find(' ')) != std::string_view::npos; list.remove_prefix(space + 1)) {
+    out += list.substr(0, space);
+    out += list.find(' ', space + 1) == std::string_view::npos ? " or " : ", ";
+  }
+  return out += list;
+}
+
+bool isRadius(std::string_view name) { return name == "radius" || name.ends_with("_radius"); }
+
+/// Lengths that must be positive; radii may also be 0.
+bool isDimension(std::string_view name) {
+  return isRadius(name) || name == "depth" || name == "diameter" || name == "width" || name == "length" ||
+         name == "pitch" || name == "travel";
+}
+
+bool isNumber(ValueType t) {
+  return t == ValueType::Length || t == ValueType::Angle || t == ValueType::Feed || t == ValueType::Spindle ||
+         t == ValueType::Time || t == ValueType::Ratio;
+}
+
+std::string quoted(std::string_view s) {
+  std::string out = "'";
+  out += s;
+  return out + "'";
+}
+
+std::string attribute(std::string_view name) { return "attribute " + quoted(name); }
+
+std::string printed(const Value &v) {
+  std::string out;
+  printValue(v, out);
+  return out;
+}
+
+/// How messages name a node: its kind and its symbol, or its label when it has no symbol.
+std::string nameOf(const Node &n) {
+  if (!n.symbol.empty())
+    return n.kind + " " + n.symbol;
+  if (!n.label.empty())
+    return n.kind + " \"" + n.label + "\"";
+  return n.kind;
+}
+
+class Verifier {
+public:
+  explicit Verifier(DiagnosticEngine &diags) : diags_(diags) {}
+
+  bool run(const Module &m) {
+    collectSymbols(m.root);
+    if (m.root.kind != "project")
+      report(m.root, "expected the root node 'project', found " + quoted(m.root.kind));
+    checkNode(m.root, nullptr, true);
+    return errors_ == 0;
+  }
+
+private:
+  void collectSymbols(const Node &n);
+  /// `parent` is null under a node of unknown kind.
+  void checkNode(const Node &n, const KindSpec *parent, bool isRoot);
+  void checkPlace(const Node &n, const KindSpec &spec, const KindSpec *parent);
+  void checkHead(const Node &n, const KindSpec &spec);
+  void checkAttrs(const Node &n, const KindSpec &spec);
+  void checkValue(const Node &n, const Attr &a);
+  void checkRef(const Node &n, const KindSpec &spec, const Attr &a);
+  void checkChildren(const Node &n, const KindSpec &spec);
+  InFlightDiagnostic report(const Node &n, const std::string &message);
+
+  DiagnosticEngine &diags_;
+  std::unordered_map<std::string_view, const Node *> symbols_;
+  unsigned errors_ = 0;
+};
+
+InFlightDiagnostic Verifier::report(const Node &n, const std::string &message) {
+  ++errors_;
+  InFlightDiagnostic d = diags_.error(n.origin.loc, nameOf(n) + ": " + message);
+  if (n.origin.entityId != 0)
+    d.entity(n.origin.entityId);
+  return d;
+}
+
+void Verifier::collectSymbols(const Node &n) {
+  if (!n.symbol.empty()) {
+    auto [first, inserted] = symbols_.emplace(n.symbol, &n);
+    if (!inserted)
+      report(n, "symbol " + quoted(n.symbol) + " is defined twice")
+          .note(first->second->origin.loc, "first defined by " + nameOf(*first->second));
+  }
+  for (const Node &c : n.children)
+    collectSymbols(c);
+}
+
+void Verifier::checkNode(const Node &n, const KindSpec *parent, bool isRoot) {
+  const KindSpec *spec = findKind(n.kind);
+  if (!spec) {
+    report(n, "unknown node kind " + quoted(n.kind));
+  } else {
+    if (!isRoot)
+      checkPlace(n, *spec, parent);
+    checkHead(n, *spec);
+    checkAttrs(n, *spec);
+    checkChildren(n, *spec);
+  }
+  if (n.comment.find('\n') != std::string::npos)
+    report(n, "the comment has a line break, expected one line");
+  for (const Node &c : n.children)
+    checkNode(c, spec, false);
+}
+
+/// Below the root: never `project`, other kinds only where their parent's spec allows them.
+void Verifier::checkPlace(const Node &n, const KindSpec &spec, const KindSpec *parent) {
+  if (spec.kind == "project")
+    report(n, "'project' is only allowed as the root node");
+  else if (parent && !childAllowed(*parent, spec))
+    report(n, "not allowed under " + quoted(parent->kind) + ", which takes " + allowedChildren(*parent));
+}
+
+/// The symbol, the label and the comment.
+void Verifier::checkHead(const Node &n, const KindSpec &spec) {
+  const char sigil = sigilChar(spec.sigil);
+  if (!sigil && !n.symbol.empty())
+    report(n, "takes no symbol, found " + quoted(n.symbol));
+  else if (sigil && n.symbol.empty())
+    report(n, std::string("missing its '") + sigil + "' symbol");
+  else if (sigil && n.symbol[0] != sigil)
+    report(n, std::string("expected a '") + sigil + "' symbol, found " + quoted(n.symbol));
+  else if (sigil && !isSymbol(n.symbol))
+    report(n, "symbol " + quoted(n.symbol) + " is not a sigil followed by letters, digits or '_'");
+  if (!spec.label && !n.label.empty())
+    report(n, "takes no label");
+}
+
+void Verifier::checkAttrs(const Node &n, const KindSpec &spec) {
+  for (const AttrSpec &a : spec.attrs)
+    if (a.required && !n.has(a.name))
+      report(n, "missing required attribute " + quoted(a.name));
+  for (auto it = n.attrs.begin(); it != n.attrs.end(); ++it) {
+    const AttrSpec *a = findAttr(spec, it->name);
+    if (std::any_of(n.attrs.begin(), it, [&](const Attr &earlier) { return earlier.name == it->name; }))
+      report(n, attribute(it->name) + " is given twice");
+    else if (!a)
+      report(n, "unknown " + attribute(it->name) + " for " + quoted(spec.kind));
+    else if (it->value.type != a->type)
+      report(n, attribute(it->name) + " is " + describeValue(*a) + ", found a value of type " +
+                    valueTypeName(it->value.type));
+    else if (a->type == ValueType::Word && !wordAllowed(*a, it->value.text))
+      report(n, attribute(it->name) + " is " + describeValue(*a) + ", found " + quoted(it->value.text));
+    else if (a->type == ValueType::Ref)
+      checkRef(n, spec, *it);
+    else
+      checkValue(n, *it);
+  }
+}
+
+/// Numbers finite, directions of unit length, dimensions positive.
+void Verifier::checkValue(const Node &n, const Attr &a) {
+  const Value &v = a.value;
+  auto attr = [&] { return attribute(a.name); };
+  if (isNumber(v.type) && !std::isfinite(v.number))
+    report(n, attr() + " must be a finite number, found " + formatShortest(v.number));
+  else if (v.type == ValueType::Length && isDimension(a.name) && (isRadius(a.name) ? v.number < 0 : v.number <= 0))
+    report(n, attr() + (isRadius(a.name) ? " must not be negative" : " must be positive") + ", found " + printed(v));
+  else if (v.type == ValueType::Point && !v.vec.allFinite())
+    report(n, attr() + " must have finite coordinates");
+  else if (v.type == ValueType::Direction && !(std::abs(v.vec.norm() - 1) <= kUnitTolerance))
+    report(n, attr() + " must be a unit vector, found length " + formatFixed(v.vec.norm(), 6));
+}
+
+/// The reference resolves, and names the kind its rule asks for.
+void Verifier::checkRef(const Node &n, const KindSpec &spec, const Attr &a) {
+  auto found = symbols_.find(a.value.text);
+  if (found == symbols_.end()) {
+    report(n, attribute(a.name) + " refers to " + quoted(a.value.text) + ", which is not defined");
+    return;
+  }
+  const Node &target = *found->second;
+  const KindSpec *targetSpec = findKind(target.kind);
+  for (const RefRule &rule : kRefRules)
+    if (rule.attr == a.name && isA(spec, rule.owner) && !(targetSpec && isA(*targetSpec, rule.target)))
+      report(n, attribute(a.name) + " refers to " + quoted(a.value.text) + ", a " + target.kind + ", expected a " +
+                    std::string(rule.target));
+}
+
+/// A workingstep has exactly one operation; an operation at most one of each of kAtMostOnePerOperation.
+void Verifier::checkChildren(const Node &n, const KindSpec &spec) {
+  auto count = [&](auto matches) { return std::count_if(n.children.begin(), n.children.end(), matches); };
+  if (spec.kind == "workingstep") {
+    auto operations = count([](const Node &c) {
+      const KindSpec *k = findKind(c.kind);
+      return k && k->category == "operation";
+    });
+    if (operations != 1)
+      report(n, "expected exactly one operation, found " + std::to_string(operations));
+  }
+  if (spec.category != "operation")
+    return;
+  for (std::string_view kinds : kAtMostOnePerOperation) {
+    auto found = count([&](const Node &c) { return inList(kinds, c.kind); });
+    if (found > 1)
+      report(n, "expected at most one " + joinWords(kinds) + ", found " + std::to_string(found));
+  }
+}
+
+} // namespace
+
+bool isNameChar(char c) {
+  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
+}
+
+char sigilChar(Sigil s) {
+  switch (s) {
+  case Sigil::Resource: return '%';
+  case Sigil::Executable: return '@';
+  case Sigil::None: return '\0';
+  }
+  return '\0';
+}
+
+bool isSymbol(std::string_view s) {
+  return s.size() >= 2 && (s[0] == '%' || s[0] == '@') && std::all_of(s.begin() + 1, s.end(), isNameChar);
+}
+
+bool wordAllowed(const AttrSpec &a, std::string_view word) {
+  if (a.words.empty())
+    return !word.empty() && std::all_of(word.begin(), word.end(), isNameChar);
+  return inList(a.words, word);
+}
+
+std::string allowedChildren(const KindSpec &parent) {
+  return parent.children.empty() ? "no children" : joinWords(parent.children);
+}
+
+bool verifyModule(const Module &m, DiagnosticEngine &diags) { return Verifier(diags).run(m); }
+
+} // namespace stepnc::ir

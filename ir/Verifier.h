@@ -1,0 +1,43 @@
+// The IR verifier: checks a module against the kind table and the rules that
+// span nodes, so every pass can assume a well-formed module and the printer's
+// text parses back.
+//
+// Table-driven checks: known kinds, attributes the kind lists with their value
+// types and allowed words, required attributes, allowed children, symbol
+// sigils. Module checks: `project` is the root and only the root, symbols are
+// unique, every reference resolves (and the tool of an operation is a `tool`,
+// the feature of a workingstep a feature, ...), a workingstep has exactly one
+// operation, an operation at most one of each technology, machine functions,
+// strategy, approach and retract. Value checks: numbers finite, directions of
+// unit length, dimensions (depth, diameter, width, length, pitch, travel)
+// positive and radii not negative.
+#pragma once
+
+#include "ir/Kinds.h"
+#include "ir/Node.h"
+#include "support/Diagnostics.h"
+
+#include <string>
+#include <string_view>
+
+namespace stepnc::ir {
+
+/// Reports every violation at the node's origin.loc (none when it is invalid),
+/// naming the node (`closed_pocket %pocket1: ...`). True when there was none.
+bool verifyModule(const Module &m, DiagnosticEngine &diags);
+
+// Rules shared with the parser.
+
+/// Letters, digits and '_': what kinds, attribute names, words and symbol names are made of.
+bool isNameChar(char c);
+/// '%' for resources, '@' for executables, '\0' for kinds without a symbol.
+char sigilChar(Sigil s);
+/// True for a sigil ('%' or '@') followed by one or more letters, digits or '_'.
+bool isSymbol(std::string_view s);
+/// True if `word` may be the value of the Word attribute `a`: one of its words,
+/// or any run of letters, digits and '_' when the table lists none.
+bool wordAllowed(const AttrSpec &a, std::string_view word);
+/// The children `parent` takes, for messages: "rawpiece, clamp or feature", or "no children".
+std::string allowedChildren(const KindSpec &parent);
+
+} // namespace stepnc::ir
