@@ -418,7 +418,7 @@ bool Binder::checkValue(const Value &v, TypeId type, const Context &ctx, bool op
         t.first = entry(ctx.entry).begin() + v.offset;
       return true;
     }
-    if (options_.unsetMandatoryIsWarning && ctx.path.empty()) {
+    if (options_.lenient && ctx.path.empty()) {
       const p21::InstanceEntry &e = entry(ctx.entry);
       diags_.warning(file_.loc(e.begin() + v.offset),
                      "attribute " + std::to_string(ctx.position) + " '" + (ctx.slot ? ctx.slot->name : "") +
@@ -616,11 +616,14 @@ void Binder::checkInstance(size_t index, const p21::ValueArena &values) {
       std::string subs;
       for (EntityId s : ent.subtypes)
         subs += (subs.empty() ? "" : ", ") + model_.entity(s).name;
-      diags_.error(file_.loc(en.begin() + records[0].offset),
-                   "entity '" + ent.name + "' is abstract and cannot be instantiated" +
-                       (subs.empty() ? std::string() : "; use one of its subtypes: " + subs))
-          .entity(en.id, entityName(index));
-      return;
+      const std::string message = "entity '" + ent.name + "' is abstract and cannot be instantiated" +
+                                  (subs.empty() ? std::string() : "; use one of its subtypes: " + subs);
+      const SourceLoc at = file_.loc(en.begin() + records[0].offset);
+      if (!options_.lenient) {
+        diags_.error(at, message).entity(en.id, entityName(index));
+        return;
+      }
+      diags_.warning(at, message + " (read as written)").entity(en.id, entityName(index));
     }
     checkRecord(index, records[0], e, false);
     return;

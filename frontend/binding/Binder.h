@@ -60,11 +60,12 @@ struct BindOptions {
   /// mandatory aggregate that may be empty (read as empty) or for a mandatory
   /// string such as a name or label (read as '').
   bool strict = false;
-  /// Report `$` in any other mandatory attribute as a warning ("read as
-  /// absent") instead of an error. Compiling uses this: lowering then reports
-  /// an error only where it needs the value, so a file whose drift does not
-  /// touch what is machined still compiles. `stepnc check` keeps it off.
-  bool unsetMandatoryIsWarning = false;
+  /// Compiling's reading: report as warnings what leaves the meaning clear
+  /// enough to machine: `$` in any other mandatory attribute ("read as
+  /// absent"; lowering reports an error where it needs the value) and an
+  /// abstract entity instantiated (its attributes are still checked).
+  /// `stepnc check` keeps these errors.
+  bool lenient = false;
 };
 
 /// Binds and checks every instance of `file` against `schema` (which must

@@ -9,12 +9,7 @@ namespace {
 
 // `depth` is a plane in the feature's frame: the feature goes down to it.
 void setDepth(Lowerer &l, Node &n, const Instance &f) {
-  Instance plane = f.ref("depth");
-  if (!plane) {
-    l.missing(f, "depth");
-    return;
-  }
-  if (auto z = l.planeHeight(plane, "feature depth"))
+  if (auto z = l.planeHeight(f, "depth", "feature depth"))
     n.set("depth", Value::length(-*z));
 }
 

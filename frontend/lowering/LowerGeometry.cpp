@@ -3,6 +3,7 @@
 #include "frontend/lowering/Lowerer.h"
 
 #include <cmath>
+#include <cstdio>
 
 namespace stepnc::lowering {
 
@@ -73,18 +74,25 @@ void Lowerer::setPlacement(Node &node, const Placement &p) {
   node.set("ref", Value::direction(p.ref));
 }
 
-std::optional<double> Lowerer::planeHeight(const Instance &plane, std::string_view role) {
-  if (!plane)
+std::optional<double> Lowerer::planeHeight(const Instance &owner, std::string_view attribute, std::string_view role) {
+  Instance plane = owner.ref(attribute);
+  if (!plane) {
+    missing(owner, attribute);
     return std::nullopt;
+  }
   if (!plane.isA("plane")) {
     unsupported(plane, std::string(role) + " must be a PLANE");
     return std::nullopt;
   }
   std::optional<Placement> p = placement(plane.ref("position"));
-  if (!p)
+  if (!p) {
+    missing(plane, "position");
     return std::nullopt;
+  }
   if (std::abs(std::abs(p->axis.z()) - 1.0) > 1e-9) {
-    unsupported(plane, std::string(role) + " not normal to the z axis");
+    char normal[96];
+    std::snprintf(normal, sizeof normal, "(%g, %g, %g)", p->axis.x(), p->axis.y(), p->axis.z());
+    unsupported(plane, std::string(role) + " whose normal " + normal + " is not the z axis");
     return std::nullopt;
   }
   return p->at.z();

@@ -144,10 +144,8 @@ std::optional<std::string> Lowerer::setup(const Instance &s) {
     if (auto p = placement(o))
       origin = *p;
   setPlacement(node, origin);
-  if (auto h = planeHeight(s.ref("its_secplane"), "security plane"))
+  if (auto h = planeHeight(s, "its_secplane", "security plane"))
     node.set("secplane", Value::length(*h));
-  else
-    missing(s, "its_secplane");
   for (const Instance &ws : s.refs("its_workpiece_setup")) {
     Node w("workpiece_setup");
     stamp(w, ws, "");
@@ -177,10 +175,8 @@ std::optional<Node> Lowerer::workingstep(const Instance &ws) {
     node.set("feature", Value::ref(*f));
   else
     missing(ws, "its_feature");
-  if (auto h = planeHeight(ws.ref("its_secplane"), "security plane"))
+  if (auto h = planeHeight(ws, "its_secplane", "security plane"))
     node.set("secplane", Value::length(*h));
-  else
-    missing(ws, "its_secplane");
   if (Instance op = ws.ref("its_operation")) {
     if (auto lowered = operation(op))
       node.add(std::move(*lowered));
@@ -229,10 +225,8 @@ bool Lowerer::executable(const Instance &exe, Node &parent) {
     Node n("rapid_movement");
     stamp(n, exe);
     n.symbol = symbolFor('@', exe.string("its_id"), "rapid");
-    if (auto h = planeHeight(exe.ref("its_secplane"), "security plane"))
+    if (auto h = planeHeight(exe, "its_secplane", "security plane"))
       n.set("secplane", Value::length(*h));
-    else
-      missing(exe, "its_secplane");
     if (Instance list = exe.ref("its_toolpath"))
       toolpaths(list, n);
     parent.add(std::move(n));

@@ -53,8 +53,10 @@ public:
   /// axis2_placement_3d, with the standard's defaults and orthonormalised axes.
   std::optional<Placement> placement(const Instance &axis2);
   void setPlacement(Node &node, const Placement &p);
-  /// The offset of a plane (elementary_surface) along z: its location's z.
-  std::optional<double> planeHeight(const Instance &plane, std::string_view role);
+  /// The offset along z of the plane (elementary_surface) that attribute
+  /// `attribute` of `owner` refers to: its location's z. Reports an absent or
+  /// unusable plane itself (callers do not report again).
+  std::optional<double> planeHeight(const Instance &owner, std::string_view attribute, std::string_view role);
   /// A toleranced_length_measure (or a plain length) as mm.
   std::optional<double> toleranced(const Instance &owner, std::string_view attribute);
   /// A profile (closed or open) as a profile node; null node kind on failure.

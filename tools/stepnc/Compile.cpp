@@ -52,7 +52,7 @@ int runCompile(const CompileOptions &opts) {
     return kExitUsage;
   }
   binding::BindOptions bindOptions;
-  bindOptions.unsetMandatoryIsWarning = true;
+  bindOptions.lenient = true;
   auto bound = binding::bind(*file, *model, *schema, diags, bindOptions);
   if (diags.hasErrors())
     return failed();
