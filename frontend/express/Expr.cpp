@@ -3,10 +3,15 @@
 namespace stepnc::express {
 
 std::string printExpr(const Expr &e) {
-  auto list = [&](std::string head) {
-    for (const Expr &a : e.args)
-      head += " " + printExpr(a);
-    return "(" + head + ")";
+  auto list = [&](const std::string &head) {
+    std::string out = "(";
+    out += head;
+    for (const Expr &a : e.args) {
+      out += ' ';
+      out += printExpr(a);
+    }
+    out += ')';
+    return out;
   };
   switch (e.kind) {
   case Expr::Integer:

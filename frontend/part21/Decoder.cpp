@@ -12,6 +12,7 @@
 
 #include "frontend/part21/Lexing.h"
 
+#include <array>
 #include <charconv>
 #include <cstdio>
 #include <cstring>
@@ -53,19 +54,32 @@ bool appendIso8859(std::string &out, unsigned part, unsigned char byte) {
     utf8::append(out, byte);
     return true;
   }
-  std::string from = "ISO-8859-" + std::to_string(part);
-  iconv_t cd = ::iconv_open("UTF-8", from.c_str());
-  if (cd == reinterpret_cast<iconv_t>(-1))
+  // The upper halves of ISO 8859-2..9, converted by iconv once, on first use
+  // (a thread-safe static initialisation).
+  using Pages = std::array<std::array<std::string, 96>, 10>;
+  static const Pages table = [] {
+    Pages pages;
+    for (unsigned page = 2; page <= 9; ++page) {
+      const std::string from = "ISO-8859-" + std::to_string(page);
+      iconv_t cd = ::iconv_open("UTF-8", from.c_str());
+      if (cd == reinterpret_cast<iconv_t>(-1))
+        continue;
+      for (unsigned b = 0xA0; b <= 0xFF; ++b) {
+        char in[1] = {static_cast<char>(b)};
+        char buf[8];
+        char *inp = in, *outp = buf;
+        size_t inLeft = 1, outLeft = sizeof buf;
+        if (::iconv(cd, &inp, &inLeft, &outp, &outLeft) != static_cast<size_t>(-1))
+          pages[page][b - 0xA0].assign(buf, static_cast<size_t>(outp - buf));
+      }
+      ::iconv_close(cd);
+    }
+    return pages;
+  }();
+  const std::string &utf8 = table[part][byte - 0xA0];
+  if (utf8.empty())
     return false;
-  char in[1] = {static_cast<char>(byte)};
-  char buf[8];
-  char *inp = in, *outp = buf;
-  size_t inLeft = 1, outLeft = sizeof buf;
-  size_t r = ::iconv(cd, &inp, &inLeft, &outp, &outLeft);
-  ::iconv_close(cd);
-  if (r == static_cast<size_t>(-1))
-    return false;
-  out.append(buf, static_cast<size_t>(outp - buf));
+  out += utf8;
   return true;
 }
 
@@ -167,8 +181,8 @@ bool Decoder::parseParam(unsigned depth) {
     } else if (isKeywordStart(c)) {
       // Typed parameter: TYPE_NAME(value).
       const char *n = p_;
-      if (*p_ == '!')
-        ++p_;
+      if (*p_ == '!' && (++p_ >= end_ || !isKeywordStart(*p_) || *p_ == '!'))
+        return fail(n, "expected a user-defined type name after '!'");
       while (p_ < end_ && isKeywordChar(*p_))
         ++p_;
       const std::string_view typeName(n, static_cast<size_t>(p_ - n));
@@ -468,8 +482,8 @@ bool Decoder::parseRecordBody(Record &out, NameId known) {
   const char *n = p_;
   if (p_ >= end_ || !isKeywordStart(*p_))
     return fail(p_, "expected an entity name");
-  if (*p_ == '!')
-    ++p_;
+  if (*p_ == '!' && (++p_ >= end_ || !isKeywordStart(*p_) || *p_ == '!'))
+    return fail(n, "expected a user-defined entity name after '!'");
   while (p_ < end_ && isKeywordChar(*p_))
     ++p_;
   // The instance table already interned a simple instance's name.

@@ -186,6 +186,7 @@ private:
   std::vector<DataSection> sections_;
   std::vector<Anchor> anchors_;
   std::vector<ExternalReference> references_;
+  std::vector<InstanceId> referenceIds_;  ///< sorted ids of references_
   std::vector<InstanceEntry> entries_;
   IdIndex index_;
 };

@@ -363,8 +363,13 @@ bool Reader::scanInstance() {
     name = kComplexInstance;
   } else if (p_ < end_ && isKeywordStart(*p_)) {
     const char *n = p_;
-    if (*p_ == '!')
+    if (*p_ == '!') {
       ++p_;
+      if (p_ >= end_ || !isKeywordStart(*p_) || *p_ == '!') {
+        diags_.error(loc(n), "expected a user-defined entity name after '!'");
+        return false;
+      }
+    }
     uint8_t classes = 0;
     while (p_ < end_ && isKeywordChar(*p_))
       classes |= classOf(*p_++);
@@ -553,9 +558,18 @@ void Reader::parseReference() {
       continue;
     }
     ++p_;
+    const char *digits = p_;
     uint64_t id = 0;
-    while (p_ < end_ && isDigit(*p_))
+    bool overflow = false;
+    while (p_ < end_ && isDigit(*p_)) {
+      overflow |= id > (UINT64_MAX - 9) / 10;
       id = id * 10 + static_cast<uint64_t>(*p_++ - '0');
+    }
+    if (overflow) {
+      diags_.error(loc(digits), "instance id is too large");
+      skipStatement();
+      continue;
+    }
     if (!layout() || p_ >= end_ || *p_ != '=') {
       diags_.error(loc(p_), "expected '=' in REFERENCE entry");
       skipStatement();
@@ -676,8 +690,7 @@ void Part21File::buildIndex(DiagnosticEngine &diags) {
 bool Part21File::isDefined(InstanceId id) const {
   if (indexOf(id) >= 0)
     return true;
-  return std::any_of(references_.begin(), references_.end(),
-                     [id](const ExternalReference &r) { return r.id == id; });
+  return std::binary_search(referenceIds_.begin(), referenceIds_.end(), id);
 }
 
 std::unique_ptr<Part21File> readPart21(const SourceFile &source, DiagnosticEngine &diags,
@@ -688,6 +701,9 @@ std::unique_ptr<Part21File> readPart21(const SourceFile &source, DiagnosticEngin
   Reader reader(*file, diags);
   reader.run();
   file->buildIndex(diags);
+  for (const ExternalReference &r : file->references_)
+    file->referenceIds_.push_back(r.id);
+  std::sort(file->referenceIds_.begin(), file->referenceIds_.end());
   return file;
 }
 

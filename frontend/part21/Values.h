@@ -38,6 +38,12 @@ enum class ValueKind : uint8_t {
 
 const char *valueKindName(ValueKind k);
 
+/// Where a list's or typed parameter's children are.
+struct NodeRef {
+  uint32_t first;  ///< index of the first child in the arena
+  NameId name;     ///< Typed: the type name
+};
+
 struct Value {
   ValueKind kind = ValueKind::Unset;
   /// List/Typed: number of children; String/Binary/Enumeration: length in bytes.
@@ -49,10 +55,7 @@ struct Value {
     double real;
     InstanceId ref;
     const char *text;
-    struct {
-      uint32_t first;  ///< index of the first child in the arena
-      NameId name;     ///< Typed: the type name
-    } node;
+    NodeRef node;
   };
 
   Value() : integer(0) {}
