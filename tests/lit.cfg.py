@@ -14,7 +14,7 @@ config.test_format = lit.formats.ShTest(execute_external=True)
 config.suffixes = [".test", ".p21"]
 config.test_source_root = os.path.dirname(__file__)
 config.test_exec_root = os.path.join(config.stepnc_obj_root, "tests")
-config.excludes = ["Inputs", "unit", "fuzz", "CMakeLists.txt", "lit.cfg.py"]
+config.excludes = ["Inputs", "unit", "fuzz", "CMakeLists.txt", "lit.cfg.py", "update-corpus-checks.py"]
 # Helper scripts beside tests (foo.test.sh) are not tests themselves.
 
 config.environment["PATH"] = os.pathsep.join(

@@ -2,7 +2,10 @@
 // operations with their technology, machine functions, strategies and
 // approach/retract, explicit toolpaths; and the tools they use (ISO 14649-111).
 #include "frontend/lowering/Lowerer.h"
+#include "support/Format.h"
 
+#include <cmath>
+#include <cstdio>
 #include <utility>
 
 namespace stepnc::lowering {
@@ -102,14 +105,34 @@ std::optional<std::string> Lowerer::tool(const Instance &t) {
 
 namespace {
 
-Node technology(const Lowerer &l, const Instance &tech) {
+// Feeds and cutting speeds whose unit the ARM leaves implicit are read as m/s
+// (UnitConventions). A converted value far outside what machines do means the
+// file uses another convention: say so, with the value as read.
+void checkPlausible(Lowerer &l, const Instance &tech, std::string_view attribute, double mmPerMin,
+                    double low, double high) {
+  if (mmPerMin == 0.0 || (std::abs(mmPerMin) >= low && std::abs(mmPerMin) <= high))
+    return;
+  char text[160];
+  std::snprintf(text, sizeof text, "%s %g read as %.1f mm/min (the value taken as m/s), outside %g..%g mm/min: "
+                "the file may use another unit", std::string(attribute).c_str(), *tech.real(attribute),
+                mmPerMin, low, high);
+  l.diags().warning(tech.attrLoc(attribute), text).entity(tech.id(), "MILLING_TECHNOLOGY");
+}
+
+Node technology(Lowerer &l, const Instance &tech) {
   Node n("technology");
-  if (auto f = tech.real("feedrate"))
-    n.set("feed", Value::feed(l.feedMmPerMin(*f)));
+  if (auto f = tech.real("feedrate")) {
+    const double feed = l.feedMmPerMin(*f);
+    n.set("feed", Value::feed(feed));
+    checkPlausible(l, tech, "feedrate", feed, 1.0, 100000.0);
+  }
   if (auto fz = tech.real("feedrate_per_tooth"))
     n.set("feed_per_tooth", Value::length(*fz));
-  if (auto vc = tech.real("cutspeed"))
-    n.set("cutting_speed", Value::feed(l.feedMmPerMin(*vc)));
+  if (auto vc = tech.real("cutspeed")) {
+    const double speed = l.feedMmPerMin(*vc);
+    n.set("cutting_speed", Value::feed(speed));
+    checkPlausible(l, tech, "cutspeed", speed, 1000.0, 3000000.0);
+  }
   if (auto s = tech.real("spindle"))
     n.set("spindle", Value::spindle(l.spindleRevPerMin(*s)));
   n.set("feed_reference", Value::word(tech.enumeration("feedrate_reference").value_or("tcp")));
@@ -225,8 +248,15 @@ std::optional<Node> Lowerer::operation(const Instance &op) {
         Node s("strategy");
         stamp(s, strategy, "");
         s.set("type", Value::word(std::string(type)));
-        if (auto o = strategy.real("overlap"))
+        if (auto o = strategy.real("overlap")) {
           s.set("overlap", Value::ratio(*o));
+          if (*o > 1.0)
+            diags_.warning(strategy.attrLoc("overlap"),
+                           "overlap " + formatFixed(*o, 4) +
+                               " is more than 1: ISO 14649 gives it as a ratio (0.5 = 50 %); read as written, "
+                               "the file may mean percent")
+                .entity(strategy.id(), std::string(strategy.entityName()));
+        }
         if (auto b = strategy.boolean("allow_multiple_passes"))
           s.set("multiple_passes", Value::boolean(*b));
         if (Instance fd = strategy.ref("feed_direction"))

@@ -1,10 +1,12 @@
 // `stepnc compile IN --emit=feature-ir`: reads a STEP-NC file, checks it
 // against its schema, lowers it to the feature IR, verifies the IR and prints
-// it. Later stages (strategy expansion, targets) extend this command. Nothing
-// is written when there are errors; files are written atomically.
+// it. `stepnc opt IN` does the same from IR text too. Later stages (strategy
+// expansion, passes, targets) extend these commands. Nothing is written when
+// there are errors; files are written atomically.
 #include "frontend/binding/Binder.h"
 #include "frontend/lowering/Lowering.h"
 #include "frontend/part21/Part21File.h"
+#include "ir/Parser.h"
 #include "ir/Printer.h"
 #include "ir/Verifier.h"
 #include "support/OutputFile.h"
@@ -27,47 +29,46 @@ struct CompileOptions {
   DiagnosticOptions diag;
 };
 
-int runCompile(const CompileOptions &opts) {
-  auto source = openInput(opts.input);
-  if (!source)
-    return kExitUsage;
-  DiagnosticSession session(opts.diag);
-  DiagnosticEngine &diags = session.engine();
-  SchemaSelection schemas(opts.schema);
-  bool io = false;
-  if (!schemas.load(diags, io))
-    return io ? kExitUsage : kExitDiagnostics;
-  auto failed = [&] {
-    std::cerr << "stepnc: " << opts.input << " has errors; nothing written\n";
-    return kExitDiagnostics;
-  };
-  auto file = p21::readPart21(*source, diags);
+// Reads `path` as IR text (a file that starts with the IR's comment line or
+// `project`) or as STEP-NC, which is checked and lowered. Returns null after
+// reporting errors.
+std::unique_ptr<ir::Module> loadModule(const SourceFile &source, const SchemaSelection &schemas,
+                                       DiagnosticEngine &diags, bool &usage) {
+  std::string_view text = source.text();
+  while (!text.empty() && (text[0] == ' ' || text[0] == '\n' || text[0] == '\r' || text[0] == '\t'))
+    text.remove_prefix(1);
+  if (text.starts_with(";") || text.starts_with("project")) {
+    auto module = ir::parseModule(source, diags);
+    if (!module || diags.hasErrors())
+      return nullptr;
+    return module;
+  }
+  auto file = p21::readPart21(source, diags);
   if (diags.hasErrors())
-    return failed();
+    return nullptr;
   const express::Model *model = nullptr;
   const express::Schema *schema = schemas.select(*file, diags, model);
   if (!schema) {
-    printToolError("cannot compile " + opts.input +
+    printToolError("cannot compile " + std::string(source.name()) +
                    " without a schema: give its EXPRESS file with --schema FILE.exp");
-    return kExitUsage;
+    usage = true;
+    return nullptr;
   }
   binding::BindOptions bindOptions;
   bindOptions.lenient = true;
   auto bound = binding::bind(*file, *model, *schema, diags, bindOptions);
   if (diags.hasErrors())
-    return failed();
+    return nullptr;
   auto module = lowering::lowerToFeatureIR(*bound, diags);
   if (!module || diags.hasErrors())
-    return failed();
-  if (!ir::verifyModule(*module, diags))
-    return failed();
+    return nullptr;
+  return module;
+}
 
-  ir::PrintOptions printOptions;
-  printOptions.locations = opts.printLocations;
-  const std::string text = ir::printModule(*module, printOptions);
+int writeText(const std::string &path, const std::string &text) {
   OutputFile out;
   std::string error;
-  if (!out.open(opts.output, error)) {
+  if (!out.open(path, error)) {
     printToolError(error);
     return kExitUsage;
   }
@@ -79,7 +80,45 @@ int runCompile(const CompileOptions &opts) {
   return kExitOk;
 }
 
+int runCompile(const CompileOptions &opts) {
+  auto source = openInput(opts.input);
+  if (!source)
+    return kExitUsage;
+  DiagnosticSession session(opts.diag);
+  DiagnosticEngine &diags = session.engine();
+  SchemaSelection schemas(opts.schema);
+  bool usage = false;
+  if (!schemas.load(diags, usage))
+    return usage ? kExitUsage : kExitDiagnostics;
+  auto module = loadModule(*source, schemas, diags, usage);
+  if (module && !ir::verifyModule(*module, diags))
+    module.reset();
+  if (!module) {
+    if (usage)
+      return kExitUsage;
+    std::cerr << "stepnc: " << opts.input << " has errors; nothing written\n";
+    return kExitDiagnostics;
+  }
+  ir::PrintOptions printOptions;
+  printOptions.locations = opts.printLocations;
+  return writeText(opts.output, ir::printModule(*module, printOptions));
+}
+
 } // namespace
+
+void registerOpt(CLI::App &app, std::function<void(int)> setResult) {
+  auto opts = std::make_shared<CompileOptions>();
+  CLI::App *cmd = app.add_subcommand(
+      "opt", "Read process IR text (or a STEP-NC file, lowered first), verify it and print it.\n"
+             "The IR tool for tests and pipelines; passes will run here as they arrive.");
+  cmd->add_option("input", opts->input, "IR text or STEP-NC file")->required();
+  cmd->add_option("-o,--output", opts->output, "Output file ('-', the default, for standard output)");
+  cmd->add_flag("--print-locs", opts->printLocations,
+                "Print each IR node's source location (file:line:col #id)");
+  addSchemaOptions(*cmd, opts->schema);
+  addDiagnosticOptions(*cmd, opts->diag);
+  cmd->callback([opts, setResult] { setResult(runCompile(*opts)); });
+}
 
 void registerCompile(CLI::App &app, std::function<void(int)> setResult) {
   auto opts = std::make_shared<CompileOptions>();

@@ -9,6 +9,7 @@ void registerCheck(CLI::App &app, std::function<void(int)> setResult);
 void registerConvert(CLI::App &app, std::function<void(int)> setResult);
 void registerSchema(CLI::App &app, std::function<void(int)> setResult);
 void registerCompile(CLI::App &app, std::function<void(int)> setResult);
+void registerOpt(CLI::App &app, std::function<void(int)> setResult);
 } // namespace stepnc::tool
 
 int main(int argc, char **argv) {
@@ -25,6 +26,7 @@ int main(int argc, char **argv) {
   registerCheck(app, setResult);
   registerConvert(app, setResult);
   registerSchema(app, setResult);
+  registerOpt(app, setResult);
   // A first word that is neither an option nor a command is a typo.
   if (argc > 1 && argv[1][0] != '-') {
     std::string names;
