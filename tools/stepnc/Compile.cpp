@@ -104,6 +104,16 @@ int runCompile(const CompileOptions &opts) {
   return writeText(opts.output, ir::printModule(*module, printOptions));
 }
 
+// Options compile and opt share: output, locations, schema, diagnostics.
+void addCommonOptions(CLI::App &cmd, const std::shared_ptr<CompileOptions> &opts,
+                      const std::function<void(int)> &setResult) {
+  cmd.add_option("-o,--output", opts->output, "Output file ('-', the default, for standard output)");
+  cmd.add_flag("--print-locs", opts->printLocations, "Print each IR node's source location (file:line:col #id)");
+  addSchemaOptions(cmd, opts->schema);
+  addDiagnosticOptions(cmd, opts->diag);
+  cmd.callback([opts, setResult] { setResult(runCompile(*opts)); });
+}
+
 } // namespace
 
 void registerOpt(CLI::App &app, std::function<void(int)> setResult) {
@@ -112,12 +122,7 @@ void registerOpt(CLI::App &app, std::function<void(int)> setResult) {
       "opt", "Read process IR text (or a STEP-NC file, lowered first), verify it and print it.\n"
              "The IR tool for tests and pipelines; passes will run here as they arrive.");
   cmd->add_option("input", opts->input, "IR text or STEP-NC file")->required();
-  cmd->add_option("-o,--output", opts->output, "Output file ('-', the default, for standard output)");
-  cmd->add_flag("--print-locs", opts->printLocations,
-                "Print each IR node's source location (file:line:col #id)");
-  addSchemaOptions(*cmd, opts->schema);
-  addDiagnosticOptions(*cmd, opts->diag);
-  cmd->callback([opts, setResult] { setResult(runCompile(*opts)); });
+  addCommonOptions(*cmd, opts, setResult);
 }
 
 void registerCompile(CLI::App &app, std::function<void(int)> setResult) {
@@ -128,15 +133,10 @@ void registerCompile(CLI::App &app, std::function<void(int)> setResult) {
                  "(--emit=feature-ir, the default); toolpaths and controller programs come next.\n"
                  "Nothing is written when the input has errors.");
   cmd->add_option("input", opts->input, "STEP-NC file (Part 21)")->required();
-  cmd->add_option("-o,--output", opts->output, "Output file ('-', the default, for standard output)");
   cmd->add_option("--emit", opts->emit, "What to write: feature-ir (the lowered process IR)")
       ->check(CLI::IsMember({"feature-ir"}))
       ->default_str("feature-ir");
-  cmd->add_flag("--print-locs", opts->printLocations,
-                "Print each IR node's source location (file:line:col #id)");
-  addSchemaOptions(*cmd, opts->schema);
-  addDiagnosticOptions(*cmd, opts->diag);
-  cmd->callback([opts, setResult] { setResult(runCompile(*opts)); });
+  addCommonOptions(*cmd, opts, setResult);
 }
 
 } // namespace stepnc::tool
