@@ -4,6 +4,8 @@
 // attributes: `at` (origin), `axis` (local z), `ref` (local x).
 #include "ir/Kinds.h"
 
+#include <algorithm>
+
 namespace stepnc::ir {
 
 namespace {
@@ -280,18 +282,56 @@ const KindSpec *findKind(std::string_view kind) {
 }
 
 bool childAllowed(const KindSpec &parent, const KindSpec &child) {
-  std::string_view list = parent.children;
+  return inList(parent.children, child.kind) || inList(parent.children, child.category);
+}
+
+bool inList(std::string_view list, std::string_view word) {
   while (!list.empty()) {
-    size_t sp = list.find(' ');
-    std::string_view w = list.substr(0, sp);
-    if (w == child.kind || w == child.category)
+    const size_t space = list.find(' ');
+    if (list.substr(0, space) == word)
       return true;
-    if (sp == std::string_view::npos)
-      break;
-    list = list.substr(sp + 1);
+    list = space == std::string_view::npos ? std::string_view() : list.substr(space + 1);
   }
   return false;
 }
+
+std::string joinWords(std::string_view list) {
+  std::string out;
+  for (size_t space; (space = list.find(' ')) != std::string_view::npos; list.remove_prefix(space + 1)) {
+    out += list.substr(0, space);
+    out += list.find(' ', space + 1) == std::string_view::npos ? " or " : ", ";
+  }
+  return out += list;
+}
+
+bool isNameChar(char c) {
+  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
+}
+
+char sigilChar(Sigil s) {
+  switch (s) {
+  case Sigil::Resource: return '%';
+  case Sigil::Executable: return '@';
+  case Sigil::None: return '\0';
+  }
+  return '\0';
+}
+
+bool isSymbol(std::string_view s) {
+  return s.size() >= 2 && (s[0] == '%' || s[0] == '@') && std::all_of(s.begin() + 1, s.end(), isNameChar);
+}
+
+bool wordAllowed(const AttrSpec &a, std::string_view word) {
+  if (a.words.empty())
+    return !word.empty() && std::all_of(word.begin(), word.end(), isNameChar);
+  return inList(a.words, word);
+}
+
+std::string allowedChildren(const KindSpec &parent) {
+  return parent.children.empty() ? "no children" : joinWords(parent.children);
+}
+
+
 
 const AttrSpec *findAttr(const KindSpec &kind, std::string_view name) {
   for (const AttrSpec &a : kind.attrs)

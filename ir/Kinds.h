@@ -5,6 +5,7 @@
 
 #include "ir/Node.h"
 
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -38,5 +39,24 @@ const std::vector<KindSpec> &allKinds();
 bool childAllowed(const KindSpec &parent, const KindSpec &child);
 /// The spec of attribute `name` of `kind`, or null.
 const AttrSpec *findAttr(const KindSpec &kind, std::string_view name);
+
+/// True if the space-separated `list` contains `word`.
+bool inList(std::string_view list, std::string_view word);
+/// "a, b or c" from the space-separated "a b c", for messages.
+std::string joinWords(std::string_view list);
+
+// Rules of the text form and the table, shared by the parser and the verifier.
+
+/// Letters, digits and '_': what kinds, attribute names, words and symbol names are made of.
+bool isNameChar(char c);
+/// '%' for resources, '@' for executables, '\0' for kinds without a symbol.
+char sigilChar(Sigil s);
+/// True for a sigil ('%' or '@') followed by one or more letters, digits or '_'.
+bool isSymbol(std::string_view s);
+/// True if `word` may be the value of the Word attribute `a`: one of its words,
+/// or any run of letters, digits and '_' when the table lists none.
+bool wordAllowed(const AttrSpec &a, std::string_view word);
+/// The children `parent` takes, for messages: "rawpiece, clamp or feature", or "no children".
+std::string allowedChildren(const KindSpec &parent);
 
 } // namespace stepnc::ir

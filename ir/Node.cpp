@@ -1,5 +1,10 @@
 #include "ir/Node.h"
 
+#include "ir/Kinds.h"
+
+#include <algorithm>
+#include <cstdint>
+
 namespace stepnc::ir {
 
 const char *valueTypeName(ValueType t) {
@@ -81,7 +86,21 @@ Node &Node::set(std::string name, Value v) {
       a.value = std::move(v);
       return *this;
     }
-  attrs.push_back({std::move(name), std::move(v)});
+  // Keep the kind table's order, so that a node built in any order prints,
+  // parses back and compares equal; attributes the table does not list go last.
+  const KindSpec *spec = findKind(kind);
+  auto rank = [spec](std::string_view attribute) -> size_t {
+    if (spec)
+      for (size_t i = 0; i < spec->attrs.size(); ++i)
+        if (spec->attrs[i].name == attribute)
+          return i;
+    return SIZE_MAX;
+  };
+  const size_t mine = rank(name);
+  auto at = attrs.end();
+  if (mine != SIZE_MAX)
+    at = std::find_if(attrs.begin(), attrs.end(), [&](const Attr &a) { return rank(a.name) > mine; });
+  attrs.insert(at, Attr{std::move(name), std::move(v)});
   return *this;
 }
 

@@ -96,7 +96,7 @@ struct Node {
 
   explicit Node(std::string k = {}) : kind(std::move(k)) {}
 
-  /// Adds or replaces an attribute.
+  /// Adds or replaces an attribute, keeping the kind table's attribute order.
   Node &set(std::string name, Value v);
   const Value *get(std::string_view name) const;
   bool has(std::string_view name) const { return get(name) != nullptr; }

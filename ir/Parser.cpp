@@ -7,7 +7,6 @@
 
 #include "ir/Kinds.h"
 #include "ir/Printer.h"
-#include "ir/Verifier.h"
 
 #include <charconv>
 #include <cstring>

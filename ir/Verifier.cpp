@@ -42,26 +42,6 @@ bool isA(const KindSpec &k, std::string_view kindOrCategory) {
 }
 
 /// True if `word` is one of the space-separated words of `list`.
-bool inList(std::string_view list, std::string_view word) {
-  while (!list.empty()) {
-    const size_t space = list.find(' ');
-    if (list.substr(0, space) == word)
-      return true;
-    list = space == std::string_view::npos ? std::string_view() : list.substr(space + 1);
-  }
-  return false;
-}
-
-/// "a, b or c" from the space-separated "a b c".
-std::string joinWords(std::string_view list) {
-  std::string out;
-  for (size_t space; (space = list.find(' ')) != std::string_view::npos; list.remove_prefix(space + 1)) {
-    out += list.substr(0, space);
-    out += list.find(' ', space + 1) == std::string_view::npos ? " or " : ", ";
-  }
-  return out += list;
-}
-
 bool isRadius(std::string_view name) { return name == "radius" || name.ends_with("_radius"); }
 
 /// Lengths that must be positive; radii may also be 0.
@@ -258,33 +238,6 @@ void Verifier::checkChildren(const Node &n, const KindSpec &spec) {
 }
 
 } // namespace
-
-bool isNameChar(char c) {
-  return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
-}
-
-char sigilChar(Sigil s) {
-  switch (s) {
-  case Sigil::Resource: return '%';
-  case Sigil::Executable: return '@';
-  case Sigil::None: return '\0';
-  }
-  return '\0';
-}
-
-bool isSymbol(std::string_view s) {
-  return s.size() >= 2 && (s[0] == '%' || s[0] == '@') && std::all_of(s.begin() + 1, s.end(), isNameChar);
-}
-
-bool wordAllowed(const AttrSpec &a, std::string_view word) {
-  if (a.words.empty())
-    return !word.empty() && std::all_of(word.begin(), word.end(), isNameChar);
-  return inList(a.words, word);
-}
-
-std::string allowedChildren(const KindSpec &parent) {
-  return parent.children.empty() ? "no children" : joinWords(parent.children);
-}
 
 bool verifyModule(const Module &m, DiagnosticEngine &diags) { return Verifier(diags).run(m); }
 

@@ -26,18 +26,4 @@ namespace stepnc::ir {
 /// naming the node (`closed_pocket %pocket1: ...`). True when there was none.
 bool verifyModule(const Module &m, DiagnosticEngine &diags);
 
-// Rules shared with the parser.
-
-/// Letters, digits and '_': what kinds, attribute names, words and symbol names are made of.
-bool isNameChar(char c);
-/// '%' for resources, '@' for executables, '\0' for kinds without a symbol.
-char sigilChar(Sigil s);
-/// True for a sigil ('%' or '@') followed by one or more letters, digits or '_'.
-bool isSymbol(std::string_view s);
-/// True if `word` may be the value of the Word attribute `a`: one of its words,
-/// or any run of letters, digits and '_' when the table lists none.
-bool wordAllowed(const AttrSpec &a, std::string_view word);
-/// The children `parent` takes, for messages: "rawpiece, clamp or feature", or "no children".
-std::string allowedChildren(const KindSpec &parent);
-
 } // namespace stepnc::ir

@@ -113,3 +113,19 @@ TEST_CASE("the sample module prints as golden text", "[ir]") {
       "        drilling_strategy reduced_cut_at_start=0.5000 reduced_feed_at_start=0.5000 depth_of_start=2.0000mm\n";
   CHECK(printModule(test::sampleModule()) == expected);
 }
+
+TEST_CASE("attributes keep the kind table's order whatever the order they are set in", "[ir]") {
+  ir::Node a("round_hole");
+  a.set("diameter", ir::Value::length(12));
+  a.set("depth", ir::Value::length(30));
+  a.set("at", ir::Value::point(ir::Vec3(1, 2, 3)));
+  ir::Node b("round_hole");
+  b.set("at", ir::Value::point(ir::Vec3(1, 2, 3)));
+  b.set("depth", ir::Value::length(30));
+  b.set("diameter", ir::Value::length(12));
+  CHECK(ir::equal(a, b));
+  REQUIRE(a.attrs.size() == 3);
+  CHECK(a.attrs[0].name == "at");
+  CHECK(a.attrs[1].name == "depth");
+  CHECK(a.attrs[2].name == "diameter");
+}
