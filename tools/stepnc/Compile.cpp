@@ -9,6 +9,7 @@
 #include "ir/Parser.h"
 #include "ir/Printer.h"
 #include "ir/Verifier.h"
+#include "passes/PassManager.h"
 #include "support/OutputFile.h"
 #include "tools/stepnc/Driver.h"
 #include "tools/stepnc/SchemaSelection.h"
@@ -25,6 +26,13 @@ struct CompileOptions {
   std::string output = "-";
   std::string emit = "feature-ir";
   bool printLocations = false;
+  // opt only
+  std::string passes;
+  std::vector<std::string> printAfter;
+  bool printAfterAll = false;
+  bool verifyEach = false;
+  bool listPasses = false;
+  bool stats = false;
   SchemaOptions schema;
   DiagnosticOptions diag;
 };
@@ -99,9 +107,43 @@ int runCompile(const CompileOptions &opts) {
     std::cerr << "stepnc: " << opts.input << " has errors; nothing written\n";
     return kExitDiagnostics;
   }
+  if (!opts.passes.empty() || opts.listPasses) {
+    std::string error;
+    auto pipeline = passes::parsePipeline(opts.passes, error);
+    if (!pipeline) {
+      printToolError(error);
+      return kExitUsage;
+    }
+    passes::PassManagerOptions pmOptions;
+    pmOptions.verifyEach = opts.verifyEach;
+    pmOptions.printAfterAll = opts.printAfterAll;
+    pmOptions.printAfter.insert(opts.printAfter.begin(), opts.printAfter.end());
+    pmOptions.print = [](std::string_view text) { std::cerr << text; };
+    passes::PassManager manager(std::move(pmOptions));
+    manager.add(*pipeline);
+    const bool ok = manager.run(*module, diags);
+    if (opts.stats)
+      for (const auto &[pass, counters] : manager.stats())
+        for (const auto &[what, n] : counters)
+          std::cerr << "stats: " << pass << ": " << n << ' ' << what << '\n';
+    if (!ok) {
+      std::cerr << "stepnc: the pass pipeline failed on " << opts.input << "; nothing written\n";
+      return kExitDiagnostics;
+    }
+  }
   ir::PrintOptions printOptions;
   printOptions.locations = opts.printLocations;
   return writeText(opts.output, ir::printModule(*module, printOptions));
+}
+
+int listPasses() {
+  for (const passes::PassInfo &p : passes::registeredPasses()) {
+    std::cout << p.name << "\n    " << p.description << '\n';
+    if (!p.options.empty())
+      std::cout << "    options: " << p.options << '\n';
+  }
+  std::cout.flush();
+  return kExitOk;
 }
 
 // Options compile and opt share: output, locations, schema, diagnostics.
@@ -119,10 +161,27 @@ void addCommonOptions(CLI::App &cmd, const std::shared_ptr<CompileOptions> &opts
 void registerOpt(CLI::App &app, std::function<void(int)> setResult) {
   auto opts = std::make_shared<CompileOptions>();
   CLI::App *cmd = app.add_subcommand(
-      "opt", "Read process IR text (or a STEP-NC file, lowered first), verify it and print it.\n"
-             "The IR tool for tests and pipelines; passes will run here as they arrive.");
-  cmd->add_option("input", opts->input, "IR text or STEP-NC file")->required();
+      "opt", "Read process IR text (or a STEP-NC file, lowered first), verify it, run a pass\n"
+             "pipeline over it (--passes) and print it.");
+  cmd->add_option("input", opts->input, "IR text or STEP-NC file");
+  cmd->add_option("--passes", opts->passes,
+                  "Pass pipeline to run, e.g. 'resolve-feeds' or 'a,b<key=value>' (-passes= works too)");
+  cmd->add_option("--print-after", opts->printAfter, "Print the IR to stderr after this pass (repeatable)");
+  cmd->add_flag("--print-after-all", opts->printAfterAll, "Print the IR to stderr after every pass");
+  cmd->add_flag("--verify-each", opts->verifyEach, "Verify the IR after every pass, naming a pass that breaks it");
+  cmd->add_flag("--list-passes", opts->listPasses, "List the passes stepnc knows, with their options, and exit");
+  cmd->add_flag("--stats", opts->stats, "Print each pass's counters to stderr");
   addCommonOptions(*cmd, opts, setResult);
+  // --list-passes needs no input; everything else does.
+  cmd->callback([opts, setResult] {
+    if (opts->listPasses)
+      return setResult(listPasses());
+    if (opts->input.empty()) {
+      printToolError("opt: an input file is required");
+      return setResult(kExitUsage);
+    }
+    setResult(runCompile(*opts));
+  });
 }
 
 void registerCompile(CLI::App &app, std::function<void(int)> setResult) {

@@ -3,6 +3,8 @@
 
 #include <CLI/CLI.hpp>
 #include <iostream>
+#include <string>
+#include <vector>
 
 namespace stepnc::tool {
 void registerCheck(CLI::App &app, std::function<void(int)> setResult);
@@ -27,6 +29,14 @@ int main(int argc, char **argv) {
   registerConvert(app, setResult);
   registerSchema(app, setResult);
   registerOpt(app, setResult);
+  // LLVM spells the pipeline option -passes=...; accept that spelling too.
+  std::vector<std::string> rewritten;
+  for (int i = 0; i < argc; ++i)
+    rewritten.emplace_back(std::string_view(argv[i]).starts_with("-passes=") ? "-" + std::string(argv[i]) : argv[i]);
+  std::vector<char *> args;
+  for (std::string &a : rewritten)
+    args.push_back(a.data());
+  argv = args.data();
   // A first word that is neither an option nor a command is a typo.
   if (argc > 1 && argv[1][0] != '-') {
     std::string names;

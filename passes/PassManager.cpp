@@ -1,0 +1,37 @@
+#include "passes/PassManager.h"
+
+#include "ir/Printer.h"
+#include "ir/Verifier.h"
+
+namespace stepnc::passes {
+
+void PassManager::add(const std::vector<PipelineEntry> &pipeline) {
+  for (const PipelineEntry &entry : pipeline)
+    if (auto pass = createPass(entry))
+      passes_.push_back(std::move(pass));
+}
+
+bool PassManager::run(ir::Module &module, DiagnosticEngine &diags) {
+  for (const auto &pass : passes_) {
+    PassStats stats;
+    const unsigned errorsBefore = diags.errorCount();
+    const PassResult result = pass->run(module, diags, stats);
+    stats_.emplace_back(std::string(pass->name()), std::move(stats));
+    if (!result.ok || diags.errorCount() > errorsBefore)
+      return false;
+    if (options_.verifyEach && !ir::verifyModule(module, diags)) {
+      diags.error({}, "pass '" + std::string(pass->name()) + "' broke verification")
+          .note("run with --print-after=" + std::string(pass->name()) + " to see the IR it produced");
+      return false;
+    }
+    if (options_.print && (options_.printAfterAll || options_.printAfter.count(pass->name()))) {
+      std::string text = "; *** IR after " + std::string(pass->name()) + (result.changed ? "" : " (unchanged)") +
+                         " ***\n";
+      text += ir::printModule(module);
+      options_.print(text);
+    }
+  }
+  return true;
+}
+
+} // namespace stepnc::passes
