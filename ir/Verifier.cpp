@@ -9,6 +9,7 @@
 #include "support/Format.h"
 
 #include <algorithm>
+#include <iterator>
 #include <cmath>
 #include <unordered_map>
 
@@ -100,6 +101,8 @@ private:
   void checkValue(const Node &n, const Attr &a);
   void checkRef(const Node &n, const KindSpec &spec, const Attr &a);
   void checkChildren(const Node &n, const KindSpec &spec);
+  void checkToolFit(const Node &workingstep);
+  const Node *lookup(const std::optional<std::string> &symbol) const;
   InFlightDiagnostic report(const Node &n, const std::string &message);
 
   DiagnosticEngine &diags_;
@@ -113,6 +116,48 @@ InFlightDiagnostic Verifier::report(const Node &n, const std::string &message) {
   if (n.origin.entityId != 0)
     d.entity(n.origin.entityId);
   return d;
+}
+
+const Node *Verifier::lookup(const std::optional<std::string> &symbol) const {
+  if (!symbol)
+    return nullptr;
+  auto it = symbols_.find(*symbol);
+  return it == symbols_.end() ? nullptr : it->second;
+}
+
+// Where it is decidable from the feature IR alone, the tool must fit the
+// feature: a finishing cutter must reach into a pocket's corners (its radius
+// no larger than the corner radius), and a tool that makes a hole must not be
+// wider than the hole. Roughing tools may be larger than the corners: they
+// leave that material for finishing, which strategy expansion accounts for.
+void Verifier::checkToolFit(const Node &ws) {
+  const Node *feature = lookup(ws.text("feature"));
+  const Node *op = nullptr;
+  for (const Node &c : ws.children)
+    if (const KindSpec *k = findKind(c.kind); k && k->category == "operation")
+      op = &c;
+  const Node *tool = op ? lookup(op->text("tool")) : nullptr;
+  const std::optional<double> toolDiameter = tool ? tool->number("diameter") : std::nullopt;
+  if (!feature || !toolDiameter)
+    return;
+  constexpr double eps = 1e-9;
+  const bool finishing = op->kind == "bottom_and_side_finish_milling" || op->kind == "side_finish_milling";
+  if (finishing && (feature->kind == "closed_pocket" || feature->kind == "open_pocket")) {
+    const std::optional<double> corner = feature->number("orthogonal_radius");
+    if (corner && *corner > 0 && *toolDiameter / 2 > *corner + eps)
+      report(*op, "tool " + tool->symbol + " of diameter " + formatFixed(*toolDiameter, 4) +
+                      " mm does not fit the corners of " + feature->symbol + " (corner radius " +
+                      formatFixed(*corner, 4) + " mm)");
+  }
+  static constexpr std::string_view kHoleMaking[] = {"drilling", "multistep_drilling", "reaming",
+                                                     "boring",   "tapping",            "thread_drilling"};
+  if (feature->kind == "round_hole" &&
+      std::find(std::begin(kHoleMaking), std::end(kHoleMaking), op->kind) != std::end(kHoleMaking)) {
+    const std::optional<double> hole = feature->number("diameter");
+    if (hole && *toolDiameter > *hole + eps)
+      report(*op, "tool " + tool->symbol + " of diameter " + formatFixed(*toolDiameter, 4) +
+                      " mm is wider than " + feature->symbol + " (diameter " + formatFixed(*hole, 4) + " mm)");
+  }
 }
 
 void Verifier::collectSymbols(const Node &n) {
@@ -136,6 +181,8 @@ void Verifier::checkNode(const Node &n, const KindSpec *parent, bool isRoot) {
     checkHead(n, *spec);
     checkAttrs(n, *spec);
     checkChildren(n, *spec);
+    if (n.kind == "workingstep")
+      checkToolFit(n);
   }
   if (n.comment.find('\n') != std::string::npos)
     report(n, "the comment has a line break, expected one line");
