@@ -3,6 +3,8 @@
 #include "ir/Printer.h"
 #include "ir/Verifier.h"
 
+#include <cstdlib>
+
 namespace stepnc::passes {
 
 void PassManager::add(const std::vector<PipelineEntry> &pipeline) {
@@ -12,6 +14,8 @@ void PassManager::add(const std::vector<PipelineEntry> &pipeline) {
 }
 
 bool PassManager::run(ir::Module &module, DiagnosticEngine &diags) {
+  const char *env = std::getenv("STEPNC_VERIFY_EACH");
+  const bool verifyEach = options_.verifyEach || (env && std::string_view(env) == "1");
   for (const auto &pass : passes_) {
     PassStats stats;
     const unsigned errorsBefore = diags.errorCount();
@@ -19,7 +23,7 @@ bool PassManager::run(ir::Module &module, DiagnosticEngine &diags) {
     stats_.emplace_back(std::string(pass->name()), std::move(stats));
     if (!result.ok || diags.errorCount() > errorsBefore)
       return false;
-    if (options_.verifyEach && !ir::verifyModule(module, diags)) {
+    if (verifyEach && !ir::verifyModule(module, diags)) {
       diags.error({}, "pass '" + std::string(pass->name()) + "' broke verification")
           .note("run with --print-after=" + std::string(pass->name()) + " to see the IR it produced");
       return false;

@@ -11,6 +11,9 @@
 namespace stepnc::passes {
 
 struct PassManagerOptions {
+  /// Verify after every pass; also on when the environment sets
+  /// STEPNC_VERIFY_EACH=1 (the test suite does), so tests catch a pass that
+  /// breaks the IR even when they do not ask.
   bool verifyEach = false;
   bool printAfterAll = false;
   std::set<std::string, std::less<>> printAfter;

@@ -19,6 +19,8 @@ config.excludes = ["Inputs", "unit", "fuzz", "CMakeLists.txt", "lit.cfg.py", "up
 
 config.environment["PATH"] = os.pathsep.join(
     [config.stepnc_tools_dir, config.llvm_tools_dir, config.environment.get("PATH", os.environ["PATH"])])
+# Every pass run by a test is followed by the IR verifier.
+config.environment["STEPNC_VERIFY_EACH"] = "1"
 for var in ("ASAN_OPTIONS", "UBSAN_OPTIONS"):
     if var in os.environ:
         config.environment[var] = os.environ[var]
