@@ -144,6 +144,12 @@ void Reader::run() {
     diags_.error(loc(base_), "files larger than 1 TiB are not supported");
     return;
   }
+  // Editors on Windows often start UTF-8 files with a byte order mark.
+  if (end_ - p_ >= 3 && static_cast<unsigned char>(p_[0]) == 0xEF && static_cast<unsigned char>(p_[1]) == 0xBB &&
+      static_cast<unsigned char>(p_[2]) == 0xBF) {
+    diags_.warning(loc(p_), "UTF-8 byte order mark at the start of the file ignored");
+    p_ += 3;
+  }
   if (!layout())
     return;
   if (p_ == end_) {

@@ -158,6 +158,12 @@ TEST_CASE("edition 3 sections are read", "[part21]") {
   CHECK(l->file->isDefined(9));
 }
 
+TEST_CASE("a UTF-8 byte order mark is skipped with a warning", "[part21]") {
+  auto l = load("\xEF\xBB\xBF" + withData("#1=A();\n"));
+  CHECK(l->messages() == std::vector<std::string>{"1:1: warning: UTF-8 byte order mark at the start of the file ignored"});
+  CHECK(l->file->entries().size() == 1);
+}
+
 TEST_CASE("sparse large ids use the sorted index", "[part21]") {
   auto l = load(withData("#3595070=A(#5);\n#5=B(#3595070);\n#900000000000=C(#5);\n"));
   CHECK(l->messages().empty());
