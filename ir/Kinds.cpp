@@ -103,7 +103,7 @@ std::vector<KindSpec> makeTable() {
                                                   {"travel_dir", T::Direction, true},
                                                   {"width", T::Length, true},
                                                   {"width_dir", T::Direction, true}}),
-       "profile boss"});
+       "profile island"});
   for (std::string_view pocket : {"closed_pocket", "open_pocket"})
     add({pocket, "feature", Sigil::Resource, true,
          join(kFeatureCommon, std::vector<AttrSpec>{{"slope", T::Angle},
@@ -111,7 +111,7 @@ std::vector<KindSpec> makeTable() {
                                                     {"bottom_radius", T::Length},
                                                     {"planar_radius", T::Length},
                                                     {"orthogonal_radius", T::Length}}),
-         "profile boss"});
+         "profile island"});
   add({"round_hole", "feature", Sigil::Resource, true,
        join(kFeatureCommon,
             std::vector<AttrSpec>{{"diameter", T::Length, true},
@@ -127,7 +127,9 @@ std::vector<KindSpec> makeTable() {
                                                   {"end_2", T::Word, true, "open radiused flat woodruff loop"},
                                                   {"end_radius", T::Length}}),
        "path profile"});
-  add({"step", "feature", Sigil::Resource, true, kFeatureCommon, "path profile"});
+  add({"step", "feature", Sigil::Resource, true, kFeatureCommon, "path profile island"});
+  // A boss standing in a pocket, face or step: the material to leave, by reference.
+  add({"island", "island", Sigil::None, false, {{"feature", T::Ref, true}}, {}});
   add({"general_outside_profile", "feature", Sigil::Resource, true, kFeatureCommon, "path profile"});
   add({"boss", "feature", Sigil::Resource, true, join(kFeatureCommon, std::vector<AttrSpec>{{"slope", T::Angle}}),
        "profile"});
@@ -156,7 +158,7 @@ std::vector<KindSpec> makeTable() {
   add({"path", "path", Sigil::None, false, {}, "curve"});
   add({"line", "curve", Sigil::None, false, {{"at", T::Point, true}, {"dir", T::Direction, true}, {"length", T::Length}}, {}});
   add({"polyline", "curve", Sigil::None, false, {}, "point"});
-  add({"point", "point", Sigil::None, false, {{"at", T::Point, true}}, {}});
+  add({"point", "point", Sigil::None, false, {{"at", T::Point, true}, {"weight", T::Ratio}}, {}});
   add({"circle", "curve", Sigil::None, false,
        join(placement(true), std::vector<AttrSpec>{{"radius", T::Length, true}}), {}});
   add({"helix", "curve", Sigil::None, false,
@@ -173,7 +175,13 @@ std::vector<KindSpec> makeTable() {
        {{"transition", T::Word, true, "discontinuous continuous cont_same_gradient cont_same_gradient_same_curvature"},
         {"same_sense", T::Flag, true}},
        "curve"});
-  add({"b_spline_curve", "curve", Sigil::None, false, {{"degree", T::Count, true}, {"closed", T::Flag}}, "point"});
+  // Control points in order (with weights when rational), then the knots.
+  add({"b_spline_curve", "curve", Sigil::None, false,
+       {{"degree", T::Count, true},
+        {"form", T::Word, true, "uniform quasi_uniform bezier with_knots"},
+        {"closed", T::Flag}},
+       "point knot"});
+  add({"knot", "knot", Sigil::None, false, {{"value", T::Ratio, true}, {"multiplicity", T::Count, true}}, {}});
 
   // Operations (the child of a workingstep).
   const char *millingChildren = "technology machine_functions strategy approach retract toolpath";

@@ -29,6 +29,7 @@ constexpr RefRule kRefRules[] = {
     {"workingstep", "feature", "feature"},
     {"workpiece_setup", "workpiece", "workpiece"},
     {"workplan", "setup", "setup"},
+    {"island", "feature", "boss"},
 };
 
 /// Children an operation has at most one of; the kinds of one entry count together.

@@ -192,14 +192,20 @@ std::optional<std::string> Lowerer::feature(const Instance &f) {
   stamp(n, f);
   n.symbol = symbolFor('%', f.string("its_id"), n.kind);
   lowered_[f.index()] = n.symbol;
-  for (const Instance &b : bosses)
-    if (b.isA("boss")) {
-      // Bosses are features of their own; the pocket or face lists them.
-      if (auto sym = feature(b))
-        (void)sym;
-    } else {
+  // Bosses are features of their own; the pocket, face or step refers to them
+  // as islands, the material its machining must leave.
+  for (const Instance &b : bosses) {
+    if (!b.isA("boss")) {
       unsupported(b, "boss");
+      continue;
     }
+    if (auto sym = feature(b)) {
+      Node island("island");
+      stamp(island, b, "");
+      island.set("feature", Value::ref(*sym));
+      n.add(std::move(island));
+    }
+  }
   const std::string symbol = n.symbol;
   std::optional<std::string> wp = workpiece(f.ref("its_workpiece"));
   Node *owner = wp ? findResource(*wp) : nullptr;

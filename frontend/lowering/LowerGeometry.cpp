@@ -294,6 +294,44 @@ std::optional<Node> Lowerer::curve(const Instance &c) {
         missing(s, "parent_curve");
       n.add(std::move(seg));
     }
+  } else if (c.isA("b_spline_curve")) {
+    n.kind = "b_spline_curve";
+    if (auto degree = c.integer("degree"))
+      n.set("degree", Value::integer(*degree));
+    else
+      missing(c, "degree");
+    const char *form = c.isA("b_spline_curve_with_knots") ? "with_knots"
+                       : c.isA("bezier_curve")            ? "bezier"
+                       : c.isA("quasi_uniform_curve")     ? "quasi_uniform"
+                                                          : "uniform";
+    n.set("form", Value::word(form));
+    if (auto closed = c.enumeration("closed_curve"); closed == "t" || closed == "f")
+      n.set("closed", Value::boolean(*closed == "t"));
+    const std::vector<Instance> points = c.refs("control_points_list");
+    const std::vector<double> weights = c.isA("rational_b_spline_curve") ? c.reals("weights_data") : std::vector<double>{};
+    if (!weights.empty() && weights.size() != points.size())
+      missing(c, "weights_data", "must have one weight per control point");
+    for (size_t i = 0; i < points.size(); ++i)
+      if (auto v = point(points[i])) {
+        Node pt("point");
+        stamp(pt, points[i], "");
+        pt.set("at", Value::point(*v));
+        if (i < weights.size() && weights.size() == points.size())
+          pt.set("weight", Value::ratio(weights[i]));
+        n.add(std::move(pt));
+      }
+    if (c.isA("b_spline_curve_with_knots")) {
+      const std::vector<double> knots = c.reals("knots");
+      const std::vector<double> multiplicities = c.reals("knot_multiplicities");
+      if (knots.size() != multiplicities.size())
+        missing(c, "knot_multiplicities", "must have one multiplicity per knot");
+      for (size_t i = 0; i < knots.size() && i < multiplicities.size(); ++i) {
+        Node k("knot");
+        k.set("value", Value::ratio(knots[i]));
+        k.set("multiplicity", Value::integer(static_cast<int64_t>(multiplicities[i])));
+        n.add(std::move(k));
+      }
+    }
   } else {
     unsupported(c, "curve");
     return std::nullopt;
