@@ -77,8 +77,7 @@ std::optional<std::string> Lowerer::feature(const Instance &f) {
     const bool closed = f.isA("closed_pocket");
     n.kind = closed ? "closed_pocket" : "open_pocket";
     commonPlacementAndDepth();
-    if (auto slope = f.real("slope"))
-      n.set("slope", Value::angle(*slope));
+    copyReal(n, "slope", f, "slope", Value::angle);
     Instance bottom = f.ref("bottom_condition");
     if (bottom.isA("planar_pocket_bottom_condition")) {
       n.set("bottom", Value::word("planar"));
@@ -182,8 +181,7 @@ std::optional<std::string> Lowerer::feature(const Instance &f) {
   } else if (f.isA("boss")) {
     n.kind = "boss";
     commonPlacementAndDepth();
-    if (auto slope = f.real("slope"))
-      n.set("slope", Value::angle(*slope));
+    copyReal(n, "slope", f, "slope", Value::angle);
     addProfile("its_boundary", true);
   } else {
     unsupported(f, "feature");

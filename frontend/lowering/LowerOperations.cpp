@@ -64,19 +64,13 @@ std::optional<std::string> Lowerer::tool(const Instance &t) {
   n.set("type", Value::word(std::string(type)));
   if (body) {
     if (Instance dim = body.ref("dimension")) {
-      auto length = [&](std::string_view irName, std::string_view attribute) {
-        if (auto v = dim.real(attribute))
-          n.set(std::string(irName), Value::length(*v));
-      };
-      length("diameter", "diameter");
-      length("corner_radius", "edge_radius");
-      if (auto a = dim.real("tool_tip_half_angle"))
-        n.set("tip_half_angle", Value::angle(*a));
-      if (auto a = dim.real("tool_circumference_angle"))
-        n.set("circumference_angle", Value::angle(*a));
-      length("cutting_edge_length", "cutting_edge_length");
-      length("edge_center_vertical", "edge_center_vertical");
-      length("edge_center_horizontal", "edge_center_horizontal");
+      copyReal(n, "diameter", dim, "diameter", Value::length);
+      copyReal(n, "corner_radius", dim, "edge_radius", Value::length);
+      copyReal(n, "tip_half_angle", dim, "tool_tip_half_angle", Value::angle);
+      copyReal(n, "circumference_angle", dim, "tool_circumference_angle", Value::angle);
+      copyReal(n, "cutting_edge_length", dim, "cutting_edge_length", Value::length);
+      copyReal(n, "edge_center_vertical", dim, "edge_center_vertical", Value::length);
+      copyReal(n, "edge_center_horizontal", dim, "edge_center_horizontal", Value::length);
     } else {
       missing(body, "dimension");
     }
@@ -84,15 +78,12 @@ std::optional<std::string> Lowerer::tool(const Instance &t) {
       n.set("flutes", Value::integer(*teeth));
     if (auto hand = body.enumeration("hand_of_cut"))
       n.set("hand", Value::word(*hand));
-    if (auto coolant = body.boolean("coolant_through_tool"))
-      n.set("coolant_through", Value::boolean(*coolant));
-    if (auto taper = body.real("taper_angle"))
-      n.set("taper_angle", Value::angle(*taper));
+    copyFlag(n, "coolant_through", body, "coolant_through_tool");
+    copyReal(n, "taper_angle", body, "taper_angle", Value::angle);
   } else {
     missing(t, "its_tool_body");
   }
-  if (auto overall = t.real("overall_assembly_length"))
-    n.set("overall_length", Value::length(*overall));
+  copyReal(n, "overall_length", t, "overall_assembly_length", Value::length);
   std::vector<Instance> edges = t.refs("its_cutting_edge");
   if (!edges.empty())
     if (auto offset = edges[0].real("tool_offset_length"))
@@ -136,27 +127,18 @@ Node technology(Lowerer &l, const Instance &tech) {
   if (auto s = tech.real("spindle"))
     n.set("spindle", Value::spindle(l.spindleRevPerMin(*s)));
   n.set("feed_reference", Value::word(tech.enumeration("feedrate_reference").value_or("tcp")));
-  if (auto b = tech.boolean("synchronize_spindle_with_feed"))
-    n.set("sync_spindle_feed", Value::boolean(*b));
-  if (auto b = tech.boolean("inhibit_feedrate_override"))
-    n.set("inhibit_feed_override", Value::boolean(*b));
-  if (auto b = tech.boolean("inhibit_spindle_override"))
-    n.set("inhibit_spindle_override", Value::boolean(*b));
+  copyFlag(n, "sync_spindle_feed", tech, "synchronize_spindle_with_feed");
+  copyFlag(n, "inhibit_feed_override", tech, "inhibit_feedrate_override");
+  copyFlag(n, "inhibit_spindle_override", tech, "inhibit_spindle_override");
   return n;
 }
 
 Node machineFunctions(const Instance &mf) {
   Node n("machine_functions");
-  for (auto [ir, arm] : {std::pair<const char *, const char *>{"coolant", "coolant"},
-                         {"mist", "mist"},
-                         {"through_spindle_coolant", "through_spindle_coolant"},
-                         {"chip_removal", "chip_removal"}})
-    if (auto b = mf.boolean(arm))
-      n.set(ir, Value::boolean(*b));
-  if (auto p = mf.real("coolant_pressure"))
-    n.set("coolant_pressure", Value::ratio(*p));
-  if (auto p = mf.real("through_pressure"))
-    n.set("through_pressure", Value::ratio(*p));
+  for (std::string_view flag : {"coolant", "mist", "through_spindle_coolant", "chip_removal"})
+    copyFlag(n, flag, mf, flag);
+  copyReal(n, "coolant_pressure", mf, "coolant_pressure", Value::ratio);
+  copyReal(n, "through_pressure", mf, "through_pressure", Value::ratio);
   return n;
 }
 
@@ -179,8 +161,7 @@ std::optional<Node> Lowerer::operation(const Instance &op) {
   else
     missing(op, "its_tool");
   auto length = [&](std::string_view irName, std::string_view attribute) {
-    if (auto v = op.real(attribute))
-      n.set(std::string(irName), Value::length(*v));
+    copyReal(n, irName, op, attribute, Value::length);
   };
   length("retract_plane", "retract_plane");
   if (Instance sp = op.ref("start_point"))
@@ -194,12 +175,9 @@ std::optional<Node> Lowerer::operation(const Instance &op) {
   // Drilling-type operations.
   length("cutting_depth", "cutting_depth");
   length("previous_diameter", "previous_diameter");
-  if (auto t = op.real("dwell_time_bottom"))
-    n.set("dwell_bottom", Value::time(*t));
-  if (auto r = op.real("feed_on_retract"))
-    n.set("feed_on_retract", Value::ratio(*r));
-  if (auto b = op.boolean("spindle_stop_at_bottom"))
-    n.set("spindle_stop_bottom", Value::boolean(*b));
+  copyReal(n, "dwell_bottom", op, "dwell_time_bottom", Value::time);
+  copyReal(n, "feed_on_retract", op, "feed_on_retract", Value::ratio);
+  copyFlag(n, "spindle_stop_bottom", op, "spindle_stop_at_bottom");
   length("depth_of_testcut", "depth_of_testcut");
   if (Instance wp = op.ref("waiting_position"))
     if (auto p = point(wp))
@@ -207,12 +185,9 @@ std::optional<Node> Lowerer::operation(const Instance &op) {
   length("retract_distance", "retract_distance");
   length("first_depth", "first_depth");
   length("depth_increment", "depth_of_step");
-  if (auto t = op.real("dwell_time_step"))
-    n.set("dwell_step", Value::time(*t));
-  if (auto b = op.boolean("compensation_chuck"))
-    n.set("compensation_chuck", Value::boolean(*b));
-  if (auto b = op.boolean("helical_movement_on_forward"))
-    n.set("helical_movement", Value::boolean(*b));
+  copyReal(n, "dwell_step", op, "dwell_time_step", Value::time);
+  copyFlag(n, "compensation_chuck", op, "compensation_chuck");
+  copyFlag(n, "helical_movement", op, "helical_movement_on_forward");
 
   if (Instance tech = op.ref("its_technology"))
     n.add(technology(*this, tech));
@@ -224,16 +199,11 @@ std::optional<Node> Lowerer::operation(const Instance &op) {
     if (strategy.isA("drilling_type_strategy")) {
       Node d("drilling_strategy");
       stamp(d, strategy, "");
-      for (auto [ir, arm] : {std::pair<const char *, const char *>{"reduced_cut_at_start", "reduced_cut_at_start"},
-                             {"reduced_feed_at_start", "reduced_feed_at_start"},
-                             {"reduced_cut_at_end", "reduced_cut_at_end"},
-                             {"reduced_feed_at_end", "reduced_feed_at_end"}})
-        if (auto r = strategy.real(arm))
-          d.set(ir, Value::ratio(*r));
-      if (auto v = strategy.real("depth_of_start"))
-        d.set("depth_of_start", Value::length(*v));
-      if (auto v = strategy.real("depth_of_end"))
-        d.set("depth_of_end", Value::length(*v));
+      for (std::string_view ratio :
+           {"reduced_cut_at_start", "reduced_feed_at_start", "reduced_cut_at_end", "reduced_feed_at_end"})
+        copyReal(d, ratio, strategy, ratio, Value::ratio);
+      copyReal(d, "depth_of_start", strategy, "depth_of_start", Value::length);
+      copyReal(d, "depth_of_end", strategy, "depth_of_end", Value::length);
       n.add(std::move(d));
     } else {
       std::string_view type;
@@ -257,8 +227,7 @@ std::optional<Node> Lowerer::operation(const Instance &op) {
                                "the file may mean percent")
                 .entity(strategy.id(), std::string(strategy.entityName()));
         }
-        if (auto b = strategy.boolean("allow_multiple_passes"))
-          s.set("multiple_passes", Value::boolean(*b));
+        copyFlag(s, "multiple_passes", strategy, "allow_multiple_passes");
         if (Instance fd = strategy.ref("feed_direction"))
           if (auto d = direction(fd))
             s.set("feed_dir", Value::direction(*d));
@@ -270,8 +239,7 @@ std::optional<Node> Lowerer::operation(const Instance &op) {
           s.set("rotation", Value::word(*w));
         if (auto w = strategy.enumeration("cutmode"))
           s.set("cutmode", Value::word(*w));
-        if (auto b = strategy.boolean("spiral_cutmode_change"))
-          s.set("spiral_cutmode_change", Value::boolean(*b));
+        copyFlag(s, "spiral_cutmode_change", strategy, "spiral_cutmode_change");
         n.add(std::move(s));
       }
     }
@@ -298,14 +266,9 @@ std::optional<Node> Lowerer::operation(const Instance &op) {
     if (Instance o = ar.ref("tool_orientation"))
       if (auto d = direction(o))
         a.set("tool_orientation", Value::direction(*d));
-    if (auto v = ar.real("angle"))
-      a.set("angle", Value::angle(*v));
-    if (auto v = ar.real("radius"))
-      a.set("radius", Value::length(*v));
-    if (auto v = ar.real("width"))
-      a.set("width", Value::length(*v));
-    if (auto v = ar.real("travel_length"))
-      a.set("travel_length", Value::length(*v));
+    copyReal(a, "angle", ar, "angle", Value::angle);
+    for (std::string_view attribute : {"radius", "width", "travel_length"})
+      copyReal(a, attribute, ar, attribute, Value::length);
     n.add(std::move(a));
   }
   if (Instance list = op.ref("its_toolpath"))

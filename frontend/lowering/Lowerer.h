@@ -26,6 +26,20 @@ struct Placement {
   Vec3 ref = Vec3::UnitX();
 };
 
+/// Copies real attribute `attribute` of `from` into `to` as `irName`, made with
+/// `make` (Value::length, Value::angle, Value::ratio, ...), when it is present.
+inline void copyReal(Node &to, std::string_view irName, const Instance &from, std::string_view attribute,
+                     Value (*make)(double)) {
+  if (auto v = from.real(attribute))
+    to.set(std::string(irName), make(*v));
+}
+
+/// Copies boolean attribute `attribute` of `from` into `to` as `irName`, when present.
+inline void copyFlag(Node &to, std::string_view irName, const Instance &from, std::string_view attribute) {
+  if (auto b = from.boolean(attribute))
+    to.set(std::string(irName), Value::boolean(*b));
+}
+
 class Lowerer {
 public:
   Lowerer(const binding::BoundFile &bound, DiagnosticEngine &diags, const LowerOptions &options)
