@@ -90,12 +90,12 @@ std::vector<KindSpec> makeTable() {
   // Executables.
   add({"workplan", "executable", Sigil::Executable, true, {{"setup", T::Ref}}, "executable"});
   add({"workingstep", "executable", Sigil::Executable, true,
-       {{"feature", T::Ref, true}, {"secplane", T::Length, true}}, "operation"});
+       {{"feature", T::Ref, true}, {"secplane", T::Length, true}}, "operation moves"});
   add({"program_stop", "executable", Sigil::None, true, {}, {}});
   add({"optional_stop", "executable", Sigil::None, true, {}, {}});
   add({"display_message", "executable", Sigil::None, true, {{"message", T::Text, true}}, {}});
   // A rapid movement is a workingstep of its own (ISO 14649-10), with explicit toolpaths.
-  add({"rapid_movement", "executable", Sigil::Executable, true, {{"secplane", T::Length, true}}, "toolpath"});
+  add({"rapid_movement", "executable", Sigil::Executable, true, {{"secplane", T::Length, true}}, "toolpath moves"});
 
   // Features (children of their workpiece).
   add({"planar_face", "feature", Sigil::Resource, true,
@@ -272,6 +272,35 @@ std::vector<KindSpec> makeTable() {
         {"speed_ratio", T::Ratio},
         {"reversed", T::Flag}},
        "curve technology machine_functions"});
+
+  // Toolpath IR: what strategy expansion makes of a workingstep. `moves` holds
+  // the state in force for every move under it (tool, spindle, coolant, the
+  // setup whose workpiece coordinates the points are in, the security plane as
+  // a height in those coordinates); each move ends at `to` and starts where
+  // the previous one ended. An arc whose `to` is at another height than its
+  // start is a helix; `turns` counts full turns made before the last arc to
+  // `to`, which is itself a whole turn when `to` is over the start in the plane.
+  // `role` marks what a move is for: positioning rapids, approach, plunge,
+  // cut, link between cuts, retract.
+  add({"moves", "toolpath", Sigil::None, false,
+       {{"tool", T::Ref, true},
+        {"spindle", T::Spindle, true},
+        {"coolant", T::Word, true, "off flood mist through_tool"},
+        {"setup", T::Ref},
+        {"secplane", T::Length, true}},
+       "move"});
+  const char *roles = "position approach plunge cut link retract";
+  add({"rapid", "move", Sigil::None, false, {{"to", T::Point, true}, {"role", T::Word, false, roles}}, {}});
+  add({"linear", "move", Sigil::None, false,
+       {{"to", T::Point, true}, {"feed", T::Feed, true}, {"role", T::Word, false, roles}}, {}});
+  add({"arc", "move", Sigil::None, false,
+       {{"to", T::Point, true},
+        {"center", T::Point, true},
+        {"dir", T::Word, true, "cw ccw"},
+        {"turns", T::Count},
+        {"feed", T::Feed, true},
+        {"role", T::Word, false, roles}},
+       {}});
   return t;
 }
 

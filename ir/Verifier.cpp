@@ -30,6 +30,8 @@ constexpr RefRule kRefRules[] = {
     {"workpiece_setup", "workpiece", "workpiece"},
     {"workplan", "setup", "setup"},
     {"island", "feature", "boss"},
+    {"moves", "tool", "tool"},
+    {"moves", "setup", "setup"},
 };
 
 /// Children an operation has at most one of; the kinds of one entry count together.
@@ -275,6 +277,11 @@ void Verifier::checkChildren(const Node &n, const KindSpec &spec) {
     });
     if (operations != 1)
       report(n, "expected exactly one operation, found " + std::to_string(operations));
+  }
+  if (spec.category == "executable") {
+    auto moves = count([](const Node &c) { return c.kind == "moves"; });
+    if (moves > 1)
+      report(n, "expected at most one 'moves', found " + std::to_string(moves));
   }
   if (spec.category != "operation")
     return;

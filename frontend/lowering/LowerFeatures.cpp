@@ -53,21 +53,24 @@ std::optional<std::string> Lowerer::feature(const Instance &f) {
     if (travel && travel.isA("linear_path")) {
       if (auto len = toleranced(travel, "distance"))
         n.set("travel", Value::length(*len));
-      if (auto d = direction(travel.ref("its_direction"))) {
+      if (auto d = direction(travel.ref("its_direction")))
         n.set("travel_dir", Value::direction(*d));
-        // Material is removed across the course of travel, in the feature's xy plane.
-        const Vec3 across = Vec3::UnitZ().cross(*d);
-        if (across.norm() > 1e-9)
-          n.set("width_dir", Value::direction(across.normalized()));
-      }
     } else {
       missing(f, "course_of_travel", "must be a LINEAR_PATH");
     }
+    // The removal boundary is a line from the profile's origin along its x
+    // axis (the feature's, when the profile has no placement of its own); the
+    // face is that line swept along the course of travel.
     if (Instance boundary = f.ref("removal_boundary")) {
       if (auto w = toleranced(boundary, "profile_length"))
         n.set("width", Value::length(*w));
       else
         missing(boundary, "profile_length");
+      Vec3 across = Vec3::UnitX();
+      if (Instance at = boundary.ref("placement"))
+        if (auto p = placement(at))
+          across = p->ref;
+      n.set("width_dir", Value::direction(across));
     } else {
       missing(f, "removal_boundary");
     }

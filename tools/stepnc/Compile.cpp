@@ -21,6 +21,9 @@ namespace stepnc::tool {
 
 namespace {
 
+/// What `compile --emit=toolpath-ir` runs.
+constexpr std::string_view kToolpathPipeline = "resolve-feeds,expand-strategies,verify-toolpaths";
+
 struct CompileOptions {
   std::string input;
   std::string output = "-";
@@ -107,9 +110,12 @@ int runCompile(const CompileOptions &opts) {
     std::cerr << "stepnc: " << opts.input << " has errors; nothing written\n";
     return kExitDiagnostics;
   }
-  if (!opts.passes.empty() || opts.listPasses) {
+  // The toolpath IR is the feature IR after the passes that make and check moves.
+  const std::string pipelineText =
+      opts.emit == "toolpath-ir" && opts.passes.empty() ? std::string(kToolpathPipeline) : opts.passes;
+  if (!pipelineText.empty() || opts.listPasses) {
     std::string error;
-    auto pipeline = passes::parsePipeline(opts.passes, error);
+    auto pipeline = passes::parsePipeline(pipelineText, error);
     if (!pipeline) {
       printToolError(error);
       return kExitUsage;
@@ -151,6 +157,7 @@ void addCommonOptions(CLI::App &cmd, const std::shared_ptr<CompileOptions> &opts
                       const std::function<void(int)> &setResult) {
   cmd.add_option("-o,--output", opts->output, "Output file ('-', the default, for standard output)");
   cmd.add_flag("--print-locs", opts->printLocations, "Print each IR node's source location (file:line:col #id)");
+  cmd.add_flag("--stats", opts->stats, "Print each pass's counters to stderr");
   addSchemaOptions(cmd, opts->schema);
   addDiagnosticOptions(cmd, opts->diag);
   cmd.callback([opts, setResult] { setResult(runCompile(*opts)); });
@@ -170,7 +177,6 @@ void registerOpt(CLI::App &app, std::function<void(int)> setResult) {
   cmd->add_flag("--print-after-all", opts->printAfterAll, "Print the IR to stderr after every pass");
   cmd->add_flag("--verify-each", opts->verifyEach, "Verify the IR after every pass, naming a pass that breaks it");
   cmd->add_flag("--list-passes", opts->listPasses, "List the passes stepnc knows, with their options, and exit");
-  cmd->add_flag("--stats", opts->stats, "Print each pass's counters to stderr");
   addCommonOptions(*cmd, opts, setResult);
   // --list-passes needs no input; everything else does.
   cmd->callback([opts, setResult] {
@@ -188,12 +194,14 @@ void registerCompile(CLI::App &app, std::function<void(int)> setResult) {
   auto opts = std::make_shared<CompileOptions>();
   CLI::App *cmd = app.add_subcommand(
       "compile", "Compile a STEP-NC file: read it, check it against its schema, lower it to the\n"
-                 "process IR and write the result. Today the output is the feature IR\n"
-                 "(--emit=feature-ir, the default); toolpaths and controller programs come next.\n"
+                 "process IR and write the result: the feature IR (--emit=feature-ir, the default)\n"
+                 "or the toolpath IR (--emit=toolpath-ir: resolve-feeds, expand-strategies and\n"
+                 "verify-toolpaths run over it); controller programs come next.\n"
                  "Nothing is written when the input has errors.");
   cmd->add_option("input", opts->input, "STEP-NC file (Part 21)")->required();
-  cmd->add_option("--emit", opts->emit, "What to write: feature-ir (the lowered process IR)")
-      ->check(CLI::IsMember({"feature-ir"}))
+  cmd->add_option("--emit", opts->emit,
+                  "What to write: feature-ir (the lowered process IR) or toolpath-ir (with moves, verified)")
+      ->check(CLI::IsMember({"feature-ir", "toolpath-ir"}))
       ->default_str("feature-ir");
   addCommonOptions(*cmd, opts, setResult);
 }

@@ -1,0 +1,377 @@
+#include "passes/FeatureShape.h"
+
+#include "ir/Kinds.h"
+#include "passes/Curves.h"
+#include "support/Format.h"
+
+#include <cmath>
+#include <numbers>
+
+namespace stepnc::passes {
+
+namespace {
+
+using geom::Loop;
+using geom::Region;
+using geom::Seg;
+using geom::Vec2;
+using ir::Node;
+
+/// How far past an open side the tool may go: the area beyond is air.
+constexpr double kOpenReach = 500.0;
+
+std::string vecText(const ir::Vec3 &v) {
+  std::string out = "(";
+  out += formatFixed(v.x(), 6);
+  out += ", ";
+  out += formatFixed(v.y(), 6);
+  out += ", ";
+  out += formatFixed(v.z(), 6);
+  out += ")";
+  return out;
+}
+
+Loop polygon(const std::vector<Vec2> &pts) {
+  Loop l;
+  for (size_t i = 0; i < pts.size(); ++i)
+    l.segs.push_back(Seg::line(pts[i], pts[(i + 1) % pts.size()]));
+  return l;
+}
+
+/// Makes outer loops counter-clockwise (a mirrored frame turns them over).
+Region outer(Loop l) {
+  if (l.area() < 0)
+    l.reverse();
+  Region r;
+  r.loops.push_back(std::move(l));
+  return r;
+}
+
+/// A rectangle centred on the origin, `length` along x and `width` along y,
+/// with corners rounded by `radius` (0: sharp).
+Loop rectangle(double length, double width, double radius) {
+  const double hx = length / 2, hy = width / 2;
+  const double r = std::min({radius, hx, hy});
+  if (r <= geom::kEps)
+    return polygon({{-hx, -hy}, {hx, -hy}, {hx, hy}, {-hx, hy}});
+  Loop l;
+  auto corner = [&](Vec2 c, Vec2 from, Vec2 to) { l.segs.push_back(Seg::arc(c + from * r, c + to * r, c, true)); };
+  auto edge = [&](Vec2 a, Vec2 b) {
+    if ((b - a).norm() > geom::kEps)
+      l.segs.push_back(Seg::line(a, b));
+  };
+  edge({-hx + r, -hy}, {hx - r, -hy});
+  corner({hx - r, -hy + r}, {0, -1}, {1, 0});
+  edge({hx, -hy + r}, {hx, hy - r});
+  corner({hx - r, hy - r}, {1, 0}, {0, 1});
+  edge({hx - r, hy}, {-hx + r, hy});
+  corner({-hx + r, hy - r}, {0, 1}, {-1, 0});
+  edge({-hx, hy - r}, {-hx, -hy + r});
+  corner({-hx + r, -hy + r}, {-1, 0}, {0, -1});
+  return l;
+}
+
+/// Maps a loop from a frame's local coordinates to workpiece coordinates.
+Loop mapLoop(const Loop &l, const PlaneFrame &f) {
+  Loop out;
+  for (const Seg &s : l.segs) {
+    Seg m = s;
+    m.a = f.map(s.a);
+    m.b = f.map(s.b);
+    m.c = f.map(s.c);
+    if (f.mirrored())
+      m.turn = static_cast<int8_t>(-m.turn);
+    out.segs.push_back(m);
+  }
+  return out;
+}
+
+class ShapeBuilder {
+public:
+  ShapeBuilder(const ir::Module &m, const Node *workpiece) : module_(m), workpiece_(workpiece) {}
+
+  std::string error;
+
+  /// A closed profile (child of `owner`) as a loop in the owner's local coordinates.
+  std::optional<Loop> closedProfile(const Node &owner, double cornerRadius) {
+    const Node *p = nullptr;
+    for (const Node &c : owner.children)
+      if (const ir::KindSpec *k = ir::findKind(c.kind); k && k->category == "profile")
+        p = &c;
+    if (!p) {
+      fail(owner.kind + " " + owner.symbol + " has no profile");
+      return std::nullopt;
+    }
+    // A profile may have a placement of its own within the feature.
+    PlaneFrame local;
+    if (p->has("at")) {
+      FrameResult fr = planeFrame(*p);
+      if (!fr.frame) {
+        fail(fr.error);
+        return std::nullopt;
+      }
+      local = *fr.frame;
+    }
+    Loop l;
+    if (p->kind == "rectangular_profile") {
+      l = rectangle(*p->number("length"), *p->number("width"), cornerRadius);
+    } else if (p->kind == "circular_profile") {
+      for (const Seg &s : geom::circle(Vec2::Zero(), *p->number("diameter") / 2, true, Vec2(*p->number("diameter") / 2, 0)))
+        l.segs.push_back(s);
+    } else if (p->kind == "general_profile") {
+      if (!p->flag("closed").value_or(false) || p->children.empty()) {
+        fail("the general profile of " + owner.symbol + " is not closed");
+        return std::nullopt;
+      }
+      CurveResult cr = curvePieces(p->children.front());
+      if (!cr.error.empty()) {
+        fail("the profile of " + owner.symbol + ": " + cr.error);
+        return std::nullopt;
+      }
+      l.segs = planarSegs(cr.pieces);
+      if (l.segs.empty() || (l.segs.front().a - l.segs.back().b).norm() > 1e-6) {
+        fail("the general profile of " + owner.symbol + " does not close on itself");
+        return std::nullopt;
+      }
+      l.segs.back().b = l.segs.front().a;
+    } else {
+      fail("a " + p->kind + " is not a closed profile (" + owner.kind + " " + owner.symbol + ")");
+      return std::nullopt;
+    }
+    return p->has("at") ? mapLoop(l, local) : l;
+  }
+
+  void islands(const Node &feature, FeatureShape &s) {
+    for (const Node *island : feature.childrenOf("island")) {
+      const Node *boss = findFeature(module_, *island->text("feature"));
+      if (!boss)
+        continue;  // the IR verifier reports dangling references
+      FrameResult fr = planeFrame(*boss);
+      if (!fr.frame) {
+        fail(fr.error);
+        return;
+      }
+      std::optional<Loop> l = closedProfile(*boss, 0);
+      if (!l)
+        return;
+      s.islands.push_back({boss->symbol, outer(mapLoop(*l, *fr.frame)), fr.frame->z});
+    }
+  }
+
+  /// Material beside a straight open boundary, towards the nearer edge of the raw piece.
+  bool step(const Node &feature, FeatureShape &s) {
+    const Node *path = feature.child("path");
+    std::vector<CurvePiece> pieces;
+    if (path && !path->children.empty()) {
+      CurveResult cr = curvePieces(path->children.front());
+      if (!cr.error.empty())
+        return fail("the open boundary of " + feature.symbol + ": " + cr.error);
+      pieces = std::move(cr.pieces);
+    }
+    if (pieces.size() != 1 || pieces[0].arc)
+      return fail("only steps along one straight open boundary are supported (" + feature.symbol + ")");
+    const Vec2 a = s.frame.map(pieces[0].from.head<2>());
+    const Vec2 b = s.frame.map(pieces[0].to.head<2>());
+    const Vec2 along = (b - a).normalized();
+    const Vec2 left(-along.y(), along.x());
+    // The step's width: from the boundary to the raw piece's edge on the nearer side.
+    const geom::Box stock = rawBox();
+    if (stock.empty())
+      return fail("step " + feature.symbol + ": its workpiece has no block raw piece to tell which side is removed");
+    auto reach = [&](const Vec2 &dir) {
+      double best = 0;
+      for (const Vec2 &corner : {stock.lo, stock.hi, Vec2(stock.lo.x(), stock.hi.y()), Vec2(stock.hi.x(), stock.lo.y())})
+        best = std::max(best, (corner - a).dot(dir));
+      return best;
+    };
+    const double toLeft = reach(left), toRight = reach(-left);
+    const Vec2 side = toLeft <= toRight ? left : Vec2(-left);
+    const double width = std::min(toLeft, toRight);
+    if (width <= geom::kEps)
+      return fail("step " + feature.symbol + " lies on the raw piece's edge: nothing to remove");
+    s.target = outer(polygon({a, b, b + side * width, a + side * width}));
+    // Only the boundary itself is a wall: the ends and the far side are open.
+    const Vec2 e = along * kOpenReach;
+    s.limit = outer(polygon({a - e, b + e, b + e + side * (width + kOpenReach), a - e + side * (width + kOpenReach)}));
+    return true;
+  }
+
+  bool slot(const Node &feature, FeatureShape &s) {
+    const Node *path = feature.child("path");
+    std::vector<CurvePiece> pieces;
+    if (path && !path->children.empty()) {
+      CurveResult cr = curvePieces(path->children.front());
+      if (!cr.error.empty())
+        return fail("the course of travel of " + feature.symbol + ": " + cr.error);
+      pieces = std::move(cr.pieces);
+    }
+    if (pieces.size() != 1 || pieces[0].arc)
+      return fail("only slots along one straight course of travel are supported (" + feature.symbol + ")");
+    double width = 0;
+    if (const Node *p = feature.child("square_u_profile"))
+      width = *p->number("width");
+    else if (const Node *q = feature.child("rounded_u_profile"))
+      width = *q->number("width");
+    else if (feature.child("vee_profile") || feature.child("partial_circular_profile"))
+      return fail("slot " + feature.symbol + " has slanted or curved walls; 2.5D strategies cut vertical walls "
+                  "only (plan: z-level passes with a form or tapered tool)");
+    else
+      return fail("slot " + feature.symbol + " has no cross-section profile");
+    const Vec2 a = s.frame.map(pieces[0].from.head<2>());
+    const Vec2 b = s.frame.map(pieces[0].to.head<2>());
+    const Vec2 along = (b - a).normalized();
+    const Vec2 n(-along.y() * width / 2, along.x() * width / 2);
+    const bool open1 = feature.text("end_1") == "open", open2 = feature.text("end_2") == "open";
+    const bool round1 = feature.text("end_1") == "radiused", round2 = feature.text("end_2") == "radiused";
+    for (const char *end : {"end_1", "end_2"})
+      if (auto w = feature.text(end); w == "woodruff" || w == "loop")
+        return fail("slot " + feature.symbol + ": " + *w + " slot ends are not supported yet");
+    // The target: the straight part, with half circles for radiused ends.
+    Loop l;
+    l.segs.push_back(Seg::line(a - n, b - n));
+    if (round2)
+      l.segs.push_back(Seg::arc(b - n, b + n, b, true));
+    else
+      l.segs.push_back(Seg::line(b - n, b + n));
+    l.segs.push_back(Seg::line(b + n, a + n));
+    if (round1)
+      l.segs.push_back(Seg::arc(a + n, a - n, a, true));
+    else
+      l.segs.push_back(Seg::line(a + n, a - n));
+    s.target = outer(l);
+    const Vec2 e = along * kOpenReach;
+    if (open1 || open2)
+      s.limit = outer(polygon({a - n - (open1 ? e : Vec2::Zero()).eval(), b - n + (open2 ? e : Vec2::Zero()).eval(),
+                               b + n + (open2 ? e : Vec2::Zero()).eval(), a + n - (open1 ? e : Vec2::Zero()).eval()}));
+    else
+      s.limit = s.target;
+    return true;
+  }
+
+  bool fail(std::string message) {
+    if (error.empty())
+      error = std::move(message);
+    return false;
+  }
+
+private:
+  geom::Box rawBox() const {
+    geom::Box box;
+    const Node *raw = workpiece_ ? workpiece_->child("rawpiece") : nullptr;
+    if (!raw || raw->text("shape") != "block" || !raw->has("size"))
+      return box;
+    FrameResult fr = planeFrame(*raw);
+    if (!fr.frame)
+      return box;
+    const ir::Vec3 size = *raw->vec("size");
+    for (const Vec2 &c : {Vec2(0, 0), Vec2(size.x(), 0), Vec2(size.x(), size.y()), Vec2(0, size.y())})
+      box.add(fr.frame->map(c));
+    return box;
+  }
+
+  const ir::Module &module_;
+  const Node *workpiece_;
+};
+
+const Node *findIn(const Node &n, std::string_view symbol, const Node **parent) {
+  for (const Node &c : n.children) {
+    if (c.symbol == symbol) {
+      if (parent)
+        *parent = &n;
+      return &c;
+    }
+    if (c.kind == "workpiece")
+      if (const Node *found = findIn(c, symbol, parent))
+        return found;
+  }
+  return nullptr;
+}
+
+} // namespace
+
+FrameResult planeFrame(const ir::Node &placed) {
+  const ir::Vec3 at = placed.vec("at").value_or(ir::Vec3::Zero());
+  const ir::Vec3 axis = placed.vec("axis").value_or(ir::Vec3::UnitZ());
+  const ir::Vec3 ref = placed.vec("ref").value_or(ir::Vec3::UnitX());
+  if (std::abs(axis.z() - 1) > 1e-9)
+    return {std::nullopt, placed.kind + (placed.symbol.empty() ? "" : " " + placed.symbol) + " has its axis along " +
+                              vecText(axis) + ": only features facing the tool axis +z are expanded (plan: "
+                              "setups per face orientation)"};
+  PlaneFrame f;
+  f.origin = at.head<2>();
+  f.x = ref.head<2>().normalized();
+  f.y = Vec2(-f.x.y(), f.x.x());
+  f.z = at.z();
+  return {f, {}};
+}
+
+double pointLength(const ir::Node &tool) {
+  const double half = tool.number("tip_half_angle").value_or(0);
+  if (!(half > 0 && half < 90))
+    return 0;
+  return tool.number("diameter").value_or(0) / 2 * std::tan(half * std::numbers::pi / 180);
+}
+
+const ir::Node *findFeature(const ir::Module &module, std::string_view symbol) {
+  const Node *n = findIn(module.root, symbol, nullptr);
+  if (!n)
+    return nullptr;
+  const ir::KindSpec *k = ir::findKind(n->kind);
+  return k && k->category == "feature" ? n : nullptr;
+}
+
+ShapeResult featureShape(const ir::Module &module, const ir::Node &feature) {
+  const Node *workpiece = nullptr;
+  findIn(module.root, feature.symbol, &workpiece);
+  FrameResult fr = planeFrame(feature);
+  if (!fr.frame)
+    return {std::nullopt, fr.error};
+  FeatureShape s;
+  s.symbol = feature.symbol;
+  s.kind = feature.kind;
+  s.frame = *fr.frame;
+  s.top = s.frame.z;
+  s.bottom = s.top - feature.number("depth").value_or(0);
+  ShapeBuilder b(module, workpiece);
+  bool ok = true;
+  if (feature.kind == "closed_pocket") {
+    if (feature.text("bottom") != "planar" && feature.text("bottom") != "through")
+      return {std::nullopt, "pocket " + feature.symbol + " has a " + feature.text("bottom").value_or("") +
+                                " bottom; only planar and through bottoms are expanded (plan: ball-end finishing)"};
+    if (auto l = b.closedProfile(feature, feature.number("orthogonal_radius").value_or(0))) {
+      s.target = outer(mapLoop(*l, s.frame));
+      s.limit = s.target;
+    }
+    b.islands(feature, s);
+  } else if (feature.kind == "planar_face") {
+    const Vec2 travel = s.frame.mapDir(feature.vec("travel_dir")->head<2>()).normalized();
+    const Vec2 across = s.frame.mapDir(feature.vec("width_dir")->head<2>()).normalized();
+    const Vec2 o = s.frame.origin;
+    const Vec2 t = travel * *feature.number("travel"), w = across * *feature.number("width");
+    s.target = outer(polygon({o, o + w, o + w + t, o + t}));
+    s.unbounded = true;
+    b.islands(feature, s);
+  } else if (feature.kind == "round_hole") {
+    s.holeCentre = s.frame.origin;
+    s.holeDiameter = *feature.number("diameter");
+    Loop l;
+    for (const Seg &seg : geom::circle(s.frame.origin, s.holeDiameter / 2, true, s.frame.origin + Vec2(s.holeDiameter / 2, 0)))
+      l.segs.push_back(seg);
+    s.target = outer(l);
+    s.limit = s.target;
+  } else if (feature.kind == "slot") {
+    ok = b.slot(feature, s);
+  } else if (feature.kind == "step") {
+    ok = b.step(feature, s);
+    b.islands(feature, s);
+  } else {
+    return {std::nullopt, feature.kind + " " + feature.symbol +
+                              " is not expanded yet (plan: open pockets and outside profiles with the same "
+                              "offset machinery, material side from the raw piece)"};
+  }
+  if (!ok || !b.error.empty() || s.target.empty())
+    return {std::nullopt, b.error.empty() ? feature.kind + " " + feature.symbol + " has no usable outline" : b.error};
+  return {std::move(s), {}};
+}
+
+} // namespace stepnc::passes

@@ -1,0 +1,83 @@
+// What a feature is in the plane of the tool: the area its machining must
+// clear, where the tool may go, and the heights between which it lies, in the
+// coordinates of its workpiece. Strategy expansion cuts this shape; the
+// toolpath verifier measures moves against it. It is the one piece of
+// interpretation the two share, so it is tested on its own (exact areas).
+//
+// Only features whose axis is the tool axis (+z of the workpiece) are 2.5D
+// shapes; others are reported as not supported.
+#pragma once
+
+#include "geom/Geometry.h"
+#include "ir/Node.h"
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace stepnc::passes {
+
+/// A feature's frame in workpiece coordinates, restricted to the plane.
+struct PlaneFrame {
+  geom::Vec2 origin = geom::Vec2::Zero();
+  geom::Vec2 x = geom::Vec2::UnitX();  ///< local x axis (unit)
+  geom::Vec2 y = geom::Vec2::UnitY();  ///< local y axis (unit)
+  double z = 0;                        ///< height of the frame's origin
+
+  geom::Vec2 map(const geom::Vec2 &local) const { return origin + local.x() * x + local.y() * y; }
+  geom::Vec2 mapDir(const geom::Vec2 &local) const { return local.x() * x + local.y() * y; }
+  /// True when the local frame is mirrored (x, y clockwise in workpiece coordinates).
+  bool mirrored() const { return geom::cross(x, y) < 0; }
+};
+
+/// Material a feature's machining must leave (a boss), up to its top.
+struct IslandShape {
+  std::string symbol;
+  geom::Region region;
+  double top = 0;
+};
+
+struct FeatureShape {
+  std::string symbol;
+  std::string kind;
+  PlaneFrame frame;
+  double top = 0;     ///< z of the feature's top (its placement)
+  double bottom = 0;  ///< z of its floor (top - depth)
+  /// The area to clear at every depth, islands not removed (see `islands`).
+  geom::Region target;
+  /// Where the tool may be below the top: `target` plus the open space past
+  /// open sides (open pockets, steps, open slot ends). Unused when `unbounded`.
+  geom::Region limit;
+  /// No walls at all: the tool may pass every side (planar faces).
+  bool unbounded = false;
+  std::vector<IslandShape> islands;
+  /// For round holes: the axis position and the diameter.
+  std::optional<geom::Vec2> holeCentre;
+  double holeDiameter = 0;
+};
+
+/// The frame of a node with `at`, `axis`, `ref` (features, profiles); an error
+/// message when its axis is not +z.
+struct FrameResult {
+  std::optional<PlaneFrame> frame;
+  std::string error;
+};
+FrameResult planeFrame(const ir::Node &placed);
+
+struct ShapeResult {
+  std::optional<FeatureShape> shape;
+  std::string error;  ///< why the feature has no shape (not supported, missing data)
+};
+
+/// The shape of `feature` (a feature node of `module`).
+ShapeResult featureShape(const ir::Module &module, const ir::Node &feature);
+
+/// How far a tool's point reaches below its cutting corner: r tan(tip half
+/// angle), the angle measured from the plane normal to the tool axis (ISO
+/// 14649-111: 0 for a flat end mill; a 140 deg carbide drill has 20 deg).
+double pointLength(const ir::Node &tool);
+
+/// The feature node a symbol names, or null.
+const ir::Node *findFeature(const ir::Module &module, std::string_view symbol);
+
+} // namespace stepnc::passes

@@ -1,0 +1,45 @@
+// Reading the toolpath IR: the moves of a `moves` node with the point each one
+// starts from, their geometry in space and in the plane, and the state in
+// force (tool, spindle, coolant). Every pass that reads moves (verification,
+// feed adaptation, the backends) walks them through here.
+#pragma once
+
+#include "geom/Geometry.h"
+#include "ir/Node.h"
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace stepnc::passes {
+
+enum class MoveKind : uint8_t { Rapid, Linear, Arc };
+
+struct Move {
+  const ir::Node *node = nullptr;
+  MoveKind kind = MoveKind::Rapid;
+  /// Where the move starts; unknown for the first move of a program.
+  std::optional<ir::Vec3> from;
+  ir::Vec3 to = ir::Vec3::Zero();
+  ir::Vec3 center = ir::Vec3::Zero();  ///< arcs: the axis position (its z is not used)
+  bool ccw = false;                    ///< arcs, seen from +z
+  /// Arcs: full turns before the last arc to `to`; that arc is itself a whole
+  /// turn when `to` is over `from` in the plane.
+  int64_t turns = 0;
+  double feed = 0;                     ///< mm/min; 0 for rapids
+  std::string role;                    ///< "position", "cut", ... (default: position for rapids, cut otherwise)
+
+  bool isFeed() const { return kind != MoveKind::Rapid; }
+  /// True when the move changes height (a plunge, a ramp, a helix).
+  bool changesHeight() const;
+  double length() const;  ///< in space; helices included
+  /// The move seen from +z: its segments in the plane (a helix's full turns as
+  /// half arcs, then the last partial arc). Empty for a purely axial move.
+  std::vector<geom::Seg> planar() const;
+};
+
+/// The moves of `moves` in order, each knowing where it starts (`start` is
+/// where the tool is before the first one, when known).
+std::vector<Move> walkMoves(const ir::Node &moves, std::optional<ir::Vec3> start = std::nullopt);
+
+} // namespace stepnc::passes

@@ -1,0 +1,828 @@
+// verify-toolpaths: checks the moves of every workingstep against its feature,
+// independently of the code that generated them. It shares with strategy
+// expansion only the reading of the feature (FeatureShape) and of the moves
+// (MoveWalk); every area is computed with the exact Booleans of geom/Boolean.h
+// (never with geom::offset or geom::clip, the generator's tools).
+//
+// Per executable with moves (docs/toolpaths.md, "Verification", says the same
+// in prose):
+//   safety  rapids at or above the security plane, or along the tool axis
+//           (up, or down into the free space above the feature); the first
+//           move a rapid up to the security plane; the spindle turning while
+//           feeding;
+//   depth   no move below the floor (bottom + allowance_bottom; through
+//           bottoms allow the tool's point and an overcut);
+//   gouge   the disc swept by feed moves below the feature's top stays in
+//           the limit shrunk by the side allowance and out of the islands
+//           grown by it (round holes: on the axis, tool no wider than the hole);
+//   uncut   at the floor level the sweep covers what the tool can reach
+//           (the opening of the allowed area with the tool radius);
+// then, per feature, the floors of roughing and finishing together cover what
+// the smallest tool can reach. Figures go into the `moves` node's comment.
+#include "passes/Pass.h"
+
+#include "geom/Boolean.h"
+#include "ir/Kinds.h"
+#include "passes/FeatureShape.h"
+#include "passes/MoveWalk.h"
+#include "support/Format.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <exception>
+#include <map>
+#include <numbers>
+
+namespace stepnc::passes {
+
+namespace {
+
+using geom::Region;
+using geom::Seg;
+using geom::Vec2;
+
+constexpr double kDefaultTolerance = 0.01;  ///< mm, when neither the option nor the workpiece gives one
+constexpr double kLevelEps = 1e-6;          ///< heights closer than this are one depth level
+constexpr double kUncutShare = 0.001;       ///< uncut area allowed at the floor: 0.1 % of the target
+/// mm a tool may pass a through bottom beyond its point when the overcut is
+/// smaller: the generator breaks through by 1 mm; explicit paths written by
+/// others commonly by up to 2 (ISO 14649-11 Example 1: 1.13 mm).
+constexpr double kThroughOvercut = 2.0;
+constexpr size_t kMaxReports = 3;           ///< errors of one kind reported per executable
+
+// --- Operations ------------------------------------------------------------------
+
+bool isOneOf(std::string_view kind, std::initializer_list<std::string_view> kinds) {
+  return std::find(kinds.begin(), kinds.end(), kind) != kinds.end();
+}
+
+bool isMilling(std::string_view op) {
+  return isOneOf(op, {"plane_rough_milling", "plane_finish_milling", "bottom_and_side_rough_milling",
+                      "bottom_and_side_finish_milling", "side_rough_milling", "side_finish_milling",
+                      "freeform_operation"});
+}
+
+bool isFinishing(std::string_view op) {
+  return isOneOf(op, {"bottom_and_side_finish_milling", "side_finish_milling", "plane_finish_milling"});
+}
+
+bool isSideMilling(std::string_view op) { return isOneOf(op, {"side_rough_milling", "side_finish_milling"}); }
+
+const ir::Node *operationOf(const ir::Node &exec) {
+  for (const ir::Node &c : exec.children)
+    if (const ir::KindSpec *k = ir::findKind(c.kind); k && k->category == "operation")
+      return &c;
+  return nullptr;
+}
+
+// --- Text --------------------------------------------------------------------------
+
+std::string mm(double v) { return formatFixed(v, 4) + " mm"; }
+std::string mm2(double v) { return formatFixed(v, 3) + " mm2"; }
+std::string pointText(const ir::Vec3 &p) {
+  return "(" + formatFixed(p.x(), 4) + ", " + formatFixed(p.y(), 4) + ", " + formatFixed(p.z(), 4) + ")";
+}
+
+/// "0.02" or "0.02mm" as a positive length; nullopt otherwise.
+std::optional<double> parseLength(std::string_view text) {
+  if (text.size() > 2 && text.substr(text.size() - 2) == "mm")
+    text.remove_suffix(2);
+  double value = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (ec != std::errc() || end != text.data() + text.size() || !std::isfinite(value) || value <= 0)
+    return std::nullopt;
+  return value;
+}
+
+// --- Regions -----------------------------------------------------------------------
+
+/// The region grown (d > 0) or shrunk (d < 0) by |d|, with the exact Booleans.
+Region offsetExact(const Region &r, double d) {
+  if (r.empty() || d == 0)
+    return r;
+  return d > 0 ? geom::growExact(r, d) : geom::shrinkExact(r, -d);
+}
+
+bool sameRegion(const Region &a, const Region &b) {
+  if (a.loops.size() != b.loops.size())
+    return false;
+  for (size_t i = 0; i < a.loops.size(); ++i) {
+    const auto &s = a.loops[i].segs, &t = b.loops[i].segs;
+    if (s.size() != t.size())
+      return false;
+    for (size_t k = 0; k < s.size(); ++k)
+      if (s[k].a != t[k].a || s[k].b != t[k].b || s[k].turn != t[k].turn ||
+          (s[k].isArc() && s[k].c != t[k].c))
+        return false;
+  }
+  return true;
+}
+
+/// Indices of the islands standing above height z: the ones a cut at z must avoid.
+std::vector<size_t> islandsAbove(const FeatureShape &shape, double z, double tol) {
+  std::vector<size_t> out;
+  for (size_t i = 0; i < shape.islands.size(); ++i)
+    if (shape.islands[i].top > z + tol)
+      out.push_back(i);
+  return out;
+}
+
+std::string indexKey(const std::vector<size_t> &indices) {
+  std::string key;
+  for (size_t i : indices)
+    key += std::to_string(i) + ",";
+  return key;
+}
+
+/// The areas derived from a feature's shape, each computed once per set of
+/// inputs (feature, tool radius, allowance, islands in force) and reused for
+/// every depth level and every workingstep that needs it.
+class RegionCache {
+public:
+  /// The islands with the given indices, united and grown by d.
+  const Region &islands(const FeatureShape &s, const std::vector<size_t> &idx, double d) {
+    return get("islands", s, {d}, idx, [&] {
+      std::vector<Region> parts;
+      for (size_t i : idx)
+        parts.push_back(s.islands[i].region);
+      return parts.empty() ? Region{} : offsetExact(geom::uniteAll(parts), d);
+    });
+  }
+
+  /// Where the tool's edge may be (bounded shapes): the limit shrunk by the
+  /// side allowance, without the islands grown by it.
+  const Region &allowed(const FeatureShape &s, double allowance, const std::vector<size_t> &idx) {
+    return get("allowed", s, {allowance}, idx, [&] {
+      const Region walls = offsetExact(s.limit, -allowance);
+      const Region &isl = islands(s, idx, allowance);
+      return isl.empty() ? walls : geom::subtract(walls, isl);
+    });
+  }
+
+  /// What a tool of radius r can reach of the target: the opening of the
+  /// allowed area (shrunk by r, grown back by r) within the target; for
+  /// unbounded shapes, the target without the closing of the grown islands.
+  const Region &reachable(const FeatureShape &s, double r, double allowance, const std::vector<size_t> &idx) {
+    return get("reachable", s, {r, allowance}, idx, [&] {
+      if (s.unbounded) {
+        const Region &isl = islands(s, idx, allowance + r);
+        return isl.empty() ? s.target : geom::subtract(s.target, geom::shrinkExact(isl, r));
+      }
+      Region open = geom::growExact(geom::shrinkExact(allowed(s, allowance, idx), r), r);
+      return sameRegion(s.limit, s.target) ? open : geom::intersect(open, s.target);
+    });
+  }
+
+  /// What side milling must clear: the reachable area within `band` of the
+  /// allowed area's boundary (walls and islands).
+  const Region &sideBand(const FeatureShape &s, double r, double allowance, double band,
+                         const std::vector<size_t> &idx) {
+    return get("band", s, {r, allowance, band}, idx, [&] {
+      const Region &reach = reachable(s, r, allowance, idx);
+      if (s.unbounded)
+        return reach;
+      const Region inner = geom::shrinkExact(allowed(s, allowance, idx), band);
+      return inner.empty() ? reach : geom::subtract(reach, inner);
+    });
+  }
+
+private:
+  template <class Make>
+  const Region &get(const char *what, const FeatureShape &s, std::initializer_list<double> numbers,
+                    const std::vector<size_t> &idx, Make &&make) {
+    std::string key = what;
+    for (const std::string &part : {s.symbol, indexKey(idx)})
+      key.append("|").append(part);
+    for (double v : numbers)
+      key.append("|").append(formatShortest(v));
+    auto it = regions_.find(key);
+    if (it == regions_.end())
+      it = regions_.emplace(key, make()).first;
+    return it->second;
+  }
+
+  std::map<std::string, Region> regions_;
+};
+
+// --- Cuts ----------------------------------------------------------------------------
+
+/// A feed move below the feature's top, in the plane: what the tool sweeps.
+struct Cut {
+  std::vector<Seg> segs;  ///< the move's planar segments; a point for a move along the axis
+  double low = 0;         ///< its lowest height
+  bool horizontal = false;
+  Vec2 lowPoint = Vec2::Zero();  ///< where it is lowest, in the plane
+};
+
+Cut cutOf(const Move &m) {
+  Cut c;
+  const ir::Vec3 &low = m.from->z() < m.to.z() ? *m.from : m.to;
+  c.low = low.z();
+  c.lowPoint = low.head<2>();
+  c.horizontal = std::abs(m.to.z() - m.from->z()) <= kLevelEps;
+  c.segs = m.planar();
+  if (c.segs.empty())
+    c.segs.push_back(Seg::line(c.lowPoint, c.lowPoint));  // a plunge cuts a disc
+  return c;
+}
+
+/// The cuts grouped by depth level (lowest heights within kLevelEps), lowest level first.
+std::vector<std::vector<const Cut *>> byLevel(std::vector<const Cut *> cuts) {
+  std::sort(cuts.begin(), cuts.end(), [](const Cut *a, const Cut *b) { return a->low < b->low; });
+  std::vector<std::vector<const Cut *>> levels;
+  for (const Cut *c : cuts) {
+    if (levels.empty() || c->low - levels.back().front()->low > kLevelEps)
+      levels.emplace_back();
+    levels.back().push_back(c);
+  }
+  return levels;
+}
+
+/// The area the regions cover together.
+double totalArea(const std::vector<Region> &regions) {
+  if (regions.size() <= 1)
+    return regions.empty() ? 0.0 : regions[0].area();
+  return geom::uniteAll(regions).area();
+}
+
+Region sweep(const std::vector<const Cut *> &cuts, double r) {
+  std::vector<Seg> segs;
+  for (const Cut *c : cuts)
+    segs.insert(segs.end(), c->segs.begin(), c->segs.end());
+  return segs.empty() ? Region{} : geom::sweptDisc(segs, r);
+}
+
+// --- The checker -----------------------------------------------------------------------
+
+struct Figures {
+  std::optional<double> swept, uncut, uncutPercent, gouge;
+  double path = 0;
+  size_t moves = 0;
+};
+
+/// One executable being verified, with everything its checks need.
+struct Step {
+  ir::Node *exec = nullptr;
+  const ir::Node *movesNode = nullptr;
+  std::string name;  ///< "workingstep @ws1", for messages
+  const ir::Node *op = nullptr;
+  const ir::Node *feature = nullptr;
+  const FeatureShape *shape = nullptr;  ///< null: no feature, or one FeatureShape cannot handle
+  const ir::Node *tool = nullptr;
+  double radius = 0;  ///< 0: unknown
+  double tol = kDefaultTolerance;
+  double secplane = 0;
+  double allowanceSide = 0, allowanceBottom = 0;
+  std::vector<Move> moves;
+  Figures figures;
+};
+
+/// A move that broke a rule, with what to say about it.
+struct Offence {
+  const ir::Node *at;
+  std::string message;
+};
+
+/// A workingstep's floor, kept for the per-feature check of roughing and finishing together.
+struct Floor {
+  const ir::Node *exec;
+  double radius;
+  double z;
+  bool finishing;
+  Region swept;
+};
+
+class ToolpathChecker {
+public:
+  ToolpathChecker(ir::Module &module, DiagnosticEngine &diags, PassStats &stats,
+                  std::optional<double> tolerance)
+      : module_(module), diags_(diags), stats_(stats), tolerance_(tolerance) {}
+
+  PassResult run() {
+    for (const ir::Node &n : module_.root.children)
+      if (n.kind == "tool")
+        tools_[n.symbol] = &n;
+    visit(module_.root);
+    checkFeatures();
+    return {errorsBefore_ == diags_.errorCount(), changed_};
+  }
+
+private:
+  void visit(ir::Node &n) {
+    for (ir::Node &c : n.children) {
+      if (c.kind == "workplan")
+        visit(c);
+      else if (c.kind == "workingstep" || c.kind == "rapid_movement")
+        for (ir::Node &m : c.children)
+          if (m.kind == "moves")
+            verify(c, m);
+    }
+  }
+
+  void verify(ir::Node &exec, ir::Node &movesNode) {
+    Step s = prepare(exec, movesNode);
+    std::string reason = locate(s);
+    checkSafety(s);
+    if (s.shape) {
+      try {
+        checkShape(s);
+      } catch (const std::exception &e) {
+        reason = e.what();
+      }
+    }
+    if (!reason.empty()) {
+      diags_.warning(exec.origin.loc, s.name + ": not verified: " + reason).entity(exec.origin.entityId);
+      ++stats_["workingsteps not verified"];
+    } else {
+      ++stats_["workingsteps verified"];
+    }
+    writeFigures(movesNode, s.figures);
+  }
+
+  Step prepare(ir::Node &exec, const ir::Node &movesNode) {
+    Step s;
+    s.exec = &exec;
+    s.movesNode = &movesNode;
+    s.name = exec.kind + " " + exec.symbol;
+    s.op = operationOf(exec);
+    s.secplane = movesNode.number("secplane").value_or(0.0);
+    if (auto it = tools_.find(movesNode.text("tool").value_or("")); it != tools_.end())
+      s.tool = it->second;
+    if (s.tool)
+      s.radius = s.tool->number("diameter").value_or(0.0) / 2;
+    if (s.op) {
+      s.allowanceSide = s.op->number("allowance_side").value_or(0.0);
+      s.allowanceBottom = s.op->number("allowance_bottom").value_or(0.0);
+    }
+    s.moves = walkMoves(movesNode);
+    s.figures.moves = s.moves.size();
+    for (const Move &m : s.moves)
+      s.figures.path += m.length();
+    stats_["moves checked"] += static_cast<long long>(s.moves.size());
+    const std::optional<std::string> feature = exec.text("feature");
+    s.feature = feature ? findFeature(module_, *feature) : nullptr;
+    s.tol = tolerance_.value_or(workpieceTolerance(s.feature));
+    return s;
+  }
+
+  /// The feature's shape and the tool's radius; why the step cannot be fully verified, or empty.
+  std::string locate(Step &s) {
+    if (s.exec->kind == "rapid_movement")
+      return {};  // no feature: only the safety rules apply
+    if (!s.feature)
+      return "its feature " + s.exec->text("feature").value_or("?") + " is not a feature of the module";
+    if (!s.tool || !(s.radius > 0))
+      return "its tool has no diameter";
+    auto it = shapes_.find(s.feature->symbol);
+    if (it == shapes_.end())
+      it = shapes_.emplace(s.feature->symbol, featureShape(module_, *s.feature)).first;
+    if (!it->second.shape)
+      return it->second.error;
+    s.shape = &*it->second.shape;
+    return {};
+  }
+
+  /// The global tolerance of the feature's workpiece (else of the first workpiece giving one).
+  double workpieceTolerance(const ir::Node *feature) const {
+    std::optional<double> first;
+    for (const ir::Node &wp : module_.root.children) {
+      if (wp.kind != "workpiece")
+        continue;
+      const std::optional<double> tol = wp.number("global_tolerance");
+      if (feature && tol && std::any_of(wp.children.begin(), wp.children.end(),
+                                        [&](const ir::Node &c) { return &c == feature; }))
+        return *tol;
+      if (!first && tol)
+        first = tol;
+    }
+    return first.value_or(kDefaultTolerance);
+  }
+
+  // --- Safety ---------------------------------------------------------------------
+
+  void checkSafety(Step &s) {
+    if (s.moves.empty())
+      return;
+    std::vector<Offence> offences;
+    const Move &first = s.moves.front();
+    if (!first.from && (first.isFeed() || first.to.z() < s.secplane - s.tol))
+      offences.push_back(
+          {first.node, "the first move starts from an unknown position: it must be a rapid ending "
+                       "at or above the security plane z=" +
+                           mm(s.secplane) + ", not a " + first.node->kind + " to " + pointText(first.to)});
+    if (s.movesNode->number("spindle").value_or(0.0) == 0)
+      for (const Move &m : s.moves)
+        if (m.isFeed()) {
+          offences.push_back({m.node, "feed move with the spindle stopped (spindle=0 on its moves)"});
+          break;
+        }
+    // A rapid movement's rapids are the file's own explicit path: where they
+    // leave the rule they are reported as warnings, to be read, not refused.
+    const bool explicitRapids = s.exec->kind == "rapid_movement";
+    std::vector<Offence> rapids;
+    for (const Move &m : s.moves)
+      if (m.kind == MoveKind::Rapid && m.from && !rapidSafe(s, m))
+        rapids.push_back({m.node, "rapid from " + pointText(*m.from) + " to " + pointText(m.to) +
+                                      " below the security plane z=" + mm(s.secplane) +
+                                      (s.shape ? " and not along the tool axis above " + s.shape->symbol
+                                               : " and not along the tool axis")});
+    if (explicitRapids) {
+      report(s, rapids, "explicit rapids below the security plane", /*warning=*/true);
+    } else {
+      offences.insert(offences.end(), rapids.begin(), rapids.end());
+    }
+    report(s, offences, "safety errors");
+  }
+
+  /// At or above the security plane, or along the tool axis: upwards (the
+  /// tool leaves through the space its own body fills) or downwards ending in
+  /// the free space above the feature.
+  bool rapidSafe(const Step &s, const Move &m) const {
+    const double low = std::min(m.from->z(), m.to.z());
+    if (low >= s.secplane - s.tol)
+      return true;
+    if ((m.to.head<2>() - m.from->head<2>()).norm() > s.tol)
+      return false;
+    if (m.to.z() >= m.from->z() || !s.shape)
+      return true;
+    return m.to.z() >= clearHeight(s, m.to.head<2>()) - s.tol;
+  }
+
+  /// The height above which the tool at xy is in free space: the feature's
+  /// top, or the top of an island standing higher within reach of the tool.
+  double clearHeight(const Step &s, const Vec2 &xy) const {
+    double z = s.shape->top;
+    for (const IslandShape &island : s.shape->islands) {
+      if (island.top <= z)
+        continue;
+      const bool near = island.region.contains(xy) ||
+                        geom::SegIndex::of(island.region).distance(xy) < s.radius + s.tol;
+      if (near)
+        z = island.top;
+    }
+    return z;
+  }
+
+  // --- Shape-dependent checks --------------------------------------------------------
+
+  void checkShape(Step &s) {
+    checkDepth(s);
+    const bool holeMaking = s.op && !isMilling(s.op->kind);
+    if (s.shape->holeCentre && holeMaking) {
+      checkHole(s);
+      return;
+    }
+    std::vector<Cut> cuts;
+    for (const Move &m : s.moves)
+      if (m.isFeed() && m.from && std::min(m.from->z(), m.to.z()) < s.shape->top - s.tol)
+        cuts.push_back(cutOf(m));
+    checkGouge(s, cuts);
+    if (s.op && isMilling(s.op->kind))
+      checkUncut(s, cuts);
+  }
+
+  void checkDepth(Step &s) {
+    const double floor = s.shape->bottom + s.allowanceBottom;
+    const double lowest = floor - throughAllowance(s);
+    std::vector<Offence> offences;
+    for (const Move &m : s.moves) {
+      const double low = m.from ? std::min(m.from->z(), m.to.z()) : m.to.z();
+      if (low < lowest - s.tol)
+        offences.push_back(
+            {m.node, m.node->kind + " to " + pointText(m.to) + " goes below the floor of " + s.shape->symbol +
+                         ": z=" + mm(low) + ", lowest allowed z=" + mm(lowest) + " (bottom " +
+                         mm(s.shape->bottom) + " + allowance_bottom " + mm(s.allowanceBottom) + ")"});
+    }
+    report(s, offences, "depth errors");
+  }
+
+  /// How far below the floor a through bottom lets the tool go: its point
+  /// (passes::pointLength) plus the operation's overcut, at least 1 mm.
+  double throughAllowance(const Step &s) const {
+    if (s.feature->text("bottom") != "through")
+      return 0;
+    const double point = pointLength(*s.tool);
+    const double overcut = s.op ? s.op->number("overcut").value_or(0.0) : 0.0;
+    return point + std::max(kThroughOvercut, overcut);
+  }
+
+  /// Hole making: on the axis below the top, and no wider than the hole.
+  void checkHole(Step &s) {
+    const Vec2 axis = *s.shape->holeCentre;
+    std::vector<Offence> offences;
+    const bool sized = isOneOf(
+        s.op->kind, {"drilling", "multistep_drilling", "reaming", "boring", "tapping", "thread_drilling"});
+    if (sized && 2 * s.radius > s.shape->holeDiameter + s.tol)
+      offences.push_back({s.exec, "tool " + s.tool->symbol + " of diameter " + mm(2 * s.radius) +
+                                      " is wider than " + s.shape->symbol + " (diameter " +
+                                      mm(s.shape->holeDiameter) + ")"});
+    for (const Move &m : s.moves) {
+      if (!m.from || std::min(m.from->z(), m.to.z()) >= s.shape->top - s.tol)
+        continue;
+      const double off = farthestFrom(m, axis);
+      if (off > s.tol)
+        offences.push_back({m.node, m.node->kind + " to " + pointText(m.to) + " leaves the axis of " +
+                                        s.shape->symbol + " below its top by " + mm(off)});
+    }
+    report(s, offences, "gouge errors");
+  }
+
+  /// The largest distance in the plane from p to the move.
+  static double farthestFrom(const Move &m, const Vec2 &p) {
+    double d = std::max((m.from->head<2>() - p).norm(), (m.to.head<2>() - p).norm());
+    for (const Seg &seg : m.planar()) {
+      if (!seg.isArc())
+        continue;
+      // The farthest point of the circle lies opposite p; it counts when the arc passes it.
+      const Vec2 out = seg.c - p;
+      const double far = out.norm() + seg.radius();
+      if (out.norm() <= geom::kEps || arcPasses(seg, out))
+        d = std::max(d, far);
+    }
+    return d;
+  }
+
+  /// True when the arc passes the direction `dir` from its centre.
+  static bool arcPasses(const Seg &arc, const Vec2 &dir) {
+    const double start = std::atan2((arc.a - arc.c).y(), (arc.a - arc.c).x());
+    double to = std::atan2(dir.y(), dir.x()) - start;  // ccw angle from the start to dir
+    to = std::fmod(to + 4 * std::numbers::pi, 2 * std::numbers::pi);
+    const double sweep = arc.sweep();
+    return sweep >= 0 ? to <= sweep : (to == 0 || 2 * std::numbers::pi - to <= -sweep);
+  }
+
+  // --- Gouge --------------------------------------------------------------------------
+
+  /// The part of the swept area outside where the tool may be.
+  Region gougeOf(const Step &s, const Region &swept, const std::vector<size_t> &idx) {
+    if (swept.empty())
+      return {};
+    if (s.shape->unbounded) {
+      const Region &isl = cache_.islands(*s.shape, idx, s.allowanceSide);
+      return isl.empty() ? Region{} : geom::intersect(swept, isl);
+    }
+    return geom::subtract(swept, cache_.allowed(*s.shape, s.allowanceSide, idx));
+  }
+
+  /// True when every cut of the group keeps its centre inside the allowed
+  /// area at least the tool radius from its boundary (less kEps, rounding):
+  /// then no disc leaves the allowed area and the exact sweep is not needed.
+  bool clearlyInside(const Step &s, const std::vector<const Cut *> &cuts, const std::vector<size_t> &idx) {
+    const Region &walls = s.shape->unbounded ? cache_.islands(*s.shape, idx, s.allowanceSide)
+                                             : cache_.allowed(*s.shape, s.allowanceSide, idx);
+    if (walls.empty())
+      return s.shape->unbounded;
+    const geom::SegIndex &index = boundaries_.try_emplace(&walls, geom::SegIndex::of(walls)).first->second;
+    for (const Cut *c : cuts)
+      for (const Seg &seg : c->segs)
+        if (walls.contains(seg.a) == s.shape->unbounded || index.distance(seg) < s.radius - geom::kEps)
+          return false;
+    return true;
+  }
+
+  void checkGouge(Step &s, const std::vector<Cut> &cuts) {
+    // Cuts facing the same islands are checked together; a failing group is
+    // checked again level by level to say where the gouge is.
+    std::map<std::string, std::pair<std::vector<size_t>, std::vector<const Cut *>>> groups;
+    for (const Cut &c : cuts) {
+      std::vector<size_t> idx = islandsAbove(*s.shape, c.low, s.tol);
+      auto &g = groups[indexKey(idx)];
+      g.first = std::move(idx);
+      g.second.push_back(&c);
+    }
+    std::vector<Region> gouges;
+    std::vector<Offence> offences;
+    for (const auto &[key, group] : groups) {
+      if (clearlyInside(s, group.second, group.first))
+        continue;
+      Region g = gougeOf(s, sweep(group.second, s.radius), group.first);
+      if (g.empty())
+        continue;
+      if (g.area() > s.tol * s.tol)
+        locateGouges(s, group.first, group.second, g.area(), offences);
+      gouges.push_back(std::move(g));
+    }
+    s.figures.gouge = totalArea(gouges);
+    report(s, offences, "gouge errors");
+  }
+
+  void locateGouges(const Step &s, const std::vector<size_t> &idx, const std::vector<const Cut *> &cuts,
+                    double total, std::vector<Offence> &offences) {
+    const size_t before = offences.size();
+    for (const auto &level : byLevel(cuts)) {
+      const double area = gougeOf(s, sweep(level, s.radius), idx).area();
+      if (area > s.tol * s.tol)
+        offences.push_back({s.exec, gougeText(s, area, "at depth level z=" + mm(level.front()->low))});
+    }
+    if (offences.size() == before)  // only the levels together exceed the tolerance
+      offences.push_back({s.exec, gougeText(s, total, "over several depth levels")});
+  }
+
+  static std::string gougeText(const Step &s, double area, const std::string &where) {
+    return "gouge of " + mm2(area) + " into " + s.shape->symbol + " " + where + " (tool " + s.tool->symbol +
+           ", radius " + mm(s.radius) + ", allowance_side " + mm(s.allowanceSide) + ")";
+  }
+
+  // --- Uncut ----------------------------------------------------------------------------
+
+  void checkUncut(Step &s, const std::vector<Cut> &cuts) {
+    const bool explicitPaths = s.op->kind == "freeform_operation";
+    const double targetArea = s.shape->target.area();
+    std::optional<double> floorZ;
+    for (const Cut &c : cuts)
+      if (c.horizontal && (!floorZ || c.low < *floorZ))
+        floorZ = c.low;
+    std::vector<Offence> offences;
+    if (!floorZ) {
+      if (!explicitPaths)
+        offences.push_back({s.exec, "no cutting move below the top of " + s.shape->symbol + " (z=" +
+                                        mm(s.shape->top) + "): nothing of it is cleared"});
+      report(s, offences, "uncut errors");
+      return;
+    }
+    // At the floor: horizontal cuts, and the lowest point of moves ending there (plunges, ramps, helices).
+    std::vector<Cut> points;
+    for (const Cut &c : cuts)
+      if (!c.horizontal && std::abs(c.low - *floorZ) <= kLevelEps)
+        points.push_back({{Seg::line(c.lowPoint, c.lowPoint)}, c.low, false, c.lowPoint});
+    std::vector<const Cut *> atFloor;
+    for (const Cut &c : cuts)
+      if (c.horizontal && std::abs(c.low - *floorZ) <= kLevelEps)
+        atFloor.push_back(&c);
+    for (const Cut &p : points)
+      atFloor.push_back(&p);
+    const std::vector<size_t> idx = islandsAbove(*s.shape, *floorZ, s.tol);
+    const Region swept = sweep(atFloor, s.radius);
+    const double uncut = geom::subtract(required(s, idx), swept).area();
+    s.figures.swept = swept.area();
+    s.figures.uncut = uncut;
+    s.figures.uncutPercent = targetArea > 0 ? 100 * uncut / targetArea : 0.0;
+    floors_[s.feature->symbol].push_back({s.exec, s.radius, *floorZ, isFinishing(s.op->kind), swept});
+    if (explicitPaths)
+      return;
+    // A finishing step must clear everything it can reach; what roughing
+    // leaves (scallops of a zigzag, say) is reported, and the check of
+    // roughing and finishing together decides.
+    if (uncut > kUncutShare * targetArea) {
+      std::vector<Offence> uncutReport = {
+          {s.exec, "leaves " + mm2(uncut) + " (" + formatFixed(*s.figures.uncutPercent, 3) + " %) of " +
+                       s.shape->symbol + " uncut at its floor level z=" + mm(*floorZ) + " (tool " +
+                       s.tool->symbol + ", radius " + mm(s.radius) + ", allowance_side " + mm(s.allowanceSide) +
+                       ")"}};
+      if (isFinishing(s.op->kind))
+        offences.insert(offences.end(), uncutReport.begin(), uncutReport.end());
+      else
+        report(s, uncutReport, "roughing steps leaving uncut area", /*warning=*/true);
+    }
+    const double floor = s.shape->bottom + s.allowanceBottom;
+    if (*floorZ > floor + s.tol)
+      offences.push_back({s.exec, "its lowest cutting level z=" + mm(*floorZ) + " is above the floor of " +
+                                      s.shape->symbol + " at z=" + mm(floor)});
+    report(s, offences, "uncut errors");
+  }
+
+  /// What the step must clear at its floor: everything the tool can reach, or
+  /// for side milling the band along the walls (radial_depth wide, else the tool radius).
+  const Region &required(const Step &s, const std::vector<size_t> &idx) {
+    if (!isSideMilling(s.op->kind))
+      return cache_.reachable(*s.shape, s.radius, s.allowanceSide, idx);
+    const double band = s.op->number("radial_depth").value_or(s.radius);
+    return cache_.sideBand(*s.shape, s.radius, s.allowanceSide, band > 0 ? band : s.radius, idx);
+  }
+
+  // --- Roughing and finishing together ---------------------------------------------------
+
+  void checkFeatures() {
+    for (const auto &[symbol, floors] : floors_) {
+      const bool finished =
+          std::any_of(floors.begin(), floors.end(), [](const Floor &f) { return f.finishing; });
+      if (floors.size() < 2 || !finished)
+        continue;
+      const FeatureShape &shape = *shapes_.at(symbol).shape;
+      try {
+        checkFeature(shape, floors);
+      } catch (const std::exception &e) {
+        diags_.warning(floors.back().exec->origin.loc, "feature " + symbol + ": not verified: " + e.what());
+      }
+    }
+  }
+
+  void checkFeature(const FeatureShape &shape, const std::vector<Floor> &floors) {
+    double radius = floors.front().radius, lowest = floors.front().z;
+    std::vector<Region> swept;
+    for (const Floor &f : floors) {
+      radius = std::min(radius, f.radius);
+      lowest = std::min(lowest, f.z);
+      swept.push_back(f.swept);
+    }
+    const double tol = tolerance_.value_or(workpieceTolerance(findFeature(module_, shape.symbol)));
+    const Region &reach = cache_.reachable(shape, radius, 0, islandsAbove(shape, lowest, tol));
+    const double uncut = geom::subtract(reach, geom::uniteAll(swept)).area();
+    const double targetArea = shape.target.area();
+    if (!(uncut > kUncutShare * targetArea))
+      return;
+    const ir::Node *feature = findFeature(module_, shape.symbol);
+    auto d =
+        diags_.error(feature->origin.loc, "feature " + shape.symbol + ": rough + finish leave " + mm2(uncut) +
+                                              " (" + formatFixed(100 * uncut / targetArea, 3) + " %) uncut");
+    d.entity(feature->origin.entityId);
+    for (const Floor &f : floors)
+      d.note(f.exec->origin.loc, "cut by " + f.exec->kind + " " + f.exec->symbol + " at z=" + mm(f.z));
+    ++stats_["uncut errors"];
+  }
+
+  // --- Reporting ---------------------------------------------------------------------------
+
+  /// Reports the first few offences as errors (the last one noting how many more there are), at
+  /// the node concerned, or at the executable when that node has no origin (moves made by a pass).
+  void report(const Step &s, const std::vector<Offence> &offences, const char *counter, bool warning = false) {
+    if (offences.empty())
+      return;
+    stats_[counter] += static_cast<long long>(offences.size());
+    for (size_t i = 0; i < offences.size() && i < kMaxReports; ++i) {
+      const ir::Origin &at = offences[i].at->origin.loc.valid() ? offences[i].at->origin : s.exec->origin;
+      auto d = warning ? diags_.warning(at.loc, s.name + ": " + offences[i].message)
+                       : diags_.error(at.loc, s.name + ": " + offences[i].message);
+      d.entity(at.entityId);
+      if (i + 1 == kMaxReports && offences.size() > kMaxReports)
+        d.note(std::to_string(offences.size() - kMaxReports) + " more like this not reported");
+    }
+  }
+
+  /// `swept 2081.27 mm2, uncut 0.00 mm2 (0.000 %), gouge 0.000 mm2, path 1234.5 mm, 87 moves`,
+  /// replacing the figures of an earlier run and keeping any other comment.
+  void writeFigures(ir::Node &movesNode, const Figures &f) {
+    std::string text;
+    auto add = [&](const std::string &part) { text += (text.empty() ? "" : ", ") + part; };
+    if (f.swept)
+      add("swept " + formatFixed(*f.swept, 2) + " mm2");
+    if (f.uncut)
+      add("uncut " + formatFixed(*f.uncut, 2) + " mm2 (" + formatFixed(f.uncutPercent.value_or(0), 3) +
+          " %)");
+    if (f.gouge)
+      add("gouge " + formatFixed(*f.gouge, 3) + " mm2");
+    add("path " + formatFixed(f.path, 1) + " mm");
+    add(std::to_string(f.moves) + " moves");
+    std::string kept;
+    std::string_view rest = movesNode.comment;
+    while (!rest.empty()) {
+      const size_t end = rest.find("; ");
+      const std::string_view part = rest.substr(0, end);
+      if (!part.starts_with("swept ") && !part.starts_with("path "))
+        kept += std::string(part) + "; ";
+      rest = end == std::string_view::npos ? std::string_view() : rest.substr(end + 2);
+    }
+    movesNode.comment = kept + text;
+    changed_ = true;
+  }
+
+  ir::Module &module_;
+  DiagnosticEngine &diags_;
+  PassStats &stats_;
+  std::optional<double> tolerance_;
+  const unsigned errorsBefore_ = diags_.errorCount();
+  bool changed_ = false;
+  std::map<std::string, const ir::Node *, std::less<>> tools_;
+  std::map<std::string, ShapeResult> shapes_;
+  std::map<std::string, std::vector<Floor>> floors_;
+  RegionCache cache_;
+  /// Distance indexes of cached regions' boundaries (the cache never moves its regions).
+  std::map<const Region *, geom::SegIndex> boundaries_;
+};
+
+class VerifyToolpathsPass final : public Pass {
+public:
+  VerifyToolpathsPass(std::optional<double> tolerance, std::string optionError)
+      : tolerance_(tolerance), optionError_(std::move(optionError)) {}
+
+  std::string_view name() const override { return "verify-toolpaths"; }
+
+  PassResult run(ir::Module &module, DiagnosticEngine &diags, PassStats &stats) override {
+    if (!optionError_.empty()) {
+      diags.error({}, optionError_);
+      return {false, false};
+    }
+    return ToolpathChecker(module, diags, stats, tolerance_).run();
+  }
+
+private:
+  std::optional<double> tolerance_;
+  std::string optionError_;
+};
+
+} // namespace
+
+std::unique_ptr<Pass> createVerifyToolpathsPass(const PassOptions &options) {
+  std::optional<double> tolerance;
+  std::string error;
+  if (auto it = options.find("tolerance"); it != options.end()) {
+    tolerance = parseLength(it->second);
+    if (!tolerance)
+      error = "verify-toolpaths: tolerance='" + it->second +
+              "' is not a length: expected a positive number of mm, such as tolerance=0.01";
+  }
+  return std::make_unique<VerifyToolpathsPass>(tolerance, std::move(error));
+}
+
+} // namespace stepnc::passes

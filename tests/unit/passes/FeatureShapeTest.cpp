@@ -1,0 +1,163 @@
+// Feature shapes: the area each kind of feature asks to clear, with exact
+// areas worked out by hand.
+#include "passes/FeatureShape.h"
+
+#include "../ir/SampleModule.h"
+
+#include <catch2/catch.hpp>
+
+#include <numbers>
+
+using namespace stepnc;
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+const std::string kHead = "project \"P\"\n"
+                          "  workpiece %wp \"WP\"\n"
+                          "    rawpiece shape=block size=(100.0000,80.0000,30.0000)mm at=(0.0000,0.0000,0.0000)mm "
+                          "axis=(0.000000,0.000000,1.000000) ref=(1.000000,0.000000,0.000000)\n";
+
+const std::string kZ = "axis=(0.000000,0.000000,1.000000) ref=(1.000000,0.000000,0.000000)";
+
+passes::ShapeResult shapeOf(const std::string &features, std::string_view symbol,
+                            std::unique_ptr<ir::Module> *keep = nullptr) {
+  auto parsed = ir::test::parse(kHead + features);
+  REQUIRE(parsed.errors.empty());
+  const ir::Node *f = passes::findFeature(*parsed.module, symbol);
+  REQUIRE(f);
+  passes::ShapeResult r = passes::featureShape(*parsed.module, *f);
+  if (keep)
+    *keep = std::move(parsed.module);
+  return r;
+}
+
+} // namespace
+
+TEST_CASE("a rectangular pocket with corner radii", "[shape]") {
+  auto r = shapeOf("    closed_pocket %p \"P\" at=(50.0000,40.0000,30.0000)mm " + kZ +
+                       " depth=10.0000mm bottom=planar orthogonal_radius=8.0000mm\n"
+                       "      rectangular_profile width=40.0000mm length=60.0000mm\n",
+                   "%p");
+  REQUIRE(r.shape);
+  CHECK(r.shape->target.area() == Approx(2400 - (4 - kPi) * 64).epsilon(1e-12));
+  CHECK(r.shape->top == 30);
+  CHECK(r.shape->bottom == 20);
+  CHECK_FALSE(r.shape->unbounded);
+  // Length along the profile's x axis: the pocket spans x 20..80, y 20..60.
+  const geom::Box box = r.shape->target.box();
+  CHECK(box.lo.x() == Approx(20));
+  CHECK(box.hi.x() == Approx(80));
+  CHECK(box.lo.y() == Approx(20));
+  CHECK(box.hi.y() == Approx(60));
+}
+
+TEST_CASE("a pocket turned by its placement keeps its area and turns its box", "[shape]") {
+  auto r = shapeOf("    closed_pocket %p \"P\" at=(50.0000,40.0000,30.0000)mm axis=(0.000000,0.000000,1.000000) "
+                   "ref=(0.000000,1.000000,0.000000) depth=10.0000mm bottom=planar\n"
+                   "      rectangular_profile width=40.0000mm length=60.0000mm\n",
+                   "%p");
+  REQUIRE(r.shape);
+  CHECK(r.shape->target.area() == Approx(2400));
+  CHECK(r.shape->target.box().hi.y() == Approx(70));
+  CHECK(r.shape->target.box().hi.x() == Approx(70));
+}
+
+TEST_CASE("a circular pocket with a boss island", "[shape]") {
+  auto r = shapeOf("    closed_pocket %p \"P\" at=(50.0000,40.0000,30.0000)mm " + kZ +
+                       " depth=10.0000mm bottom=planar\n"
+                       "      circular_profile diameter=60.0000mm\n"
+                       "      island feature=%b\n"
+                       "    boss %b \"B\" at=(55.0000,40.0000,25.0000)mm " + kZ + " depth=5.0000mm\n"
+                       "      circular_profile diameter=10.0000mm\n",
+                   "%p");
+  REQUIRE(r.shape);
+  CHECK(r.shape->target.area() == Approx(900 * kPi).epsilon(1e-12));
+  REQUIRE(r.shape->islands.size() == 1);
+  CHECK(r.shape->islands[0].region.area() == Approx(25 * kPi).epsilon(1e-12));
+  CHECK(r.shape->islands[0].top == 25);
+  CHECK(r.shape->islands[0].region.contains({55, 40}));
+}
+
+TEST_CASE("an L-shaped pocket from a general profile", "[shape]") {
+  auto r = shapeOf("    closed_pocket %p \"P\" at=(10.0000,10.0000,30.0000)mm " + kZ +
+                       " depth=5.0000mm bottom=planar\n"
+                       "      general_profile closed=true\n"
+                       "        polyline\n"
+                       "          point at=(0.0000,0.0000,0.0000)mm\n"
+                       "          point at=(40.0000,0.0000,0.0000)mm\n"
+                       "          point at=(40.0000,20.0000,0.0000)mm\n"
+                       "          point at=(20.0000,20.0000,0.0000)mm\n"
+                       "          point at=(20.0000,40.0000,0.0000)mm\n"
+                       "          point at=(0.0000,40.0000,0.0000)mm\n"
+                       "          point at=(0.0000,0.0000,0.0000)mm\n",
+                   "%p");
+  REQUIRE(r.shape);
+  CHECK(r.shape->target.area() == Approx(1200));
+  CHECK(r.shape->target.contains({15, 15}));
+  CHECK_FALSE(r.shape->target.contains({45, 45}));
+}
+
+TEST_CASE("a slot with radiused ends and one with open ends", "[shape]") {
+  const std::string path = "      path\n        line at=(0.0000,0.0000,0.0000)mm dir=(1.000000,0.000000,0.000000) "
+                           "length=50.0000mm\n      square_u_profile width=10.0000mm\n";
+  auto closed = shapeOf("    slot %s \"S\" at=(20.0000,40.0000,30.0000)mm " + kZ +
+                            " depth=5.0000mm end_1=radiused end_2=radiused\n" + path,
+                        "%s");
+  REQUIRE(closed.shape);
+  CHECK(closed.shape->target.area() == Approx(500 + 25 * kPi).epsilon(1e-12));
+  CHECK(closed.shape->limit.area() == Approx(closed.shape->target.area()));
+  auto open = shapeOf("    slot %s \"S\" at=(20.0000,40.0000,30.0000)mm " + kZ +
+                          " depth=5.0000mm end_1=open end_2=open\n" + path,
+                      "%s");
+  REQUIRE(open.shape);
+  CHECK(open.shape->target.area() == Approx(500));
+  CHECK(open.shape->limit.area() > 500);
+  CHECK(open.shape->limit.contains({10, 40}));  // past the open end
+}
+
+TEST_CASE("a vee slot is reported, not guessed", "[shape]") {
+  auto r = shapeOf("    slot %s \"S\" at=(20.0000,40.0000,30.0000)mm " + kZ +
+                       " depth=5.0000mm end_1=open end_2=open\n      path\n        line "
+                       "at=(0.0000,0.0000,0.0000)mm dir=(1.000000,0.000000,0.000000) length=50.0000mm\n"
+                       "      vee_profile profile_angle=60.0000deg tilt_angle=0.0000deg\n",
+                   "%s");
+  CHECK_FALSE(r.shape);
+  CHECK(r.error.find("slanted") != std::string::npos);
+}
+
+TEST_CASE("a planar face is unbounded; a step takes the nearer side of the raw piece", "[shape]") {
+  auto face = shapeOf("    planar_face %f \"F\" at=(0.0000,0.0000,30.0000)mm " + kZ +
+                          " depth=2.0000mm travel=80.0000mm travel_dir=(0.000000,1.000000,0.000000) "
+                          "width=100.0000mm width_dir=(1.000000,0.000000,0.000000)\n",
+                      "%f");
+  REQUIRE(face.shape);
+  CHECK(face.shape->unbounded);
+  CHECK(face.shape->target.area() == Approx(8000));
+  CHECK(face.shape->target.contains({50, 40}));
+  auto step = shapeOf("    step %t \"T\" at=(85.0000,0.0000,30.0000)mm " + kZ +
+                          " depth=10.0000mm\n      path\n        line at=(0.0000,0.0000,0.0000)mm "
+                          "dir=(0.000000,1.000000,0.000000) length=80.0000mm\n",
+                      "%t");
+  REQUIRE(step.shape);
+  CHECK(step.shape->target.area() == Approx(15 * 80));
+  CHECK(step.shape->target.contains({90, 40}));
+  CHECK(step.shape->limit.contains({120, 40}));
+  CHECK_FALSE(step.shape->limit.contains({80, 40}));
+}
+
+TEST_CASE("a round hole and a tilted feature", "[shape]") {
+  auto hole = shapeOf("    round_hole %h \"H\" at=(20.0000,30.0000,30.0000)mm " + kZ +
+                          " depth=12.0000mm diameter=8.0000mm bottom=flat\n",
+                      "%h");
+  REQUIRE(hole.shape);
+  REQUIRE(hole.shape->holeCentre);
+  CHECK(hole.shape->holeCentre->x() == 20);
+  CHECK(hole.shape->target.area() == Approx(16 * kPi).epsilon(1e-12));
+  auto tilted = shapeOf("    round_hole %h \"H\" at=(20.0000,30.0000,30.0000)mm axis=(1.000000,0.000000,0.000000) "
+                        "ref=(0.000000,1.000000,0.000000) depth=12.0000mm diameter=8.0000mm bottom=flat\n",
+                        "%h");
+  CHECK_FALSE(tilted.shape);
+  CHECK(tilted.error.find("+z") != std::string::npos);
+}

@@ -1,0 +1,138 @@
+// Tests of passes/MoveWalk.h: where each move starts, lengths of lines, arcs
+// and helices (worked out by hand), and what the moves are in the plane.
+#include "passes/MoveWalk.h"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <numbers>
+
+using namespace stepnc;
+using namespace stepnc::passes;
+using ir::Node;
+using ir::Value;
+using ir::Vec3;
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+Node &rapid(Node &moves, const Vec3 &to) {
+  Node &m = moves.add(Node("rapid"));
+  m.set("to", Value::point(to));
+  return m;
+}
+
+Node &linear(Node &moves, const Vec3 &to) {
+  Node &m = moves.add(Node("linear"));
+  m.set("to", Value::point(to)).set("feed", Value::feed(600));
+  return m;
+}
+
+Node &arc(Node &moves, const Vec3 &to, const Vec3 &centre, bool ccw, int64_t turns = 0) {
+  Node &m = moves.add(Node("arc"));
+  m.set("to", Value::point(to))
+      .set("center", Value::point(centre))
+      .set("dir", Value::word(ccw ? "ccw" : "cw"));
+  if (turns > 0)
+    m.set("turns", Value::integer(turns));
+  m.set("feed", Value::feed(300));
+  return m;
+}
+
+double totalSweep(const std::vector<geom::Seg> &segs) {
+  double sum = 0;
+  for (const geom::Seg &s : segs)
+    sum += s.sweep();
+  return sum;
+}
+
+} // namespace
+
+TEST_CASE("walkMoves knows where every move starts", "[verify][movewalk]") {
+  Node moves("moves");
+  rapid(moves, Vec3(0, 0, 50));
+  rapid(moves, Vec3(10, 0, 5)).set("role", Value::word("approach"));
+  linear(moves, Vec3(10, 0, 0));
+  arc(moves, Vec3(30, 0, 0), Vec3(20, 0, 0), false);
+  moves.add(Node("unrelated"));  // not a move: skipped
+
+  std::vector<Move> walk = walkMoves(moves);
+  REQUIRE(walk.size() == 4);
+  CHECK_FALSE(walk[0].from);
+  CHECK(walk[0].length() == 0);  // from an unknown position
+  REQUIRE(walk[1].from);
+  CHECK(*walk[1].from == Vec3(0, 0, 50));
+  CHECK(*walk[2].from == Vec3(10, 0, 5));
+  CHECK(*walk[3].from == Vec3(10, 0, 0));
+  CHECK(walk[0].role == "position");
+  CHECK(walk[1].role == "approach");
+  CHECK(walk[2].role == "cut");
+  CHECK(walk[2].feed == 600);
+  CHECK(walk[0].feed == 0);
+  CHECK_FALSE(walk[0].isFeed());
+  CHECK(walk[3].kind == MoveKind::Arc);
+  CHECK_FALSE(walk[3].ccw);
+  CHECK(walk[2].changesHeight());
+  CHECK_FALSE(walk[3].changesHeight());
+
+  // A known start makes the first move measurable.
+  std::vector<Move> known = walkMoves(moves, Vec3(0, 0, 20));
+  REQUIRE(known[0].from);
+  CHECK(known[0].length() == Approx(30));
+}
+
+TEST_CASE("lengths of lines, arcs and helices", "[verify][movewalk]") {
+  Node moves("moves");
+  rapid(moves, Vec3(0, 0, 0));
+  linear(moves, Vec3(30, 40, 0));                              // 50
+  arc(moves, Vec3(50, 40, 0), Vec3(40, 40, 0), false);         // cw half circle, r 10: 10 pi
+  arc(moves, Vec3(40, 50, 0), Vec3(40, 40, 0), true);          // ccw from (50,40) to (40,50): a quarter
+  arc(moves, Vec3(40, 50, 0), Vec3(40, 40, 0), false);         // start == end: a whole turn, 20 pi
+  arc(moves, Vec3(50, 40, -6), Vec3(40, 40, 0), false, 2);     // helix: 2 turns + 1/4 cw, down 6
+  linear(moves, Vec3(50, 40, -10));                             // axial: 4
+
+  std::vector<Move> w = walkMoves(moves);
+  REQUIRE(w.size() == 7);
+  CHECK(w[1].length() == Approx(50));
+  CHECK(w[2].length() == Approx(10 * kPi));
+  CHECK(w[3].length() == Approx(10 * kPi / 2));
+  CHECK(w[4].length() == Approx(20 * kPi));
+  const double helixPlanar = 10 * (2 * 2 * kPi + kPi / 2);
+  CHECK(w[5].length() == Approx(std::sqrt(helixPlanar * helixPlanar + 36)));
+  CHECK(w[5].changesHeight());
+  CHECK(w[6].length() == Approx(4));
+}
+
+TEST_CASE("planar(): lines, axial moves, full circles and helices", "[verify][movewalk]") {
+  Node moves("moves");
+  rapid(moves, Vec3(10, 0, 5));
+  linear(moves, Vec3(10, 0, -5));                              // axial: nothing in the plane
+  linear(moves, Vec3(20, 0, -5));                              // one line
+  arc(moves, Vec3(20, 0, -5), Vec3(10, 0, 0), true);           // a full circle: two half arcs
+  arc(moves, Vec3(10, 10, -9), Vec3(10, 0, 0), true, 2);       // helix: 2 turns then a quarter
+  arc(moves, Vec3(10, 10, -12), Vec3(10, 0, 0), false, 2);     // 2 turns then a whole turn back to the start
+
+  std::vector<Move> w = walkMoves(moves);
+  REQUIRE(w.size() == 6);
+  CHECK(w[1].planar().empty());
+  REQUIRE(w[2].planar().size() == 1);
+  CHECK_FALSE(w[2].planar()[0].isArc());
+
+  std::vector<geom::Seg> circle = w[3].planar();
+  REQUIRE(circle.size() == 2);
+  CHECK(totalSweep(circle) == Approx(2 * kPi));
+  CHECK(circle.front().a.isApprox(geom::Vec2(20, 0)));
+  CHECK(circle.back().b.isApprox(geom::Vec2(20, 0)));
+
+  std::vector<geom::Seg> helix = w[4].planar();
+  REQUIRE(helix.size() == 5);  // 4 half arcs, then the quarter to (10, 10)
+  CHECK(totalSweep(helix) == Approx(4 * kPi + kPi / 2));
+  CHECK(helix.back().b.isApprox(geom::Vec2(10, 10)));
+  for (const geom::Seg &s : helix)
+    CHECK(s.radius() == Approx(10));
+
+  std::vector<geom::Seg> back = w[5].planar();
+  REQUIRE(back.size() == 6);  // 3 whole turns, clockwise
+  CHECK(totalSweep(back) == Approx(-6 * kPi));
+}
