@@ -11,7 +11,6 @@ namespace stepnc::geom {
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
 constexpr double kTwoPi = 2 * std::numbers::pi;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
@@ -33,7 +32,7 @@ double pseudoAngle(const Vec2 &v) {
   const double sum = std::abs(v.x()) + std::abs(v.y());
   if (sum == 0)
     return 0;
-  const double t = v.y() / sum;  // in [-1, 1]
+  const double t = v.y() / sum; // in [-1, 1]
   return v.x() >= 0 ? (t >= 0 ? t : 4 + t) : 2 - t;
 }
 
@@ -86,8 +85,8 @@ int lineCrossing(const Vec2 &a, const Vec2 &b, const Vec2 &p) {
     return 0;
   const double side = cross(b - a, p - a);
   if (bAbove)
-    return side > 0 ? 1 : 0;  // going up: the crossing is right of p when p is left of the line
-  return side < 0 ? -1 : 0;   // going down: when p is right of the line
+    return side > 0 ? 1 : 0; // going up: the crossing is right of p when p is left of the line
+  return side < 0 ? -1 : 0;  // going down: when p is right of the line
 }
 
 /// A piece u -> w of the circle (centre c, radius r) that is monotone in y and
@@ -131,7 +130,7 @@ int arcCrossings(const Seg &s, const Vec2 &p) {
   for (int k = 0; k <= count; ++k) {
     const Vec2 to = k < count ? cuts[k].at : s.b;
     const double toTravel = k < count ? cuts[k].travel : sweep;
-    double mid = start + s.turn * (fromTravel + toTravel) / 2;  // pseudo-angle inside the piece
+    double mid = start + s.turn * (fromTravel + toTravel) / 2; // pseudo-angle inside the piece
     mid = mid < 0 ? mid + 4 : mid >= 4 ? mid - 4 : mid;
     const bool east = mid < 1 || mid > 3;
     sum += monotoneArcCrossing(from, to, s.c, r, east, p);
@@ -141,7 +140,9 @@ int arcCrossings(const Seg &s, const Vec2 &p) {
   return sum;
 }
 
-int crossings(const Seg &s, const Vec2 &p) { return s.isArc() ? arcCrossings(s, p) : lineCrossing(s.a, s.b, p); }
+int crossings(const Seg &s, const Vec2 &p) {
+  return s.isArc() ? arcCrossings(s, p) : lineCrossing(s.a, s.b, p);
+}
 
 // --- Intersections -----------------------------------------------------------
 
@@ -206,15 +207,15 @@ void intersectLineArc(const Seg &line, const Seg &arc, const Box &lb, const Box 
   if (len > tol) {
     const Vec2 u = d / len;
     const Vec2 f = arc.c - line.a;
-    const double along = f.dot(u);  // position of the centre's foot along the line
-    const double h = cross(u, f);    // signed distance of the centre from the line
+    const double along = f.dot(u); // position of the centre's foot along the line
+    const double h = cross(u, f);  // signed distance of the centre from the line
     const Vec2 foot = line.a + along * u;
     auto consider = [&](double at, const Vec2 &q) {
       if (at >= -tol && at <= len + tol && inSpan(arc, q, tol))
         addPoint(pts, q, tol, false);
     };
     if (std::abs(std::abs(h) - r) <= tol) {
-      consider(along, foot);  // tangent
+      consider(along, foot); // tangent
     } else if (std::abs(h) < r) {
       const double half = std::sqrt(r * r - h * h);
       consider(along - half, foot - half * u);
@@ -224,7 +225,8 @@ void intersectLineArc(const Seg &line, const Seg &arc, const Box &lb, const Box 
   addTouchingEnds(line, arc, lb, ab, tol, pts);
 }
 
-void intersectArcs(const Seg &s, const Seg &t, const Box &sb, const Box &tb, double tol, std::vector<Vec2> &pts) {
+void intersectArcs(const Seg &s, const Seg &t, const Box &sb, const Box &tb, double tol,
+                   std::vector<Vec2> &pts) {
   const double r1 = s.radius(), r2 = t.radius();
   const Vec2 dc = t.c - s.c;
   const double dist = dc.norm();
@@ -235,9 +237,9 @@ void intersectArcs(const Seg &s, const Seg &t, const Box &sb, const Box &tb, dou
         addPoint(pts, q, tol, false);
     };
     if (std::abs(dist - (r1 + r2)) <= tol) {
-      consider(s.c + r1 * u);  // touching from outside
+      consider(s.c + r1 * u); // touching from outside
     } else if (std::abs(dist - std::abs(r1 - r2)) <= tol) {
-      consider(r1 >= r2 ? Vec2(s.c + r1 * u) : Vec2(s.c - r1 * u));  // touching from inside
+      consider(r1 >= r2 ? Vec2(s.c + r1 * u) : Vec2(s.c - r1 * u)); // touching from inside
     } else if (dist < r1 + r2 && dist > std::abs(r1 - r2)) {
       const double along = (dist * dist + r1 * r1 - r2 * r2) / (2 * dist);
       const double half = std::sqrt(std::max(0.0, r1 * r1 - along * along));
@@ -260,9 +262,9 @@ double Seg::sweep() const {
   if (!isArc())
     return 0;
   const Vec2 u = a - c, v = b - c;
-  double angle = std::atan2(cross(u, v), u.dot(v));  // in (-pi, pi]
+  double angle = std::atan2(cross(u, v), u.dot(v)); // in (-pi, pi]
   if (angle == 0)
-    return 0;  // a == b: degenerate (a full circle is two arcs)
+    return 0; // a == b: degenerate (a full circle is two arcs)
   if (turn > 0 && angle < 0)
     angle += kTwoPi;
   else if (turn < 0 && angle > 0)

@@ -58,7 +58,7 @@ double along(const Seg &s, const Vec2 &q, double len) {
   }
   const double sweep = std::abs(s.sweep());
   double travel = travelTo(s, q);
-  if (travel > sweep)  // just outside the arc (within tolerance): the nearer end
+  if (travel > sweep) // just outside the arc (within tolerance): the nearer end
     travel = travel - sweep < kTwoPi - travel ? sweep : 0;
   return travel / sweep * len;
 }
@@ -90,8 +90,8 @@ private:
 /// A segment of the raw curve or a part of one, between two vertices.
 struct Piece {
   Seg seg;
-  uint32_t from = 0, to = 0;  ///< vertices at seg.a and seg.b
-  uint32_t raw = 0;           ///< the raw piece it is part of
+  uint32_t from = 0, to = 0; ///< vertices at seg.a and seg.b
+  uint32_t raw = 0;          ///< the raw piece it is part of
   Vec2 mid = Vec2::Zero();
 };
 
@@ -125,10 +125,13 @@ std::vector<Piece> rawOffset(const Region &region, double d, Vertices &vertices)
       // consecutive raw pieces meet exactly.
       const Vec2 a = s.a + d * rightNormal(t0[i]);
       const Vec2 b = s.b + d * rightNormal(t1[i]);
+      const double radius = s.radius() + s.turn * d;
       if (!s.isArc())
         raw.push_back({Seg::line(a, b), startVertex[i], endVertex[i]});
-      else if (s.radius() + s.turn * d > kEps)
+      else if (radius > kEps)
         raw.push_back({Seg::arc(a, b, s.c, s.turn > 0), startVertex[i], endVertex[i]});
+      else if (radius > -kEps)
+        vertices.unite(startVertex[i], endVertex[i]); // shrunk to its centre
 
       // The join towards the next segment: where the direction turns towards
       // the offset side (d * turn > 0) the moved pieces separate; a reversal
@@ -153,7 +156,7 @@ std::vector<Piece> rawOffset(const Region &region, double d, Vertices &vertices)
 std::vector<Piece> splitPieces(const std::vector<Piece> &raw, Vertices &vertices) {
   struct Split {
     uint32_t piece;
-    double at;  ///< mm along the piece
+    double at; ///< mm along the piece
     Vec2 p;
     uint32_t vertex;
   };
@@ -207,8 +210,10 @@ std::vector<Piece> splitPieces(const std::vector<Piece> &raw, Vertices &vertices
   for (uint32_t i = 0; i < n; ++i) {
     const Seg &s = segs[i];
     const double len = lengths[i];
-    if (!(len > kEps))
+    if (!(len > kEps)) {
+      vertices.unite(raw[i].from, raw[i].to); // too short to split: a point
       continue;
+    }
     const auto first = grouped.begin() + count[i], last = grouped.begin() + count[i + 1];
     std::sort(first, last, [](const Split &x, const Split &y) { return x.at < y.at; });
     double fromAt = 0;
@@ -223,7 +228,7 @@ std::vector<Piece> splitPieces(const std::vector<Piece> &raw, Vertices &vertices
     };
     for (auto it = first; it != last; ++it) {
       if (it->at - fromAt <= kSplitTol)
-        vertices.unite(it->vertex, fromVertex);  // the same point as the last one
+        vertices.unite(it->vertex, fromVertex); // the same point as the last one
       else if (len - it->at <= kSplitTol)
         vertices.unite(it->vertex, raw[i].to);
       else
@@ -244,7 +249,9 @@ bool reverses(const Seg &s, const Seg &t) {
 /// Whether t repeats s, both going between the same vertices (raw pieces that
 /// nearly coincide: the offsets of a very short segment and its almost
 /// collinear neighbour).
-bool repeats(const Seg &s, const Seg &t) { return s.turn == t.turn && (!s.isArc() || (s.c - t.c).norm() <= 1e-6); }
+bool repeats(const Seg &s, const Seg &t) {
+  return s.turn == t.turn && (!s.isArc() || (s.c - t.c).norm() <= 1e-6);
+}
 
 /// Whether two consecutive segments are one line or one arc, and that piece.
 bool mergeable(const Seg &s, const Seg &t, Seg &merged) {
@@ -291,7 +298,7 @@ Region chainLoops(std::vector<Piece> pieces, Vertices &vertices, bool shrink) {
   for (uint32_t i = 0; i < n; ++i) {
     pieces[i].from = vertices.find(pieces[i].from);
     pieces[i].to = vertices.find(pieces[i].to);
-    dead[i] = pieces[i].from == pieces[i].to;  // shorter than the tolerances
+    dead[i] = pieces[i].from == pieces[i].to; // shorter than the tolerances
   }
   // Pieces leaving and entering each vertex, in CSR form.
   std::vector<uint32_t> outStart(nv + 1, 0), inStart(nv + 1, 0), outItems(n), inItems(n);
@@ -304,7 +311,8 @@ Region chainLoops(std::vector<Piece> pieces, Vertices &vertices, bool shrink) {
     inStart[v + 1] += inStart[v];
   }
   {
-    std::vector<uint32_t> outFill(outStart.begin(), outStart.end() - 1), inFill(inStart.begin(), inStart.end() - 1);
+    std::vector<uint32_t> outFill(outStart.begin(), outStart.end() - 1),
+        inFill(inStart.begin(), inStart.end() - 1);
     for (uint32_t i = 0; i < n; ++i) {
       outItems[outFill[pieces[i].from]++] = i;
       inItems[inFill[pieces[i].to]++] = i;
@@ -397,7 +405,7 @@ Region chainLoops(std::vector<Piece> pieces, Vertices &vertices, bool shrink) {
       chain.push_back(uint32_t(best));
     }
     if (!closed)
-      continue;  // numerical trouble: these pieces are dropped
+      continue; // numerical trouble: these pieces are dropped
 
     Loop loop;
     loop.segs.reserve(chain.size());
@@ -472,7 +480,7 @@ std::vector<Seg> clip(const Region &r, const Vec2 &p, const Vec2 &q) {
 
   // Pieces between cuts whose midpoints are inside; neighbours join up.
   auto point = [&](double t) { return t >= 1.0 ? q : t <= 0.0 ? p : Vec2(p + t * d); };
-  double openFrom = -1;  // start of the piece being collected, or -1
+  double openFrom = -1; // start of the piece being collected, or -1
   for (size_t k = 0; k + 1 < distinct.size(); ++k) {
     const bool inside = index.winding(p + (distinct[k] + distinct[k + 1]) / 2 * d) != 0;
     if (inside && openFrom < 0)

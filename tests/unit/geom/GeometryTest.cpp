@@ -23,12 +23,16 @@ Loop polygon(const std::vector<Vec2> &pts) {
   return l;
 }
 
-Loop rect(double x0, double y0, double x1, double y1) { return polygon({{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}); }
+Loop rect(double x0, double y0, double x1, double y1) {
+  return polygon({{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}});
+}
 
 /// Counter-clockwise rectangle with corners rounded to radius r.
 Loop roundedRect(double x0, double y0, double x1, double y1, double r) {
   Loop l;
-  auto line = [&](double ax, double ay, double bx, double by) { l.segs.push_back(Seg::line({ax, ay}, {bx, by})); };
+  auto line = [&](double ax, double ay, double bx, double by) {
+    l.segs.push_back(Seg::line({ax, ay}, {bx, by}));
+  };
   auto arc = [&](double ax, double ay, double bx, double by, double cx, double cy) {
     l.segs.push_back(Seg::arc({ax, ay}, {bx, by}, {cx, cy}, true));
   };
@@ -81,7 +85,8 @@ TEST_CASE("loop areas are exact for lines and arcs", "[geom]") {
   Region withHole{{rect(0, 0, 40, 40), circleLoop({20, 20}, 5, false)}};
   CHECK(withHole.area() == Approx(1600 - 25 * pi).epsilon(1e-13));
   // An arc longer than a half circle: a 270 degree sector.
-  Loop sector{{Seg::line({0, 0}, {2, 0}), Seg::arc({2, 0}, {0, -2}, {0, 0}, true), Seg::line({0, -2}, {0, 0})}};
+  Loop sector{
+      {Seg::line({0, 0}, {2, 0}), Seg::arc({2, 0}, {0, -2}, {0, 0}, true), Seg::line({0, -2}, {0, 0})}};
   CHECK(sector.area() == Approx(0.75 * pi * 4).epsilon(1e-13));
 }
 
@@ -120,17 +125,17 @@ TEST_CASE("arc sweep, points, tangents and reversal", "[geom]") {
 
 TEST_CASE("arc boxes include the axis extremes the arc passes", "[geom]") {
   const double s3 = std::sqrt(3.0), s2 = std::sqrt(2.0);
-  Box b = arcDeg({0, 0}, 2, 30, 120, true).box();  // passes the top
+  Box b = arcDeg({0, 0}, 2, 30, 120, true).box(); // passes the top
   CHECK(b.lo.x() == Approx(-1));
   CHECK(b.hi.x() == Approx(s3));
   CHECK(b.lo.y() == Approx(1));
   CHECK(b.hi.y() == Approx(2));
-  b = arcDeg({0, 0}, 2, 45, -45, false).box();  // clockwise through the right
+  b = arcDeg({0, 0}, 2, 45, -45, false).box(); // clockwise through the right
   CHECK(b.lo.x() == Approx(s2));
   CHECK(b.hi.x() == Approx(2));
   CHECK(b.lo.y() == Approx(-s2));
   CHECK(b.hi.y() == Approx(s2));
-  b = arcDeg({1, 1}, 2, 45, -45, true).box();  // counter-clockwise the long way
+  b = arcDeg({1, 1}, 2, 45, -45, true).box(); // counter-clockwise the long way
   CHECK(b.lo.x() == Approx(-1));
   CHECK(b.hi.x() == Approx(1 + s2));
   CHECK(b.lo.y() == Approx(-1));
@@ -153,8 +158,8 @@ TEST_CASE("circle() makes two half arcs from the start point", "[geom]") {
 TEST_CASE("winding numbers and containment", "[geom]") {
   const Loop rr = roundedRect(0, 0, 60, 40, 8);
   CHECK(rr.winding({30, 20}) == 1);
-  CHECK(rr.winding({2, 2}) == 0);  // cut off by the corner arc: |(2,2) - (8,8)| > 8
-  CHECK(rr.winding({3, 3}) == 1);  // |(3,3) - (8,8)| < 8
+  CHECK(rr.winding({2, 2}) == 0); // cut off by the corner arc: |(2,2) - (8,8)| > 8
+  CHECK(rr.winding({3, 3}) == 1); // |(3,3) - (8,8)| < 8
   CHECK(rr.winding({58, 39}) == 0);
   CHECK(rr.winding({-1, 20}) == 0);
   CHECK(rr.winding({30, 40.5}) == 0);
@@ -179,7 +184,7 @@ TEST_CASE("winding numbers and containment", "[geom]") {
   CHECK(l.winding({5, 15}) == 1);
   CHECK(l.winding({15, 15}) == 0);
   CHECK(l.winding({15, 5}) == 1);
-  CHECK(l.winding({5, 10}) == 1);  // the ray runs along the edge y = 10
+  CHECK(l.winding({5, 10}) == 1); // the ray runs along the edge y = 10
 }
 
 TEST_CASE("distance from a point to a line or an arc", "[geom]") {
@@ -188,11 +193,11 @@ TEST_CASE("distance from a point to a line or an arc", "[geom]") {
   CHECK(distance(line, {-3, 4}) == Approx(5));
   CHECK(near(closestPoint(line, {12, -1}), Vec2(10, 0)));
 
-  const Seg arc = Seg::arc({5, 0}, {0, 5}, {0, 0}, true);  // quarter, radius 5
-  CHECK(distance(arc, {6, 6}) == Approx(std::sqrt(72.0) - 5));  // outside the circle, within the span
-  CHECK(distance(arc, {2, 2}) == Approx(5 - std::sqrt(8.0)));   // inside the circle, within the span
-  CHECK(distance(arc, {0, -3}) == Approx(std::sqrt(34.0)));     // outside the span: the end (5, 0)
-  CHECK(distance(arc, {-4, 1}) == Approx(std::sqrt(32.0)));     // outside the span: the end (0, 5)
+  const Seg arc = Seg::arc({5, 0}, {0, 5}, {0, 0}, true);      // quarter, radius 5
+  CHECK(distance(arc, {6, 6}) == Approx(std::sqrt(72.0) - 5)); // outside the circle, within the span
+  CHECK(distance(arc, {2, 2}) == Approx(5 - std::sqrt(8.0)));  // inside the circle, within the span
+  CHECK(distance(arc, {0, -3}) == Approx(std::sqrt(34.0)));    // outside the span: the end (5, 0)
+  CHECK(distance(arc, {-4, 1}) == Approx(std::sqrt(32.0)));    // outside the span: the end (0, 5)
   CHECK(near(closestPoint(arc, {6, 8}), Vec2(3, 4)));
 }
 
@@ -229,7 +234,8 @@ TEST_CASE("distance between segments", "[geom]") {
 
 TEST_CASE("segment distances agree with dense sampling", "[geom]") {
   std::mt19937 rng(12345);
-  std::uniform_real_distribution<double> coord(0, 20), radius(0.5, 8), angle(0, 2 * pi), sweep(0.05, 2 * pi - 0.05);
+  std::uniform_real_distribution<double> coord(0, 20), radius(0.5, 8), angle(0, 2 * pi),
+      sweep(0.05, 2 * pi - 0.05);
   auto randomSeg = [&]() {
     if (rng() % 2)
       return Seg::line({coord(rng), coord(rng)}, {coord(rng), coord(rng)});
@@ -237,7 +243,8 @@ TEST_CASE("segment distances agree with dense sampling", "[geom]") {
     const double r = radius(rng), a0 = angle(rng), sw = sweep(rng);
     const bool ccw = rng() % 2;
     const double a1 = ccw ? a0 + sw : a0 - sw;
-    return Seg::arc(c + r * Vec2(std::cos(a0), std::sin(a0)), c + r * Vec2(std::cos(a1), std::sin(a1)), c, ccw);
+    return Seg::arc(c + r * Vec2(std::cos(a0), std::sin(a0)), c + r * Vec2(std::cos(a1), std::sin(a1)), c,
+                    ccw);
   };
   for (int k = 0; k < 300; ++k) {
     const Seg s = randomSeg(), t = randomSeg();
@@ -248,7 +255,7 @@ TEST_CASE("segment distances agree with dense sampling", "[geom]") {
     const double exact = distance(s, t);
     CAPTURE(k, s.turn, t.turn);
     CHECK(exact <= sampled + 1e-9);
-    CHECK(exact >= sampled - s.length() / samples);  // samples step along s
+    CHECK(exact >= sampled - s.length() / samples); // samples step along s
     CHECK(distance(t, s) == Approx(exact).margin(1e-12));
   }
 }
@@ -273,7 +280,7 @@ TEST_CASE("intersections of lines and arcs", "[geom]") {
   pts = intersect(upperHalf, leftOfSecond);
   CHECK(pts.size() == 1);
   CHECK(hasPoint(pts, {3, 4}));
-  pts = intersect(Seg::arc({0, 5}, {0, -5}, {0, 0}, false), leftOfSecond);  // right half of the first
+  pts = intersect(Seg::arc({0, 5}, {0, -5}, {0, 0}, false), leftOfSecond); // right half of the first
   CHECK(pts.size() == 2);
   CHECK(hasPoint(pts, {3, 4}));
   CHECK(hasPoint(pts, {3, -4}));
@@ -320,8 +327,8 @@ TEST_CASE("SegIndex agrees with brute force", "[geom]") {
     } else {
       const double r = radius(rng), a0 = angle(rng), a1 = a0 + angle(rng) * 0.9 + 0.1;
       const bool ccw = rng() % 2;
-      segs.push_back(Seg::arc(a + r * Vec2(std::cos(a0), std::sin(a0)), a + r * Vec2(std::cos(a1), std::sin(a1)),
-                              a, ccw));
+      segs.push_back(Seg::arc(a + r * Vec2(std::cos(a0), std::sin(a0)),
+                              a + r * Vec2(std::cos(a1), std::sin(a1)), a, ccw));
     }
   }
   // A few long segments crossing many cells.
@@ -371,7 +378,8 @@ TEST_CASE("SegIndex winding agrees with the loops", "[geom]") {
   int inside = 0;
   for (int k = 0; k < 5000; ++k) {
     // Also points on the grid lines of integers, which rays along edges meet.
-    const Vec2 p = k % 5 ? Vec2(coord(rng), coord(rng)) : Vec2(std::round(coord(rng)) + 0.5, std::round(coord(rng)));
+    const Vec2 p =
+        k % 5 ? Vec2(coord(rng), coord(rng)) : Vec2(std::round(coord(rng)) + 0.5, std::round(coord(rng)));
     int w = 0;
     for (const Loop &l : r.loops)
       w += l.winding(p);

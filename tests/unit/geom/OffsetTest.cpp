@@ -24,7 +24,9 @@ Loop polygon(const std::vector<Vec2> &pts) {
   return l;
 }
 
-Loop rect(double x0, double y0, double x1, double y1) { return polygon({{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}); }
+Loop rect(double x0, double y0, double x1, double y1) {
+  return polygon({{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}});
+}
 
 Loop reversed(Loop l) {
   l.reverse();
@@ -34,7 +36,9 @@ Loop reversed(Loop l) {
 /// Counter-clockwise rectangle with corners rounded to radius r.
 Loop roundedRect(double x0, double y0, double x1, double y1, double r) {
   Loop l;
-  auto line = [&](double ax, double ay, double bx, double by) { l.segs.push_back(Seg::line({ax, ay}, {bx, by})); };
+  auto line = [&](double ax, double ay, double bx, double by) {
+    l.segs.push_back(Seg::line({ax, ay}, {bx, by}));
+  };
   auto arc = [&](double ax, double ay, double bx, double by, double cx, double cy) {
     l.segs.push_back(Seg::arc({ax, ay}, {bx, by}, {cx, cy}, true));
   };
@@ -55,8 +59,7 @@ Loop circleLoop(const Vec2 &c, double r, bool ccw) { return {circle(c, r, ccw, c
 Loop lShape() { return polygon({{0, 0}, {20, 0}, {20, 10}, {10, 10}, {10, 20}, {0, 20}}); }
 
 /// A star-shaped polygon about the origin: radii from `radius` at n sorted random angles.
-template <class Radius>
-Loop star(std::mt19937 &rng, int n, Radius radius) {
+template <class Radius> Loop star(std::mt19937 &rng, int n, Radius radius) {
   std::uniform_real_distribution<double> angle(0, 2 * pi);
   std::vector<double> angles(n);
   for (double &a : angles)
@@ -209,6 +212,15 @@ TEST_CASE("shrinking a rounded rectangle", "[geom][offset]") {
     CHECK(segCount(r) == 4);
     CHECK(arcCount(r) == 0);
   }
+  SECTION("by the corner radius: the corner arcs shrink to points") {
+    for (double d : {8.0, 8.0 - 1e-12, 8.0 + 1e-12}) {
+      const Region r = offset(rr, -d);
+      REQUIRE(r.loops.size() == 1);
+      checkLoops(r);
+      CHECK(r.area() == Approx((60 - 2 * d) * (40 - 2 * d)).epsilon(1e-9));
+      CHECK(segCount(r) == 4);
+    }
+  }
   SECTION("growing by 2 gives corner radius 10") {
     const Region r = offset(rr, 2);
     CHECK(r.area() == Approx(64 * 44 - (4 - pi) * 100).epsilon(1e-12));
@@ -270,7 +282,7 @@ TEST_CASE("the hole grows when the region shrinks, and vanishes when it grows", 
   checkLoops(r);
   CHECK(r.area() == Approx(36 * 36 - 49 * pi).epsilon(1e-12));
   const std::vector<double> areas = loopAreas(r);
-  CHECK(areas[0] == Approx(-49 * pi).epsilon(1e-12));  // the hole, clockwise
+  CHECK(areas[0] == Approx(-49 * pi).epsilon(1e-12)); // the hole, clockwise
   CHECK(areas[1] == Approx(36 * 36).epsilon(1e-12));
 
   r = offset(withHole, 6);
@@ -284,8 +296,18 @@ TEST_CASE("the hole grows when the region shrinks, and vanishes when it grows", 
 
 TEST_CASE("a dumbbell splits in two when shrunk", "[geom][offset]") {
   // Squares [0,20]^2 and [30,50]x[0,20], joined by the corridor [20,30]x[8,12].
-  const Region dumbbell{{polygon({{0, 0}, {20, 0}, {20, 8}, {30, 8}, {30, 0}, {50, 0}, {50, 20}, {30, 20}, {30, 12},
-                                  {20, 12}, {20, 20}, {0, 20}})}};
+  const Region dumbbell{{polygon({{0, 0},
+                                  {20, 0},
+                                  {20, 8},
+                                  {30, 8},
+                                  {30, 0},
+                                  {50, 0},
+                                  {50, 20},
+                                  {30, 20},
+                                  {30, 12},
+                                  {20, 12},
+                                  {20, 20},
+                                  {0, 20}})}};
   const Region r = offset(dumbbell, -3);
   REQUIRE(r.loops.size() == 2);
   checkLoops(r);
@@ -420,9 +442,8 @@ TEST_CASE("offset of a 10,000 vertex polygon", "[geom][offset]") {
   for (double roughness : {0.0, 0.05}) {
     std::mt19937 rng(5);
     std::uniform_real_distribution<double> noise(-roughness, roughness);
-    const Region p{{star(rng, 10000, [&](double a) {
-      return 60 + 8 * std::sin(7 * a) + 4 * std::cos(13 * a) + noise(rng);
-    })}};
+    const Region p{{star(
+        rng, 10000, [&](double a) { return 60 + 8 * std::sin(7 * a) + 4 * std::cos(13 * a) + noise(rng); })}};
     CAPTURE(roughness);
     const Region shrunk = offset(p, -2);
     REQUIRE(shrunk.loops.size() == 1);
