@@ -76,8 +76,8 @@ Vec2 arcPoint(const Seg &s, double sweep, double t) { return s.c + rotated(s.a -
 /// `from` to the next piece's `from`.
 struct Piece {
   Vec2 from;
-  Vec2 mid;
-  bool arc = false;
+  Vec2 mid = Vec2::Zero();
+  int turn = 0;  ///< 0: line, +1/-1: counter-clockwise/clockwise arc
 };
 
 bool finite(const Vec2 &p) { return std::isfinite(p.x()) && std::isfinite(p.y()); }
@@ -117,12 +117,12 @@ std::vector<Piece> cleanLoop(const Loop &loop, size_t loopIndex) {
   for (const Kept &k : kept) {
     const Seg &s = *k.seg;
     if (!s.isArc()) {
-      pieces.push_back({s.a, Vec2::Zero(), false});
+      pieces.push_back({s.a, Vec2::Zero(), 0});
     } else if (std::abs(k.sweep) > 1.5 * kPi) {
-      pieces.push_back({s.a, arcPoint(s, k.sweep, 0.25), true});
-      pieces.push_back({arcPoint(s, k.sweep, 0.5), arcPoint(s, k.sweep, 0.75), true});
+      pieces.push_back({s.a, arcPoint(s, k.sweep, 0.25), s.turn});
+      pieces.push_back({arcPoint(s, k.sweep, 0.5), arcPoint(s, k.sweep, 0.75), s.turn});
     } else {
-      pieces.push_back({s.a, arcPoint(s, k.sweep, 0.5), true});
+      pieces.push_back({s.a, arcPoint(s, k.sweep, 0.5), s.turn});
     }
   }
   if (pieces.size() < 2)
@@ -131,8 +131,10 @@ std::vector<Piece> cleanLoop(const Loop &loop, size_t loopIndex) {
 }
 
 /// A loop as a CGAL polygon: its pieces as curves, split into x-monotone parts.
-/// An arc whose mid point does not lie between its (snapped) ends on the side
-/// its turn says becomes a line: it is too flat or too short to matter.
+/// An arc whose mid point does not lie on the side of its (snapped) ends that
+/// its turn says (or on the line through them) becomes a line: it is too flat
+/// or too short to matter, and the circle through the three points would go
+/// the wrong way round.
 CgalPolygon toPolygon(const std::vector<Piece> &pieces) {
   std::vector<KPoint> vertices;
   vertices.reserve(pieces.size());
@@ -149,9 +151,10 @@ CgalPolygon toPolygon(const std::vector<Piece> &pieces) {
     if (from == to)
       continue;
     Curve curve(from, to);
-    if (pieces[i].arc) {
+    if (pieces[i].turn != 0) {
+      // Three points in counter-clockwise order on a circle make a left turn.
       KPoint mid(pieces[i].mid.x(), pieces[i].mid.y());
-      if (CGAL::orientation(from, mid, to) != CGAL::COLLINEAR)
+      if (CGAL::orientation(from, mid, to) == (pieces[i].turn > 0 ? CGAL::LEFT_TURN : CGAL::RIGHT_TURN))
         curve = Curve(from, mid, to);
     }
     parts.clear();
@@ -205,21 +208,23 @@ std::vector<CgalPolygonWithHoles> toPolygons(const Region &region) {
       }
     }
     const Piece &p = hole.pieces[longest];
-    Vec2 probe = p.arc ? p.mid : 0.5 * (p.from + hole.pieces[(longest + 1) % hole.pieces.size()].from);
+    Vec2 probe = p.turn != 0 ? p.mid : 0.5 * (p.from + hole.pieces[(longest + 1) % hole.pieces.size()].from);
     Box probeBox;
     probeBox.add(probe);
 
     size_t owner = outers.size();
     for (size_t k = 0; k < outers.size() && owner == outers.size(); ++k)
-      if (outers[k].area > hole.area && outers[k].box.overlaps(probeBox) && outers[k].loop->winding(probe) != 0)
+      if (outers[k].area > hole.area && outers[k].box.overlaps(probeBox) &&
+          outers[k].loop->winding(probe) != 0)
         owner = k;
     if (owner < outers.size()) {
       holesOf[owner].push_back(toPolygon(hole.pieces));
     } else {
       // Reverse the pieces: each keeps its mid point, the order and the ends swap.
+      const std::vector<Piece> &forward = hole.pieces;
       std::vector<Piece> reversed;
-      for (size_t k = hole.pieces.size(); k-- > 0;)
-        reversed.push_back({hole.pieces[(k + 1) % hole.pieces.size()].from, hole.pieces[k].mid, hole.pieces[k].arc});
+      for (size_t k = forward.size(); k-- > 0;)
+        reversed.push_back({forward[(k + 1) % forward.size()].from, forward[k].mid, -forward[k].turn});
       result.emplace_back(toPolygon(reversed));
     }
   }
@@ -332,8 +337,10 @@ Loop toLoop(const CgalPolygon &polygon) {
 
   Loop loop;
   if (start == n) {
-    // The whole loop is one circle (a loop of lines always has a corner): cut
-    // it into arcs of about equal sweep, fewer than 2 pi each.
+    // The whole loop is one circle (a closed loop of lines has a corner, or
+    // no area): cut it into arcs of about equal sweep, fewer than 2 pi each.
+    if (pieces[0].turn == 0)
+      return {};
     std::vector<double> cumulative(n + 1, 0.0);
     for (size_t i = 0; i < n; ++i)
       cumulative[i + 1] = cumulative[i] + pieceSweep(pieces[i], to(i));
@@ -346,7 +353,8 @@ Loop toLoop(const CgalPolygon &polygon) {
         // The cut nearest to k / parts of the way round, leaving room for the rest.
         double target = total * double(k) / double(parts);
         end = begin + 1;
-        while (end + (parts - k) < n && std::abs(cumulative[end + 1] - target) < std::abs(cumulative[end] - target))
+        while (end + (parts - k) < n &&
+               std::abs(cumulative[end + 1] - target) < std::abs(cumulative[end] - target))
           ++end;
       }
       const OutPiece &first = pieces[begin];
@@ -464,7 +472,8 @@ std::vector<Region> sweptArcParts(const Seg &s, double r) {
     Loop loop;
     if (inner > kEps) {
       Vec2 ai = c + inner * ua, bi = c + inner * ub;
-      loop.segs = {Seg::arc(ao, bo, c, true), Seg::line(bo, bi), Seg::arc(bi, ai, c, false), Seg::line(ai, ao)};
+      loop.segs = {Seg::arc(ao, bo, c, true), Seg::line(bo, bi), Seg::arc(bi, ai, c, false),
+                   Seg::line(ai, ao)};
     } else {
       loop.segs = {Seg::line(c, ao), Seg::arc(ao, bo, c, true), Seg::line(bo, c)};
     }
