@@ -424,14 +424,6 @@ Region toRegion(const PolygonSet &set) {
 
 // --- Swept discs -----------------------------------------------------------------
 
-/// A circle as a loop of two half arcs, counter-clockwise unless `ccw` is false.
-Loop circleLoop(const Vec2 &c, double r, bool ccw) {
-  Vec2 east = c + Vec2(r, 0), west = c - Vec2(r, 0);
-  Loop loop;
-  loop.segs = {Seg::arc(east, west, c, ccw), Seg::arc(west, east, c, ccw)};
-  return loop;
-}
-
 Region disc(const Vec2 &c, double r) { return Region{{circleLoop(c, r, true)}}; }
 
 /// The capsule a disc of radius r sweeps along the line a -> b (|b - a| > 0).

@@ -320,6 +320,44 @@ std::vector<Seg> circle(const Vec2 &c, double r, bool ccw, const Vec2 &start) {
   return {Seg::arc(s, opposite, c, ccw), Seg::arc(opposite, s, c, ccw)};
 }
 
+Loop polygon(const std::vector<Vec2> &pts) {
+  Loop l;
+  for (size_t i = 0; i < pts.size(); ++i)
+    l.segs.push_back(Seg::line(pts[i], pts[(i + 1) % pts.size()]));
+  return l;
+}
+
+Loop roundedRectangle(const Vec2 &lo, const Vec2 &hi, double radius) {
+  const double r = std::min({radius, (hi.x() - lo.x()) / 2, (hi.y() - lo.y()) / 2});
+  if (r <= kEps)
+    return polygon({lo, {hi.x(), lo.y()}, hi, {lo.x(), hi.y()}});
+  Loop l;
+  auto edge = [&](const Vec2 &a, const Vec2 &b) {
+    if ((b - a).norm() > kEps)
+      l.segs.push_back(Seg::line(a, b));
+  };
+  // Corner arcs from where one side ends to where the next begins, so that
+  // pieces meet exactly.
+  auto corner = [&](const Vec2 &a, const Vec2 &b, const Vec2 &c) { l.segs.push_back(Seg::arc(a, b, c, true)); };
+  const double x0 = lo.x(), y0 = lo.y(), x1 = hi.x(), y1 = hi.y();
+  edge({x0 + r, y0}, {x1 - r, y0});
+  corner({x1 - r, y0}, {x1, y0 + r}, {x1 - r, y0 + r});
+  edge({x1, y0 + r}, {x1, y1 - r});
+  corner({x1, y1 - r}, {x1 - r, y1}, {x1 - r, y1 - r});
+  edge({x1 - r, y1}, {x0 + r, y1});
+  corner({x0 + r, y1}, {x0, y1 - r}, {x0 + r, y1 - r});
+  edge({x0, y1 - r}, {x0, y0 + r});
+  corner({x0, y0 + r}, {x0 + r, y0}, {x0 + r, y0 + r});
+  return l;
+}
+
+Loop circleLoop(const Vec2 &c, double r, bool ccw) {
+  const Vec2 east = c + Vec2(r, 0), west = c - Vec2(r, 0);
+  Loop l;
+  l.segs = {Seg::arc(east, west, c, ccw), Seg::arc(west, east, c, ccw)};
+  return l;
+}
+
 // --- Loop, Region, Chain -----------------------------------------------------
 
 double Loop::area() const {

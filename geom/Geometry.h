@@ -82,6 +82,15 @@ struct Loop {
   int winding(const Vec2 &p) const;
 };
 
+/// A closed polygon through the points, in their order.
+Loop polygon(const std::vector<Vec2> &pts);
+/// The counter-clockwise rectangle [lo, hi] with corners rounded to radius r
+/// (clamped to half the shorter side; sharp when r is 0), starting on its
+/// bottom side.
+Loop roundedRectangle(const Vec2 &lo, const Vec2 &hi, double r);
+/// A circle as two half arcs, the first from its east point (c + (r, 0)).
+Loop circleLoop(const Vec2 &c, double r, bool ccw);
+
 struct Region {
   std::vector<Loop> loops;
 

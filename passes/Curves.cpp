@@ -1,5 +1,7 @@
 #include "passes/Curves.h"
 
+#include "support/Format.h"
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -29,8 +31,8 @@ double ccwAngle(const Vec3 &c, const Vec3 &a, const Vec3 &b) {
 bool axisAlongZ(const Node &n, bool &positive, std::string &error) {
   const Vec3 axis = n.vec("axis").value_or(Vec3::UnitZ());
   if (std::abs(std::abs(axis.z()) - 1) > 1e-9) {
-    error = n.kind + " with its axis along (" + std::to_string(axis.x()) + ", " + std::to_string(axis.y()) + ", " +
-            std::to_string(axis.z()) + "): only circles and helices about the tool axis are supported";
+    error = n.kind + " with its axis along " + formatTuple({axis.x(), axis.y(), axis.z()}, 6) +
+            ": only circles and helices about the tool axis are supported";
     return false;
   }
   positive = axis.z() > 0;

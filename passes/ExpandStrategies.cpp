@@ -56,7 +56,6 @@ public:
   const Vec3 &position() const { return pos_; }
   bool positioned() const { return positioned_; }
   double secplane() const { return secplane_; }
-  size_t count() const { return moves_.children.size(); }
 
   void rapid(const Vec3 &to, const char *role = "position") {
     if (positioned_ && (to - pos_).norm() <= geom::kEps)
@@ -174,7 +173,7 @@ double sharpestCorner(const Region &r) {
 }
 
 struct Plan {
-  const Node *workingstep = nullptr;
+  const Node *feature = nullptr;
   const Node *op = nullptr;
   const Node *tool = nullptr;
   double radius = 0;
@@ -229,8 +228,7 @@ private:
     if (!feature || !tool)
       return;  // the IR verifier reports dangling references
     Plan p;
-    p.workingstep = &ws;
-    radius_ = tool->number("diameter").value_or(0) / 2;
+    p.feature = feature;
     p.op = op;
     p.tool = tool;
     p.radius = tool->number("diameter").value_or(0) / 2;
@@ -250,7 +248,13 @@ private:
       report(ws, "its tool " + tool->symbol + " has no diameter");
       return;
     }
-    ShapeResult shape = featureShape(*module_, *feature);
+    // Axial approaches start the retract plane above the feature's top, never
+    // above the security plane.
+    auto clearanceAbove = [&](double top) {
+      return std::min(top + op->number("retract_plane").value_or(kDefaultClearance),
+                      ws.number("secplane").value_or(1e300));
+    };
+    Node moves = makeMoves(ws, tool->symbol, p.spindle, coolant(*op), setup);
     // Explicit toolpaths need no shape: they are in the feature's frame.
     if (!op->childrenOf("toolpath").empty()) {
       FrameResult fr = planeFrame(*feature);
@@ -258,13 +262,12 @@ private:
         unsupported(ws, fr.error);
         return;
       }
-      p.clearanceZ = std::min(fr.frame->z + op->number("retract_plane").value_or(kDefaultClearance),
-                              ws.number("secplane").value_or(1e300));
-      Node moves = makeMoves(ws, p, setup);
+      p.clearanceZ = clearanceAbove(fr.frame->z);
       explicitToolpaths(ws, *op, *fr.frame, p, moves);
       attach(ws, std::move(moves));
       return;
     }
+    ShapeResult shape = featureShape(*module_, *feature);
     if (!shape.shape) {
       unsupported(ws, shape.error);
       return;
@@ -276,24 +279,24 @@ private:
                      " (z=" + formatFixed(s.top, 4) + " mm): there is no safe height to travel at");
       return;
     }
-    p.clearanceZ = std::min(s.top + op->number("retract_plane").value_or(kDefaultClearance),
-                            ws.number("secplane").value_or(1e300));
-    Node moves = makeMoves(ws, p, setup);
+    p.clearanceZ = clearanceAbove(s.top);
     // Hole-making operations are those that take a drilling strategy.
     const bool holeMaking = ir::inList(ir::findKind(op->kind)->children, "drilling_strategy");
     if (holeMaking ? expandHoleMaking(ws, *op, s, p, moves) : milling(ws, *op, s, p, moves))
       attach(ws, std::move(moves));
   }
 
-  Node makeMoves(const Node &ws, const Plan &p, const std::string &setup) {
+  /// An empty `moves` for the executable `exec`, with the state in force.
+  static Node makeMoves(const Node &exec, const std::string &tool, double spindle, const std::string &coolant,
+                        const std::string &setup) {
     Node moves("moves");
-    moves.set("tool", Value::ref(p.tool->symbol));
-    moves.set("spindle", Value::spindle(p.spindle));
-    moves.set("coolant", Value::word(coolant(*p.op)));
+    moves.set("tool", Value::ref(tool));
+    moves.set("spindle", Value::spindle(spindle));
+    moves.set("coolant", Value::word(coolant));
     if (!setup.empty())
       moves.set("setup", Value::ref(setup));
-    moves.set("secplane", Value::length(ws.number("secplane").value_or(0)));
-    moves.origin = ws.origin;
+    moves.set("secplane", Value::length(exec.number("secplane").value_or(0)));
+    moves.origin = exec.origin;
     return moves;
   }
 
@@ -381,17 +384,11 @@ private:
   }
 
   void rapidMovement(Node &rm, const std::string &setup) {
-    Node moves("moves");
     // A rapid movement keeps the tool of the workingstep before it; the IR
     // names it where known.
     if (lastTool_.empty())
       return;
-    moves.set("tool", Value::ref(lastTool_));
-    moves.set("spindle", Value::spindle(0));
-    moves.set("coolant", Value::word("off"));
-    if (!setup.empty())
-      moves.set("setup", Value::ref(setup));
-    moves.set("secplane", Value::length(rm.number("secplane").value_or(0)));
+    Node moves = makeMoves(rm, lastTool_, 0, "off", setup);
     Emitter e(moves, rm.number("secplane").value_or(0));
     for (const Node *tp : rm.childrenOf("toolpath"))
       for (const Node &curve : tp->children)
@@ -407,7 +404,6 @@ private:
             e.rapid(c.to);
           }
         }
-    moves.origin = rm.origin;
     attach(rm, std::move(moves));
   }
 
@@ -425,7 +421,7 @@ private:
                      " mm) is wider than the hole (" + formatFixed(s.holeDiameter, 3) + " mm)");
       return false;
     }
-    const Node &feature = *findFeature(*module_, ws.text("feature").value_or(""));
+    const Node &feature = *p.feature;
     // The depth the tool's tip reaches: the floor, or past it for through holes.
     double bottom = s.bottom;
     const double point = pointLength(*p.tool);
@@ -507,56 +503,80 @@ private:
     else if (!rotation.empty())
       followOrientation = rotation == "ccw";
 
+    const Vec2 strokeDir = strokeDirection(*p.feature, s, strategy);
+    const bool linkAtDepth = type == "contour_spiral" || type == "contour_parallel" || type == "bidirectional" ||
+                             type == "contour_bidirectional" || type == "bidirectional_contour";
     Emitter e(moves, ws.number("secplane").value_or(0));
+    // The centre area and the paths depend on the level only through the
+    // islands standing at it: they are made again only when that set changes.
+    std::optional<std::vector<bool>> standing;
+    Region centres;
+    std::vector<std::vector<Seg>> paths;
     for (int i = 1; i <= levels; ++i) {
       const double z = s.top - (s.top - floorZ) * i / levels;
-      // Islands count at the levels below their top.
-      Region area = s.unbounded ? s.target : s.limit;
-      std::vector<Region> islands;
+      std::vector<bool> here;
       for (const IslandShape &isl : s.islands)
-        if (isl.top > z + 1e-9)
-          islands.push_back(geom::offset(isl.region, p.allowanceSide));
-      Region centres = centreArea(s, area, islands, p);
-      if (centres.empty() && s.holeCentre && 2 * p.radius <= s.holeDiameter + 1e-6) {
+        here.push_back(isl.top > z + 1e-9);
+      if (standing != here) {
+        standing = here;
+        std::vector<Region> islands;
+        for (size_t k = 0; k < s.islands.size(); ++k)
+          if (here[k])
+            islands.push_back(geom::offset(s.islands[k].region, p.allowanceSide));
+        centres = centreArea(s, s.unbounded ? s.target : s.limit, islands, p);
+        paths.clear();
+        if (!centres.empty()) {
+          auto made = strategyPaths(type, face, sideOnly, centres, strokeDir, stepover, followOrientation, p.radius);
+          if (!made) {
+            unsupported(ws, "strategy '" + type + "' is not expanded yet");
+            return false;
+          }
+          paths = std::move(*made);
+        } else if (!(s.holeCentre && 2 * p.radius <= s.holeDiameter + 1e-6)) {
+          report(ws, "its tool " + p.tool->symbol + " (diameter " + formatFixed(2 * p.radius, 3) +
+                         " mm) does not fit in " + s.symbol + " with the side allowance");
+          return false;
+        }
+      }
+      if (centres.empty()) {
         // A cutter as wide as the hole: straight down its axis.
         e.travel(*s.holeCentre, p.clearanceZ);
         e.linear(at(*s.holeCentre, z), p.plungeFeed, "plunge");
         e.retract();
         continue;
       }
-      if (centres.empty()) {
-        report(ws, "its tool " + p.tool->symbol + " (diameter " + formatFixed(2 * p.radius, 3) +
-                       " mm) does not fit in " + s.symbol + " with the side allowance");
-        return false;
-      }
-      std::vector<std::vector<Seg>> paths;
-      if (face && (type == "bidirectional" || type == "unidirectional"))
-        paths = strokes(centres, faceDirection(s, strategy), stepover, type == "bidirectional", p.radius);
-      else if (sideOnly)
-        paths = rings(centres, stepover, followOrientation, /*all=*/false);
-      else if (type == "contour_parallel" || type == "contour_spiral")
-        paths = rings(centres, stepover, followOrientation, true);
-      else if (type == "bidirectional" || type == "unidirectional")
-        paths = strokes(centres, faceDirection(s, strategy), stepover, type == "bidirectional", 0);
-      else if (type == "contour_bidirectional" || type == "bidirectional_contour") {
-        // Zigzag inside the first ring, and the ring: before or after.
-        std::vector<std::vector<Seg>> ring = rings(centres, stepover, followOrientation, false);
-        std::vector<std::vector<Seg>> zig =
-            strokes(geom::offset(centres, -stepover), faceDirection(s, strategy), stepover, true, 0);
-        paths = type == "contour_bidirectional" ? ring : zig;
-        auto &rest = type == "contour_bidirectional" ? zig : ring;
-        paths.insert(paths.end(), rest.begin(), rest.end());
-      } else {
-        unsupported(ws, "strategy '" + type + "' is not expanded yet");
-        return false;
-      }
-      const bool linkAtDepth = type == "contour_spiral" || type == "contour_parallel" || type == "bidirectional" ||
-                               type == "contour_bidirectional" || type == "bidirectional_contour";
       for (size_t k = 0; k < paths.size(); ++k)
         cutPath(e, paths[k], z, p, op, centres, linkAtDepth && k > 0, s.unbounded);
     }
     e.retract();
     return true;
+  }
+
+  /// The plane paths of a strategy in the centre area; none for a strategy
+  /// not expanded yet.
+  std::optional<std::vector<std::vector<Seg>>> strategyPaths(const std::string &type, bool face, bool sideOnly,
+                                                             const Region &centres, const Vec2 &strokeDir,
+                                                             double stepover, bool followOrientation,
+                                                             double radius) {
+    const bool strokesOnly = type == "bidirectional" || type == "unidirectional";
+    if (face && strokesOnly)
+      return strokes(centres, strokeDir, stepover, type == "bidirectional", radius);
+    if (sideOnly)
+      return rings(centres, stepover, followOrientation, /*all=*/false, radius);
+    if (type == "contour_parallel" || type == "contour_spiral")
+      return rings(centres, stepover, followOrientation, /*all=*/true, radius);
+    if (strokesOnly)
+      return strokes(centres, strokeDir, stepover, type == "bidirectional", 0);
+    if (type == "contour_bidirectional" || type == "bidirectional_contour") {
+      // Zigzag inside the first ring, and the ring: before or after.
+      std::vector<std::vector<Seg>> ring = rings(centres, stepover, followOrientation, false, radius);
+      std::vector<std::vector<Seg>> zig = strokes(geom::offset(centres, -stepover), strokeDir, stepover, true, 0);
+      std::vector<std::vector<Seg>> paths = type == "contour_bidirectional" ? ring : zig;
+      const auto &rest = type == "contour_bidirectional" ? zig : ring;
+      paths.insert(paths.end(), rest.begin(), rest.end());
+      return paths;
+    }
+    return std::nullopt;
   }
 
   /// Where the tool centre may be at one level: away from walls and islands by
@@ -579,7 +599,8 @@ private:
 
   /// Contour-parallel rings: the boundaries of the centre area shrunk by 0,
   /// s, 2s, ... innermost first (all) or the outermost ring only.
-  std::vector<std::vector<Seg>> rings(const Region &centres, double stepover, bool followOrientation, bool all) {
+  std::vector<std::vector<Seg>> rings(const Region &centres, double stepover, bool followOrientation, bool all,
+                                      double radius) {
     std::vector<Region> shells;
     for (Region r = centres; !r.empty(); r = geom::offset(r, -stepover)) {
       shells.push_back(r);
@@ -595,35 +616,30 @@ private:
         const double mid = (lo + hi) / 2;
         (geom::offset(shells.back(), -mid).empty() ? hi : lo) = mid;
       }
-      if (lo > radius_ * 0.9) {
-        Region middle = geom::offset(shells.back(), -std::max(lo - std::min(0.1 * radius_, lo / 2), 0.0));
+      if (lo > radius * 0.9) {
+        Region middle = geom::offset(shells.back(), -std::max(lo - std::min(0.1 * radius, lo / 2), 0.0));
         if (!middle.empty())
           shells.push_back(std::move(middle));
       }
     }
     std::vector<std::vector<Seg>> out;
     for (auto it = shells.rbegin(); it != shells.rend(); ++it)
-      for (const Loop &l : it->loops) {
-        std::vector<Seg> path = l.segs;
-        if (!followOrientation) {
-          std::reverse(path.begin(), path.end());
-          for (Seg &sg : path)
-            sg = sg.reversed();
-        }
-        out.push_back(std::move(path));
+      for (Loop l : it->loops) {
+        if (!followOrientation)
+          l.reverse();
+        out.push_back(std::move(l.segs));
       }
     return out;
   }
 
   /// The stroke direction: the strategy's feed direction, else the face's
   /// course of travel, else the feature's x axis.
-  Vec2 faceDirection(const FeatureShape &s, const Node *strategy) {
+  static Vec2 strokeDirection(const Node &feature, const FeatureShape &s, const Node *strategy) {
     if (strategy)
       if (auto d = strategy->vec("feed_dir"); d && d->head<2>().norm() > 1e-9)
         return s.frame.mapDir(d->head<2>()).normalized();
-    if (const Node *f = findFeature(*module_, s.symbol))
-      if (auto d = f->vec("travel_dir"))
-        return s.frame.mapDir(d->head<2>()).normalized();
+    if (auto d = feature.vec("travel_dir"))
+      return s.frame.mapDir(d->head<2>()).normalized();
     return s.frame.x;
   }
 
@@ -739,7 +755,6 @@ private:
     e.linear(at(start, z), p.plungeFeed, "plunge");
   }
 
-  double radius_ = 0;  ///< the tool radius of the workingstep being expanded
   ir::Module *module_ = nullptr;
   DiagnosticEngine *diags_ = nullptr;
   PassStats *stats_ = nullptr;

@@ -20,24 +20,6 @@ using ir::Node;
 /// How far past an open side the tool may go: the area beyond is air.
 constexpr double kOpenReach = 500.0;
 
-std::string vecText(const ir::Vec3 &v) {
-  std::string out = "(";
-  out += formatFixed(v.x(), 6);
-  out += ", ";
-  out += formatFixed(v.y(), 6);
-  out += ", ";
-  out += formatFixed(v.z(), 6);
-  out += ")";
-  return out;
-}
-
-Loop polygon(const std::vector<Vec2> &pts) {
-  Loop l;
-  for (size_t i = 0; i < pts.size(); ++i)
-    l.segs.push_back(Seg::line(pts[i], pts[(i + 1) % pts.size()]));
-  return l;
-}
-
 /// Makes outer loops counter-clockwise (a mirrored frame turns them over).
 Region outer(Loop l) {
   if (l.area() < 0)
@@ -45,30 +27,6 @@ Region outer(Loop l) {
   Region r;
   r.loops.push_back(std::move(l));
   return r;
-}
-
-/// A rectangle centred on the origin, `length` along x and `width` along y,
-/// with corners rounded by `radius` (0: sharp).
-Loop rectangle(double length, double width, double radius) {
-  const double hx = length / 2, hy = width / 2;
-  const double r = std::min({radius, hx, hy});
-  if (r <= geom::kEps)
-    return polygon({{-hx, -hy}, {hx, -hy}, {hx, hy}, {-hx, hy}});
-  Loop l;
-  auto corner = [&](Vec2 c, Vec2 from, Vec2 to) { l.segs.push_back(Seg::arc(c + from * r, c + to * r, c, true)); };
-  auto edge = [&](Vec2 a, Vec2 b) {
-    if ((b - a).norm() > geom::kEps)
-      l.segs.push_back(Seg::line(a, b));
-  };
-  edge({-hx + r, -hy}, {hx - r, -hy});
-  corner({hx - r, -hy + r}, {0, -1}, {1, 0});
-  edge({hx, -hy + r}, {hx, hy - r});
-  corner({hx - r, hy - r}, {1, 0}, {0, 1});
-  edge({hx - r, hy}, {-hx + r, hy});
-  corner({-hx + r, hy - r}, {0, 1}, {-1, 0});
-  edge({-hx, hy - r}, {-hx, -hy + r});
-  corner({-hx + r, -hy + r}, {-1, 0}, {0, -1});
-  return l;
 }
 
 /// Maps a loop from a frame's local coordinates to workpiece coordinates.
@@ -114,10 +72,11 @@ public:
     }
     Loop l;
     if (p->kind == "rectangular_profile") {
-      l = rectangle(*p->number("length"), *p->number("width"), cornerRadius);
+      // Centred on the profile's origin, its length along x and its width along y.
+      const Vec2 half(*p->number("length") / 2, *p->number("width") / 2);
+      l = geom::roundedRectangle(-half, half, cornerRadius);
     } else if (p->kind == "circular_profile") {
-      for (const Seg &s : geom::circle(Vec2::Zero(), *p->number("diameter") / 2, true, Vec2(*p->number("diameter") / 2, 0)))
-        l.segs.push_back(s);
+      l = geom::circleLoop(Vec2::Zero(), *p->number("diameter") / 2, true);
     } else if (p->kind == "general_profile") {
       if (!p->flag("closed").value_or(false) || p->children.empty()) {
         fail("the general profile of " + owner.symbol + " is not closed");
@@ -158,20 +117,33 @@ public:
     }
   }
 
-  /// Material beside a straight open boundary, towards the nearer edge of the raw piece.
-  bool step(const Node &feature, FeatureShape &s) {
+  /// The feature's `path` when it is one straight piece, mapped to workpiece
+  /// coordinates; `what` names the path in messages ("open boundary").
+  std::optional<std::pair<Vec2, Vec2>> straightPath(const Node &feature, const FeatureShape &s,
+                                                    const std::string &what) {
     const Node *path = feature.child("path");
     std::vector<CurvePiece> pieces;
     if (path && !path->children.empty()) {
       CurveResult cr = curvePieces(path->children.front());
-      if (!cr.error.empty())
-        return fail("the open boundary of " + feature.symbol + ": " + cr.error);
+      if (!cr.error.empty()) {
+        fail("the " + what + " of " + feature.symbol + ": " + cr.error);
+        return std::nullopt;
+      }
       pieces = std::move(cr.pieces);
     }
-    if (pieces.size() != 1 || pieces[0].arc)
-      return fail("only steps along one straight open boundary are supported (" + feature.symbol + ")");
-    const Vec2 a = s.frame.map(pieces[0].from.head<2>());
-    const Vec2 b = s.frame.map(pieces[0].to.head<2>());
+    if (pieces.size() != 1 || pieces[0].arc) {
+      fail("only " + feature.kind + "s along one straight " + what + " are supported (" + feature.symbol + ")");
+      return std::nullopt;
+    }
+    return std::pair(s.frame.map(pieces[0].from.head<2>()), s.frame.map(pieces[0].to.head<2>()));
+  }
+
+  /// Material beside a straight open boundary, towards the nearer edge of the raw piece.
+  bool step(const Node &feature, FeatureShape &s) {
+    const auto path = straightPath(feature, s, "open boundary");
+    if (!path)
+      return false;
+    const auto [a, b] = *path;
     const Vec2 along = (b - a).normalized();
     const Vec2 left(-along.y(), along.x());
     // The step's width: from the boundary to the raw piece's edge on the nearer side.
@@ -189,24 +161,18 @@ public:
     const double width = std::min(toLeft, toRight);
     if (width <= geom::kEps)
       return fail("step " + feature.symbol + " lies on the raw piece's edge: nothing to remove");
-    s.target = outer(polygon({a, b, b + side * width, a + side * width}));
+    s.target = outer(geom::polygon({a, b, b + side * width, a + side * width}));
     // Only the boundary itself is a wall: the ends and the far side are open.
     const Vec2 e = along * kOpenReach;
-    s.limit = outer(polygon({a - e, b + e, b + e + side * (width + kOpenReach), a - e + side * (width + kOpenReach)}));
+    s.limit = outer(geom::polygon({a - e, b + e, b + e + side * (width + kOpenReach), a - e + side * (width + kOpenReach)}));
     return true;
   }
 
   bool slot(const Node &feature, FeatureShape &s) {
-    const Node *path = feature.child("path");
-    std::vector<CurvePiece> pieces;
-    if (path && !path->children.empty()) {
-      CurveResult cr = curvePieces(path->children.front());
-      if (!cr.error.empty())
-        return fail("the course of travel of " + feature.symbol + ": " + cr.error);
-      pieces = std::move(cr.pieces);
-    }
-    if (pieces.size() != 1 || pieces[0].arc)
-      return fail("only slots along one straight course of travel are supported (" + feature.symbol + ")");
+    const auto path = straightPath(feature, s, "course of travel");
+    if (!path)
+      return false;
+    const auto [a, b] = *path;
     double width = 0;
     if (const Node *p = feature.child("square_u_profile"))
       width = *p->number("width");
@@ -217,8 +183,6 @@ public:
                   "only (plan: z-level passes with a form or tapered tool)");
     else
       return fail("slot " + feature.symbol + " has no cross-section profile");
-    const Vec2 a = s.frame.map(pieces[0].from.head<2>());
-    const Vec2 b = s.frame.map(pieces[0].to.head<2>());
     const Vec2 along = (b - a).normalized();
     const Vec2 n(-along.y() * width / 2, along.x() * width / 2);
     const bool open1 = feature.text("end_1") == "open", open2 = feature.text("end_2") == "open";
@@ -241,7 +205,7 @@ public:
     s.target = outer(l);
     const Vec2 e = along * kOpenReach;
     if (open1 || open2)
-      s.limit = outer(polygon({a - n - (open1 ? e : Vec2::Zero()).eval(), b - n + (open2 ? e : Vec2::Zero()).eval(),
+      s.limit = outer(geom::polygon({a - n - (open1 ? e : Vec2::Zero()).eval(), b - n + (open2 ? e : Vec2::Zero()).eval(),
                                b + n + (open2 ? e : Vec2::Zero()).eval(), a + n - (open1 ? e : Vec2::Zero()).eval()}));
     else
       s.limit = s.target;
@@ -295,7 +259,7 @@ FrameResult planeFrame(const ir::Node &placed) {
   const ir::Vec3 ref = placed.vec("ref").value_or(ir::Vec3::UnitX());
   if (std::abs(axis.z() - 1) > 1e-9)
     return {std::nullopt, placed.kind + (placed.symbol.empty() ? "" : " " + placed.symbol) + " has its axis along " +
-                              vecText(axis) + ": only features facing the tool axis +z are expanded (plan: "
+                              formatTuple({axis.x(), axis.y(), axis.z()}, 6) + ": only features facing the tool axis +z are expanded (plan: "
                               "setups per face orientation)"};
   PlaneFrame f;
   f.origin = at.head<2>();
@@ -348,16 +312,13 @@ ShapeResult featureShape(const ir::Module &module, const ir::Node &feature) {
     const Vec2 across = s.frame.mapDir(feature.vec("width_dir")->head<2>()).normalized();
     const Vec2 o = s.frame.origin;
     const Vec2 t = travel * *feature.number("travel"), w = across * *feature.number("width");
-    s.target = outer(polygon({o, o + w, o + w + t, o + t}));
+    s.target = outer(geom::polygon({o, o + w, o + w + t, o + t}));
     s.unbounded = true;
     b.islands(feature, s);
   } else if (feature.kind == "round_hole") {
     s.holeCentre = s.frame.origin;
     s.holeDiameter = *feature.number("diameter");
-    Loop l;
-    for (const Seg &seg : geom::circle(s.frame.origin, s.holeDiameter / 2, true, s.frame.origin + Vec2(s.holeDiameter / 2, 0)))
-      l.segs.push_back(seg);
-    s.target = outer(l);
+    s.target = outer(geom::circleLoop(s.frame.origin, s.holeDiameter / 2, true));
     s.limit = s.target;
   } else if (feature.kind == "slot") {
     ok = b.slot(feature, s);

@@ -80,9 +80,7 @@ const ir::Node *operationOf(const ir::Node &exec) {
 
 std::string mm(double v) { return formatFixed(v, 4) + " mm"; }
 std::string mm2(double v) { return formatFixed(v, 3) + " mm2"; }
-std::string pointText(const ir::Vec3 &p) {
-  return "(" + formatFixed(p.x(), 4) + ", " + formatFixed(p.y(), 4) + ", " + formatFixed(p.z(), 4) + ")";
-}
+std::string pointText(const ir::Vec3 &p) { return formatTuple({p.x(), p.y(), p.z()}, 4); }
 
 /// "0.02" or "0.02mm" as a positive length; nullopt otherwise.
 std::optional<double> parseLength(std::string_view text) {

@@ -22,6 +22,17 @@ std::string formatFixed(double value, int decimals) {
   return s;
 }
 
+std::string formatTuple(std::initializer_list<double> values, int decimals) {
+  std::string s = "(";
+  for (double v : values) {
+    if (s.size() > 1)
+      s += ", ";
+    s += formatFixed(v, decimals);
+  }
+  s += ')';
+  return s;
+}
+
 std::string hashId(uint64_t id) {
   std::string s(1, '#');
   s += std::to_string(id);

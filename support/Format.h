@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <initializer_list>
 #include <string>
 
 namespace stepnc {
@@ -14,6 +15,9 @@ std::string formatShortest(double value);
 /// Fixed-point with exactly `decimals` digits after the point; `-0.000` prints
 /// as "0.000". Non-finite values print as "nan"/"inf" (callers reject them first).
 std::string formatFixed(double value, int decimals);
+
+/// "(1.0000, -2.5000, 0.0000)": numbers in fixed point, for messages.
+std::string formatTuple(std::initializer_list<double> values, int decimals);
 
 /// "#123": a Part 21 instance name as written in files and messages.
 std::string hashId(uint64_t id);

@@ -163,10 +163,13 @@ std::optional<Node> Lowerer::operation(const Instance &op) {
   auto length = [&](std::string_view irName, std::string_view attribute) {
     copyReal(n, irName, op, attribute, Value::length);
   };
+  auto position = [&](std::string_view irName, std::string_view attribute) {
+    if (Instance at = op.ref(attribute))
+      if (auto p = point(at))
+        n.set(std::string(irName), Value::point(*p));
+  };
   length("retract_plane", "retract_plane");
-  if (Instance sp = op.ref("start_point"))
-    if (auto p = point(sp))
-      n.set("start_point", Value::point(*p));
+  position("start_point", "start_point");
   length("overcut", "overcut_length");
   length("axial_depth", "axial_cutting_depth");
   length("radial_depth", "radial_cutting_depth");
@@ -179,9 +182,7 @@ std::optional<Node> Lowerer::operation(const Instance &op) {
   copyReal(n, "feed_on_retract", op, "feed_on_retract", Value::ratio);
   copyFlag(n, "spindle_stop_bottom", op, "spindle_stop_at_bottom");
   length("depth_of_testcut", "depth_of_testcut");
-  if (Instance wp = op.ref("waiting_position"))
-    if (auto p = point(wp))
-      n.set("waiting_position", Value::point(*p));
+  position("waiting_position", "waiting_position");
   length("retract_distance", "retract_distance");
   length("first_depth", "first_depth");
   length("depth_increment", "depth_of_step");

@@ -16,18 +16,12 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-Loop rectLoop(double x0, double y0, double x1, double y1) {
-  Loop loop;
-  Vec2 p[4] = {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
-  for (int i = 0; i < 4; ++i)
-    loop.segs.push_back(Seg::line(p[i], p[(i + 1) % 4]));
-  return loop;
-}
+Loop rectLoop(double x0, double y0, double x1, double y1) { return polygon({{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}); }
 
 Region rect(double x0, double y0, double x1, double y1) { return Region{{rectLoop(x0, y0, x1, y1)}}; }
 
 /// A circle as two half arcs, the first starting at `startAngle`.
-Loop circleLoop(const Vec2 &c, double r, bool ccw, double startAngle = 0) {
+Loop circleAt(const Vec2 &c, double r, bool ccw, double startAngle = 0) {
   Vec2 u(std::cos(startAngle), std::sin(startAngle));
   Vec2 p = c + r * u, q = c - r * u;
   Loop loop;
@@ -36,10 +30,8 @@ Loop circleLoop(const Vec2 &c, double r, bool ccw, double startAngle = 0) {
 }
 
 Loop reversedLoop(Loop loop) {
-  Loop out;
-  for (auto it = loop.segs.rbegin(); it != loop.segs.rend(); ++it)
-    out.segs.push_back(Seg{it->b, it->a, it->c, int8_t(-it->turn)});
-  return out;
+  loop.reverse();
+  return loop;
 }
 
 int arcCount(const Loop &loop) {
@@ -149,7 +141,7 @@ TEST_CASE("a rectangle minus a circle keeps the circle's arcs", "[geom][boolean]
   Region plate = rect(0, 0, 60, 40);
   for (double start : {0.0, kPi / 4, 2.0}) {
     CAPTURE(start);
-    Region hole{{circleLoop({30, 20}, 5, true, start)}};
+    Region hole{{circleAt({30, 20}, 5, true, start)}};
     Region r = subtract(plate, hole);
     checkWellFormed(r);
     CHECK(r.area() == Approx(2400 - 25 * kPi).epsilon(1e-9));
@@ -263,7 +255,7 @@ TEST_CASE("shrinkExact and growExact", "[geom][boolean]") {
   CHECK(out.loops[0].segs.size() == 8);
   CHECK(arcCount(out) == 4);
 
-  Region disc{{circleLoop({1, 2}, 10, true)}};
+  Region disc{{circleAt({1, 2}, 10, true)}};
   Region smaller = shrinkExact(disc, 4);
   checkWellFormed(smaller);
   CHECK(smaller.area() == Approx(36 * kPi).epsilon(1e-6));
@@ -330,7 +322,7 @@ TEST_CASE("a region survives the round trip through CGAL", "[geom][boolean]") {
   arc({3, 20}, {0, 17}, {3, 17});
   line({0, 17}, {0, 3});
   arc({0, 3}, {3, 0}, {3, 3});
-  Region r{{rounded, circleLoop({20, 10}, 4, false, kPi / 4)}};
+  Region r{{rounded, circleAt({20, 10}, 4, false, kPi / 4)}};
   double area = 800 - (36 - 9 * kPi) - 16 * kPi;
   REQUIRE(r.area() == Approx(area).epsilon(1e-12));
 

@@ -16,38 +16,14 @@ namespace {
 
 constexpr double pi = std::numbers::pi;
 
-Loop polygon(const std::vector<Vec2> &pts) {
-  Loop l;
-  for (size_t i = 0; i < pts.size(); ++i)
-    l.segs.push_back(Seg::line(pts[i], pts[(i + 1) % pts.size()]));
-  return l;
-}
-
 Loop rect(double x0, double y0, double x1, double y1) {
   return polygon({{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}});
 }
 
 /// Counter-clockwise rectangle with corners rounded to radius r.
 Loop roundedRect(double x0, double y0, double x1, double y1, double r) {
-  Loop l;
-  auto line = [&](double ax, double ay, double bx, double by) {
-    l.segs.push_back(Seg::line({ax, ay}, {bx, by}));
-  };
-  auto arc = [&](double ax, double ay, double bx, double by, double cx, double cy) {
-    l.segs.push_back(Seg::arc({ax, ay}, {bx, by}, {cx, cy}, true));
-  };
-  line(x0 + r, y0, x1 - r, y0);
-  arc(x1 - r, y0, x1, y0 + r, x1 - r, y0 + r);
-  line(x1, y0 + r, x1, y1 - r);
-  arc(x1, y1 - r, x1 - r, y1, x1 - r, y1 - r);
-  line(x1 - r, y1, x0 + r, y1);
-  arc(x0 + r, y1, x0, y1 - r, x0 + r, y1 - r);
-  line(x0, y1 - r, x0, y0 + r);
-  arc(x0, y0 + r, x0 + r, y0, x0 + r, y0 + r);
-  return l;
+  return roundedRectangle({x0, y0}, {x1, y1}, r);
 }
-
-Loop circleLoop(const Vec2 &c, double r, bool ccw) { return {circle(c, r, ccw, c + Vec2(r, 0))}; }
 
 /// The L of two 10 wide arms: [0,20]x[0,10] and [0,10]x[0,20].
 Loop lShape() { return polygon({{0, 0}, {20, 0}, {20, 10}, {10, 10}, {10, 20}, {0, 20}}); }
