@@ -467,7 +467,7 @@ private:
   bool milling(const Node &ws, const Node &op, const FeatureShape &s, const Plan &p, Node &moves) {
     const Node *strategy = op.child("strategy");
     std::string type = strategy ? strategy->text("type").value_or("") : "";
-    const bool face = op.kind == "plane_rough_milling" || op.kind == "plane_finish_milling" || s.unbounded;
+    const bool face = op.kind == "plane_rough_milling" || op.kind == "plane_finish_milling" || s.kind == "planar_face";
     if (type.empty())
       type = face ? "bidirectional" : "contour_parallel";
     const bool sideOnly = op.kind == "side_rough_milling" || op.kind == "side_finish_milling";
@@ -525,8 +525,22 @@ private:
             islands.push_back(geom::offset(s.islands[k].region, p.allowanceSide));
         centres = centreArea(s, s.unbounded ? s.target : s.limit, islands, p);
         paths.clear();
-        if (!centres.empty()) {
-          auto made = strategyPaths(type, face, sideOnly, centres, strokeDir, stepover, followOrientation, p.radius);
+        // Center milling, and slots exactly as wide as the tool: along the course of travel.
+        if (s.slot && (type == "center_milling" || centres.empty())) {
+          std::optional<std::vector<Seg>> line = slotCentreline(*s.slot, p);
+          if (!line) {
+            report(ws, "its tool " + p.tool->symbol + " (diameter " + formatFixed(2 * p.radius, 3) +
+                           " mm) does not fit in slot " + s.symbol + " (width " + formatFixed(s.slot->width, 3) +
+                           " mm) with the side allowance");
+            return false;
+          }
+          centres = geom::offset(s.target, -geom::kEps);  // links stay in the slot
+          paths.push_back(std::move(*line));
+        } else if (type == "center_milling") {
+          unsupported(ws, "center milling follows the course of travel of a slot; " + s.symbol + " is a " + s.kind);
+          return false;
+        } else if (!centres.empty()) {
+          auto made = strategyPaths(type, face, s.unbounded, sideOnly, centres, strokeDir, stepover, followOrientation, p.radius);
           if (!made) {
             unsupported(ws, "strategy '" + type + "' is not expanded yet");
             return false;
@@ -545,6 +559,17 @@ private:
         e.retract();
         continue;
       }
+      if (s.slot && paths.size() == 1 && !geom::Chain{paths[0]}.closed()) {
+        // One open path per level (center milling): down at the end where the
+        // level before finished, and back along it.
+        if (i > 1) {
+          Loop back{paths[0]};
+          back.reverse();
+          paths[0] = std::move(back.segs);
+        }
+        cutPath(e, paths[0], z, p, op, centres, false, false);
+        continue;
+      }
       for (size_t k = 0; k < paths.size(); ++k)
         cutPath(e, paths[k], z, p, op, centres, linkAtDepth && k > 0, s.unbounded);
     }
@@ -552,17 +577,51 @@ private:
     return true;
   }
 
+  /// The tool centre's path along a slot: its course of travel, stopped the
+  /// tool radius (and side allowance) short of flat ends, short of radiused
+  /// ends as far as the tool is narrower than the slot, and run a radius past
+  /// open ends. None when the tool is wider than the slot less its allowances.
+  static std::optional<std::vector<Seg>> slotCentreline(const FeatureShape::SlotPath &slot, const Plan &p) {
+    const double reach = p.radius + p.allowanceSide;
+    if (2 * reach > slot.width + 1e-6)
+      return std::nullopt;
+    auto inset = [&](const std::string &end) {
+      if (end == "open")
+        return -p.radius;
+      if (end == "radiused")
+        return std::max(0.0, reach - slot.width / 2);
+      return reach;
+    };
+    const Vec2 along = (slot.to - slot.from).normalized();
+    const double length = (slot.to - slot.from).norm();
+    const double in1 = inset(slot.end1), in2 = inset(slot.end2);
+    if (length - in1 - in2 < -1e-9)
+      return std::nullopt;
+    const Vec2 a = slot.from + along * in1;
+    const Vec2 b = slot.from + along * std::max(in1, length - in2);
+    return std::vector<Seg>{Seg::line(a, b)};
+  }
+
   /// The plane paths of a strategy in the centre area; none for a strategy
   /// not expanded yet.
-  std::optional<std::vector<std::vector<Seg>>> strategyPaths(const std::string &type, bool face, bool sideOnly,
+  std::optional<std::vector<std::vector<Seg>>> strategyPaths(const std::string &type, bool face, bool unbounded,
+                                                             bool sideOnly,
                                                              const Region &centres, const Vec2 &strokeDir,
                                                              double stepover, bool followOrientation,
                                                              double radius) {
     const bool strokesOnly = type == "bidirectional" || type == "unidirectional";
     if (face && strokesOnly)
       return strokes(centres, strokeDir, stepover, type == "bidirectional", radius);
-    if (sideOnly)
-      return rings(centres, stepover, followOrientation, /*all=*/false, radius);
+    if (sideOnly) {
+      // Side milling follows the walls; with no walls around (outside
+      // profiles, faces) only the rings round what stands.
+      std::vector<std::vector<Seg>> out = rings(centres, stepover, followOrientation, /*all=*/false, radius);
+      if (face || unbounded)
+        std::erase_if(out, [&](const std::vector<Seg> &ring) {
+          return (Loop{ring}.area() > 0) == followOrientation;
+        });
+      return out;
+    }
     if (type == "contour_parallel" || type == "contour_spiral")
       return rings(centres, stepover, followOrientation, /*all=*/true, radius);
     if (strokesOnly)
@@ -706,6 +765,14 @@ private:
         e.linear(at(start, z), p.feed, "link");
         linked = true;
       }
+    }
+    const Node *a = op.child("approach");
+    const bool straightDown = !a || a->text("type").value_or("plunge_toolaxis") == "plunge_toolaxis";
+    if (!linked && straightDown && e.positioned() && (e.position().head<2>() - start).norm() <= geom::kEps &&
+        e.position().z() > z) {
+      // Already over the start, in what the level above cut: straight down.
+      e.linear(at(start, z), p.plungeFeed, "plunge");
+      linked = true;
     }
     if (!linked)
       approach(e, path, z, p, op, centres);

@@ -1,5 +1,6 @@
 #include "passes/FeatureShape.h"
 
+#include "geom/Boolean.h"
 #include "ir/Kinds.h"
 #include "passes/Curves.h"
 #include "support/Format.h"
@@ -50,26 +51,35 @@ public:
 
   std::string error;
 
-  /// A closed profile (child of `owner`) as a loop in the owner's local coordinates.
-  std::optional<Loop> closedProfile(const Node &owner, double cornerRadius) {
+  /// The first profile child of `owner` (the boundary: an open pocket's wall
+  /// boundary comes after it), with the frame of its own placement within the
+  /// owner, if it has one.
+  const Node *profile(const Node &owner, std::optional<PlaneFrame> &local) {
     const Node *p = nullptr;
     for (const Node &c : owner.children)
-      if (const ir::KindSpec *k = ir::findKind(c.kind); k && k->category == "profile")
+      if (const ir::KindSpec *k = ir::findKind(c.kind); k && k->category == "profile" && !p)
         p = &c;
     if (!p) {
       fail(owner.kind + " " + owner.symbol + " has no profile");
-      return std::nullopt;
+      return nullptr;
     }
-    // A profile may have a placement of its own within the feature.
-    PlaneFrame local;
     if (p->has("at")) {
       FrameResult fr = planeFrame(*p);
       if (!fr.frame) {
         fail(fr.error);
-        return std::nullopt;
+        return nullptr;
       }
       local = *fr.frame;
     }
+    return p;
+  }
+
+  /// A closed profile (child of `owner`) as a loop in the owner's local coordinates.
+  std::optional<Loop> closedProfile(const Node &owner, double cornerRadius) {
+    std::optional<PlaneFrame> local;
+    const Node *p = profile(owner, local);
+    if (!p)
+      return std::nullopt;
     Loop l;
     if (p->kind == "rectangular_profile") {
       // Centred on the profile's origin, its length along x and its width along y.
@@ -97,7 +107,62 @@ public:
       fail("a " + p->kind + " is not a closed profile (" + owner.kind + " " + owner.symbol + ")");
       return std::nullopt;
     }
-    return p->has("at") ? mapLoop(l, local) : l;
+    return local ? mapLoop(l, *local) : l;
+  }
+
+  /// An open pocket: the area its open boundary (the walls, an open profile)
+  /// closes with the straight line between its ends, which is the open side:
+  /// beyond that line is air.
+  bool openPocket(const Node &feature, FeatureShape &s) {
+    std::optional<PlaneFrame> local;
+    const Node *p = profile(feature, local);
+    if (!p)
+      return false;
+    if (p->kind != "general_profile" || p->flag("closed").value_or(true) || p->children.empty())
+      return fail("the open boundary of pocket " + feature.symbol + " is a " + p->kind +
+                  ": an open pocket is expanded from an open general profile (its walls)");
+    CurveResult cr = curvePieces(p->children.front());
+    if (!cr.error.empty())
+      return fail("the open boundary of " + feature.symbol + ": " + cr.error);
+    Loop walls;
+    walls.segs = planarSegs(cr.pieces);
+    if (walls.segs.empty())
+      return fail("the open boundary of " + feature.symbol + " is empty");
+    if (local)
+      walls = mapLoop(walls, *local);
+    walls = mapLoop(walls, s.frame);
+    const Vec2 a = walls.segs.back().b, b = walls.segs.front().a;  // the open side, from the walls' end to their start
+    Loop l = walls;
+    l.segs.push_back(Seg::line(a, b));
+    const double area = l.area();
+    if (std::abs(area) < geom::kEps || (a - b).norm() < geom::kEps)
+      return fail("the open boundary of pocket " + feature.symbol +
+                  " encloses no area with the line between its ends");
+    s.target = outer(l);
+    // The outward side of the opening: right of a -> b when the loop runs counter-clockwise.
+    const Vec2 along = (b - a).normalized();
+    const Vec2 out = area > 0 ? Vec2(along.y(), -along.x()) : Vec2(-along.y(), along.x());
+    const Vec2 e = along * kOpenReach, o = out * kOpenReach;
+    s.limit = geom::unite(s.target, outer(geom::polygon({a - e, a - e + o, b + e + o, b + e})));
+    return true;
+  }
+
+  /// A general outside profile: the material around its boundary, out to the
+  /// raw piece's edges, is removed; the boundary stands as an island to the
+  /// feature's top. The tool may pass every outer side.
+  bool outsideProfile(const Node &feature, FeatureShape &s) {
+    std::optional<Loop> l = closedProfile(feature, 0);
+    if (!l)
+      return false;
+    const geom::Box stock = rawBox();
+    if (stock.empty())
+      return fail("general outside profile " + feature.symbol +
+                  ": its workpiece has no block raw piece to tell how much material surrounds it");
+    s.target = outer(geom::polygon(
+        {stock.lo, Vec2(stock.hi.x(), stock.lo.y()), stock.hi, Vec2(stock.lo.x(), stock.hi.y())}));
+    s.unbounded = true;
+    s.islands.push_back({feature.symbol, outer(mapLoop(*l, s.frame)), s.top});
+    return true;
   }
 
   void islands(const Node &feature, FeatureShape &s) {
@@ -203,12 +268,14 @@ public:
     else
       l.segs.push_back(Seg::line(a + n, a - n));
     s.target = outer(l);
+    s.slot = FeatureShape::SlotPath{a, b, width, std::string(*feature.text("end_1")), std::string(*feature.text("end_2"))};
+    // Open ends: the slot's width continued into the air past them.
     const Vec2 e = along * kOpenReach;
-    if (open1 || open2)
-      s.limit = outer(geom::polygon({a - n - (open1 ? e : Vec2::Zero()).eval(), b - n + (open2 ? e : Vec2::Zero()).eval(),
-                               b + n + (open2 ? e : Vec2::Zero()).eval(), a + n - (open1 ? e : Vec2::Zero()).eval()}));
-    else
-      s.limit = s.target;
+    s.limit = s.target;
+    if (open1)
+      s.limit = geom::unite(s.limit, outer(geom::polygon({a - n - e, a - n, a + n, a + n - e})));
+    if (open2)
+      s.limit = geom::unite(s.limit, outer(geom::polygon({b - n, b - n + e, b + n + e, b + n})));
     return true;
   }
 
@@ -298,11 +365,13 @@ ShapeResult featureShape(const ir::Module &module, const ir::Node &feature) {
   s.bottom = s.top - feature.number("depth").value_or(0);
   ShapeBuilder b(module, workpiece);
   bool ok = true;
-  if (feature.kind == "closed_pocket") {
+  if (feature.kind == "closed_pocket" || feature.kind == "open_pocket") {
     if (feature.text("bottom") != "planar" && feature.text("bottom") != "through")
       return {std::nullopt, "pocket " + feature.symbol + " has a " + feature.text("bottom").value_or("") +
                                 " bottom; only planar and through bottoms are expanded (plan: ball-end finishing)"};
-    if (auto l = b.closedProfile(feature, feature.number("orthogonal_radius").value_or(0))) {
+    if (feature.kind == "open_pocket") {
+      ok = b.openPocket(feature, s);
+    } else if (auto l = b.closedProfile(feature, feature.number("orthogonal_radius").value_or(0))) {
       s.target = outer(mapLoop(*l, s.frame));
       s.limit = s.target;
     }
@@ -325,10 +394,10 @@ ShapeResult featureShape(const ir::Module &module, const ir::Node &feature) {
   } else if (feature.kind == "step") {
     ok = b.step(feature, s);
     b.islands(feature, s);
+  } else if (feature.kind == "general_outside_profile") {
+    ok = b.outsideProfile(feature, s);
   } else {
-    return {std::nullopt, feature.kind + " " + feature.symbol +
-                              " is not expanded yet (plan: open pockets and outside profiles with the same "
-                              "offset machinery, material side from the raw piece)"};
+    return {std::nullopt, feature.kind + " " + feature.symbol + " is not a feature strategy expansion can cut"};
   }
   if (!ok || !b.error.empty() || s.target.empty())
     return {std::nullopt, b.error.empty() ? feature.kind + " " + feature.symbol + " has no usable outline" : b.error};

@@ -54,6 +54,14 @@ struct FeatureShape {
   /// For round holes: the axis position and the diameter.
   std::optional<geom::Vec2> holeCentre;
   double holeDiameter = 0;
+  /// For slots: the course of travel, the width, and how each end is closed
+  /// ("open", "radiused", "flat"): what center milling follows.
+  struct SlotPath {
+    geom::Vec2 from = geom::Vec2::Zero(), to = geom::Vec2::Zero();
+    double width = 0;
+    std::string end1, end2;
+  };
+  std::optional<SlotPath> slot;
 };
 
 /// The frame of a node with `at`, `axis`, `ref` (features, profiles); an error

@@ -173,13 +173,16 @@ public:
   }
 
   /// What side milling must clear: the reachable area within `band` of the
-  /// allowed area's boundary (walls and islands).
+  /// allowed area's boundary (walls and islands; only islands when unbounded).
   const Region &sideBand(const FeatureShape &s, double r, double allowance, double band,
                          const std::vector<size_t> &idx) {
     return get("band", s, {r, allowance, band}, idx, [&] {
       const Region &reach = reachable(s, r, allowance, idx);
-      if (s.unbounded)
-        return reach;
+      if (s.unbounded) {
+        // No walls: the band round what stands (nothing, on a bare face).
+        const Region &isl = islands(s, idx, allowance);
+        return isl.empty() ? Region{} : geom::intersect(reach, geom::growExact(isl, band));
+      }
       const Region inner = geom::shrinkExact(allowed(s, allowance, idx), band);
       return inner.empty() ? reach : geom::subtract(reach, inner);
     });

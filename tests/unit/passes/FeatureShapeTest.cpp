@@ -117,6 +117,62 @@ TEST_CASE("a slot with radiused ends and one with open ends", "[shape]") {
   CHECK(open.shape->limit.contains({10, 40}));  // past the open end
 }
 
+TEST_CASE("a slot open at one end and radiused at the other keeps both in its limit", "[shape]") {
+  auto r = shapeOf("    slot %s \"S\" at=(20.0000,40.0000,30.0000)mm " + kZ +
+                       " depth=5.0000mm end_1=open end_2=radiused\n      path\n        line "
+                       "at=(0.0000,0.0000,0.0000)mm dir=(1.000000,0.000000,0.000000) length=50.0000mm\n"
+                       "      rounded_u_profile width=10.0000mm\n",
+                   "%s");
+  REQUIRE(r.shape);
+  CHECK(r.shape->target.area() == Approx(500 + 12.5 * kPi).epsilon(1e-12));
+  CHECK(r.shape->limit.contains({73, 40}));       // in the radiused end
+  CHECK_FALSE(r.shape->limit.contains({76, 40}));  // past it: material
+  CHECK(r.shape->limit.contains({0, 40}));        // past the open end: air
+  REQUIRE(r.shape->slot);
+  CHECK((r.shape->slot->from - geom::Vec2(20, 40)).norm() < 1e-12);
+  CHECK((r.shape->slot->to - geom::Vec2(70, 40)).norm() < 1e-12);
+  CHECK(r.shape->slot->width == 10);
+  CHECK(r.shape->slot->end1 == "open");
+  CHECK(r.shape->slot->end2 == "radiused");
+}
+
+TEST_CASE("an open pocket is its walls closed by the open side, with air beyond", "[shape]") {
+  // Walls from (10,60) down to (10,20), across to (40,20), up to (40,60):
+  // 30 x 40 = 1200 mm2, open towards +y.
+  auto r = shapeOf("    open_pocket %p \"P\" at=(0.0000,0.0000,30.0000)mm " + kZ +
+                       " depth=8.0000mm bottom=planar\n      general_profile closed=false\n        polyline\n"
+                       "          point at=(10.0000,60.0000,0.0000)mm\n          point at=(10.0000,20.0000,0.0000)mm\n"
+                       "          point at=(40.0000,20.0000,0.0000)mm\n          point at=(40.0000,60.0000,0.0000)mm\n",
+                   "%p");
+  REQUIRE(r.shape);
+  CHECK(r.shape->target.area() == Approx(1200).epsilon(1e-12));
+  CHECK_FALSE(r.shape->unbounded);
+  CHECK(r.shape->limit.contains({25, 70}));        // past the open side
+  CHECK(r.shape->limit.contains({0, 70}));         // beside it, still beyond the open side's line
+  CHECK_FALSE(r.shape->limit.contains({5, 40}));   // behind a wall
+  CHECK_FALSE(r.shape->limit.contains({25, 15}));  // behind the bottom wall
+  // An open boundary that is one straight line encloses nothing.
+  auto flat = shapeOf("    open_pocket %p \"P\" at=(0.0000,0.0000,30.0000)mm " + kZ +
+                          " depth=8.0000mm bottom=planar\n      general_profile closed=false\n        polyline\n"
+                          "          point at=(10.0000,60.0000,0.0000)mm\n          point at=(10.0000,20.0000,0.0000)mm\n",
+                      "%p");
+  CHECK_FALSE(flat.shape);
+  CHECK(flat.error.find("encloses no area") != std::string::npos);
+}
+
+TEST_CASE("a general outside profile stands as an island in the raw piece", "[shape]") {
+  auto r = shapeOf("    general_outside_profile %o \"O\" at=(50.0000,40.0000,30.0000)mm " + kZ +
+                       " depth=10.0000mm\n      circular_profile diameter=20.0000mm\n",
+                   "%o");
+  REQUIRE(r.shape);
+  CHECK(r.shape->unbounded);
+  CHECK(r.shape->target.area() == Approx(100 * 80));
+  REQUIRE(r.shape->islands.size() == 1);
+  CHECK(r.shape->islands[0].region.area() == Approx(100 * kPi).epsilon(1e-12));
+  CHECK(r.shape->islands[0].top == 30);
+  CHECK(r.shape->bottom == 20);
+}
+
 TEST_CASE("a vee slot is reported, not guessed", "[shape]") {
   auto r = shapeOf("    slot %s \"S\" at=(20.0000,40.0000,30.0000)mm " + kZ +
                        " depth=5.0000mm end_1=open end_2=open\n      path\n        line "
