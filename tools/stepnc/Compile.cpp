@@ -1,8 +1,11 @@
-// `stepnc compile IN --emit=feature-ir`: reads a STEP-NC file, checks it
-// against its schema, lowers it to the feature IR, verifies the IR and prints
-// it. `stepnc opt IN` does the same from IR text too. Later stages (strategy
-// expansion, passes, targets) extend these commands. Nothing is written when
-// there are errors; files are written atomically.
+// `stepnc compile IN`: reads a STEP-NC file, checks it against its schema,
+// lowers it to the feature IR and verifies it; then, by --emit and --target,
+// writes the feature IR, or runs the pass pipeline and writes the toolpath IR
+// or a controller program. `stepnc opt IN` runs passes over IR text (or a
+// STEP-NC file). Nothing is written when there are errors; files are written
+// atomically.
+#include "backends/Backend.h"
+#include "backends/common/ToolTable.h"
 #include "frontend/binding/Binder.h"
 #include "frontend/lowering/Lowering.h"
 #include "frontend/part21/Part21File.h"
@@ -14,7 +17,11 @@
 #include "tools/stepnc/Driver.h"
 #include "tools/stepnc/SchemaSelection.h"
 
+#include "support/Format.h"
+
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <filesystem>
 #include <iostream>
 
 namespace stepnc::tool {
@@ -27,8 +34,15 @@ constexpr std::string_view kToolpathPipeline = "resolve-feeds,expand-strategies,
 struct CompileOptions {
   std::string input;
   std::string output = "-";
-  std::string emit = "feature-ir";
+  std::string emit;  ///< feature-ir, toolpath-ir or program; empty: program with --target, else feature-ir
   bool printLocations = false;
+  // compile only: the controller target
+  std::string target;
+  std::string toolTable;
+  bool noCycles = false;
+  std::optional<double> tolerance;
+  std::vector<std::string> targetOptions;
+  bool listTargets = false;
   // opt only
   std::string passes;
   std::vector<std::string> printAfter;
@@ -91,7 +105,57 @@ int writeText(const std::string &path, const std::string &text) {
   return kExitOk;
 }
 
+std::string targetList();
+
+/// The program name: the output file's stem, else the input's.
+std::string programName(const CompileOptions &opts) {
+  const std::string &from = opts.output != "-" ? opts.output : opts.input;
+  return std::filesystem::path(from).stem().string();
+}
+
+/// The options that shaped a program, for its header.
+std::string optionsText(const CompileOptions &opts) {
+  std::string text;
+  auto add = [&](const std::string &part) { text += (text.empty() ? "" : " ") + part; };
+  if (!opts.passes.empty())
+    add("--passes=" + opts.passes);
+  if (!opts.toolTable.empty())
+    add("--tool-table " + opts.toolTable);
+  if (opts.noCycles)
+    add("--no-cycles");
+  if (opts.tolerance)
+    add("--tolerance " + formatShortest(*opts.tolerance));
+  for (const std::string &o : opts.targetOptions)
+    add("--target-opt " + o);
+  return text;
+}
+
 int runCompile(const CompileOptions &opts) {
+  const std::string emit = !opts.emit.empty() ? opts.emit : opts.target.empty() ? "feature-ir" : "program";
+  std::unique_ptr<backends::Backend> backend;
+  if (emit == "program") {
+    if (opts.target.empty()) {
+      printToolError("compile: --emit=program needs a --target (" + targetList() + ")");
+      return kExitUsage;
+    }
+    backend = backends::createBackend(opts.target);
+    if (!backend) {
+      printToolError("compile: unknown target '" + opts.target + "' (" + targetList() + ")");
+      return kExitUsage;
+    }
+    if (opts.tolerance && !(*opts.tolerance > 0 && *opts.tolerance < 10)) {
+      printToolError("compile: --tolerance " + formatShortest(*opts.tolerance) +
+                     " is not a contour tolerance: give a number of mm above 0 and below 10, such as 0.01");
+      return kExitUsage;
+    }
+    std::vector<std::string> overrides = opts.targetOptions;
+    if (opts.noCycles)
+      overrides.push_back("cycles=off");
+    if (std::string error = backends::applyOverrides(backend->descriptor(), overrides); !error.empty()) {
+      printToolError("compile: " + error);
+      return kExitUsage;
+    }
+  }
   auto source = openInput(opts.input);
   if (!source)
     return kExitUsage;
@@ -110,9 +174,10 @@ int runCompile(const CompileOptions &opts) {
     std::cerr << "stepnc: " << opts.input << " has errors; nothing written\n";
     return kExitDiagnostics;
   }
-  // The toolpath IR is the feature IR after the passes that make and check moves.
+  // The toolpath IR is the feature IR after the passes that make and check
+  // moves; a program is written from the toolpath IR.
   const std::string pipelineText =
-      opts.emit == "toolpath-ir" && opts.passes.empty() ? std::string(kToolpathPipeline) : opts.passes;
+      emit != "feature-ir" && opts.passes.empty() ? std::string(kToolpathPipeline) : opts.passes;
   if (!pipelineText.empty() || opts.listPasses) {
     std::string error;
     auto pipeline = passes::parsePipeline(pipelineText, error);
@@ -137,9 +202,53 @@ int runCompile(const CompileOptions &opts) {
       return kExitDiagnostics;
     }
   }
+  if (backend) {
+    std::optional<backends::ToolTable> table;
+    std::unique_ptr<SourceFile> tableFile;
+    if (!opts.toolTable.empty()) {
+      tableFile = openInput(opts.toolTable);
+      if (!tableFile)
+        return kExitUsage;
+      table = backends::ToolTable::parse(*tableFile, diags);
+      if (!table) {
+        std::cerr << "stepnc: the tool table " << opts.toolTable << " has errors; nothing written\n";
+        return kExitDiagnostics;
+      }
+    }
+    backends::EmitOptions emitOptions;
+    emitOptions.source = std::filesystem::path(opts.input).filename().string();
+    emitOptions.programName = programName(opts);
+    emitOptions.optionsText = optionsText(opts);
+    emitOptions.tolerance = opts.tolerance;
+    emitOptions.toolTable = table ? &*table : nullptr;
+    std::optional<std::string> program = backend->emit(*module, emitOptions, diags);
+    if (!program || diags.hasErrors()) {
+      std::cerr << "stepnc: cannot write a " << opts.target << " program for " << opts.input << "; nothing written\n";
+      return kExitDiagnostics;
+    }
+    const int rc = writeText(opts.output, *program);
+    if (rc == kExitOk && opts.output != "-")
+      std::cerr << "stepnc: wrote " << opts.output << " (" << opts.target << ", "
+                << std::count(program->begin(), program->end(), '\n') << " lines)\n";
+    return rc;
+  }
   ir::PrintOptions printOptions;
   printOptions.locations = opts.printLocations;
   return writeText(opts.output, ir::printModule(*module, printOptions));
+}
+
+std::string targetList() {
+  std::string names;
+  for (const backends::TargetInfo &t : backends::registeredTargets())
+    names += (names.empty() ? "" : ", ") + std::string(t.name);
+  return "targets: " + names;
+}
+
+int listTargets() {
+  for (const backends::TargetInfo &t : backends::registeredTargets())
+    std::cout << t.name << "\n    " << t.description << '\n';
+  std::cout.flush();
+  return kExitOk;
 }
 
 int listPasses() {
@@ -194,16 +303,34 @@ void registerCompile(CLI::App &app, std::function<void(int)> setResult) {
   auto opts = std::make_shared<CompileOptions>();
   CLI::App *cmd = app.add_subcommand(
       "compile", "Compile a STEP-NC file: read it, check it against its schema, lower it to the\n"
-                 "process IR and write the result: the feature IR (--emit=feature-ir, the default)\n"
-                 "or the toolpath IR (--emit=toolpath-ir: resolve-feeds, expand-strategies and\n"
-                 "verify-toolpaths run over it); controller programs come next.\n"
-                 "Nothing is written when the input has errors.");
-  cmd->add_option("input", opts->input, "STEP-NC file (Part 21)")->required();
+                 "process IR, run resolve-feeds, expand-strategies and verify-toolpaths, and write\n"
+                 "a controller program for --target (or stop early with --emit). Without --target\n"
+                 "the feature IR is written. Nothing is written when the input has errors.");
+  cmd->add_option("input", opts->input, "STEP-NC file (Part 21)");
+  cmd->add_option("--target", opts->target, "Controller to write for: siemens-840d, heidenhain-tnc, rs274 "
+                                            "(--list-targets)");
   cmd->add_option("--emit", opts->emit,
-                  "What to write: feature-ir (the lowered process IR) or toolpath-ir (with moves, verified)")
-      ->check(CLI::IsMember({"feature-ir", "toolpath-ir"}))
-      ->default_str("feature-ir");
+                  "What to write: program (with --target, the default then), feature-ir (the lowered\n"
+                  "process IR; the default without --target) or toolpath-ir (with moves, verified)")
+      ->check(CLI::IsMember({"feature-ir", "toolpath-ir", "program"}));
+  cmd->add_option("--tool-table", opts->toolTable,
+                  "Tool numbers and lengths by STEP-NC tool id (docs/tool-table.md); without one,\n"
+                  "tools are numbered in order of first use");
+  cmd->add_flag("--no-cycles", opts->noCycles, "Write hole making as moves, not as the controller's canned cycles");
+  cmd->add_option("--tolerance", opts->tolerance, "Contour tolerance for the controller's path mode, mm");
+  cmd->add_option("--target-opt", opts->targetOptions,
+                  "Override a target capability, key=value (repeatable): " + backends::overrideHelp());
+  cmd->add_flag("--list-targets", opts->listTargets, "List the controller targets and exit");
   addCommonOptions(*cmd, opts, setResult);
+  cmd->callback([opts, setResult] {
+    if (opts->listTargets)
+      return setResult(listTargets());
+    if (opts->input.empty()) {
+      printToolError("compile: an input file is required");
+      return setResult(kExitUsage);
+    }
+    setResult(runCompile(*opts));
+  });
 }
 
 } // namespace stepnc::tool

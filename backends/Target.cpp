@@ -1,0 +1,53 @@
+#include "backends/Target.h"
+
+#include <charconv>
+
+namespace stepnc::backends {
+
+namespace {
+
+bool parseInt(const std::string &text, long lo, long hi, long &out) {
+  const char *end = text.data() + text.size();
+  auto [p, ec] = std::from_chars(text.data(), end, out);
+  return ec == std::errc() && p == end && out >= lo && out <= hi;
+}
+
+} // namespace
+
+std::string overrideHelp() {
+  return "decimals=N (coordinates, 0..6), line-numbers=none|every, number-step=N, "
+         "max-line-length=N (0: none), arcs=ijk|radius, cycles=on|off";
+}
+
+std::string applyOverrides(TargetDescriptor &d, const std::vector<std::string> &overrides) {
+  for (const std::string &o : overrides) {
+    const size_t eq = o.find('=');
+    if (eq == std::string::npos)
+      return "--target-opt '" + o + "' is not key=value (" + overrideHelp() + ")";
+    const std::string key = o.substr(0, eq), value = o.substr(eq + 1);
+    long n = 0;
+    if (key == "decimals" && parseInt(value, 0, 6, n)) {
+      d.coordDecimals = static_cast<int>(n);
+    } else if (key == "line-numbers" && (value == "none" || value == "every")) {
+      if (d.numbering == Numbering::FromZero)
+        return "--target-opt line-numbers: " + d.name + " numbers every block from 0; it cannot be changed";
+      d.numbering = value == "none" ? Numbering::None : Numbering::Every;
+    } else if (key == "number-step" && parseInt(value, 1, 1000, n)) {
+      d.numberStep = static_cast<int>(n);
+    } else if (key == "max-line-length" && parseInt(value, 0, 100000, n)) {
+      d.maxLineLength = static_cast<size_t>(n);
+    } else if (key == "arcs" && (value == "ijk" || value == "radius")) {
+      if (d.arcs == ArcForm::ModalCentre)
+        return "--target-opt arcs: " + d.name + " writes arcs with a centre block (CC); it cannot be changed";
+      d.arcs = value == "ijk" ? ArcForm::IncrementalCentre : ArcForm::Radius;
+    } else if (key == "cycles" && (value == "on" || value == "off")) {
+      if (value == "off")
+        d.cycles.clear();
+    } else {
+      return "--target-opt '" + o + "' is not understood (" + overrideHelp() + ")";
+    }
+  }
+  return "";
+}
+
+} // namespace stepnc::backends

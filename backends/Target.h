@@ -1,0 +1,56 @@
+// What a controller can do, chosen per target and overridable from the
+// command line (`--target-opt key=value`). Emitters read the descriptor
+// instead of hard-coding a dialect's choices, so one G-code emitter core
+// (common/) serves every target and a new target is a descriptor plus the
+// words that are its own.
+#pragma once
+
+#include <set>
+#include <string>
+#include <vector>
+
+namespace stepnc::backends {
+
+/// How an arc's centre is written.
+enum class ArcForm {
+  IncrementalCentre,  ///< I J K from the start point (RS274, 840D)
+  Radius,             ///< radius word, negative beyond 180 deg (R, CR=); no full circles
+  ModalCentre,        ///< centre block then the end point (Heidenhain CC + C)
+};
+
+enum class Numbering {
+  None,      ///< no block numbers
+  Every,     ///< N10, N20, ... (the step is `numberStep`)
+  FromZero,  ///< 0, 1, 2, ... on every line (Heidenhain)
+};
+
+/// Canned cycles a controller has, by what they do.
+enum class CycleKind { Drill, Peck, Bore, Tap };
+
+struct TargetDescriptor {
+  std::string name;         ///< as given to --target
+  std::string description;  ///< one line, for --list-targets
+  std::string extension;    ///< of the program file, with its dot
+  ArcForm arcs = ArcForm::IncrementalCentre;
+  bool helix = true;         ///< helical arcs (a z change along an arc) in one block
+  bool helixTurns = true;    ///< several turns of a helix in one block
+  std::set<CycleKind> cycles;  ///< canned cycles used when they reproduce the planned moves
+  Numbering numbering = Numbering::None;
+  int numberStep = 10;
+  size_t maxLineLength = 0;  ///< 0: no limit
+  int coordDecimals = 3;     ///< X Y Z I J K and radii, mm
+  int feedDecimals = 0;      ///< mm/min
+  int speedDecimals = 0;     ///< rev/min
+  double tolerance = 0.01;   ///< contour tolerance for the path mode (mm), --tolerance overrides
+};
+
+/// Applies `key=value` overrides (--target-opt) to a descriptor: decimals,
+/// line-numbers (none|every), number-step, max-line-length, arcs
+/// (ijk|radius), cycles (on|off). Returns an error message, or "" when all
+/// applied.
+std::string applyOverrides(TargetDescriptor &d, const std::vector<std::string> &overrides);
+
+/// The overrides applyOverrides understands, one per line, for --help.
+std::string overrideHelp();
+
+} // namespace stepnc::backends

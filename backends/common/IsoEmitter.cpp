@@ -1,0 +1,182 @@
+#include "backends/common/IsoEmitter.h"
+
+#include "support/Format.h"
+
+#include <cmath>
+#include <numbers>
+
+namespace stepnc::backends {
+
+std::vector<std::string> headerLines(const Program &p, const EmitOptions &o, const TargetDescriptor &d) {
+  std::vector<std::string> lines;
+  lines.push_back("stepnc: " + p.name + " from " + o.source);
+  lines.push_back("target " + d.name + (o.optionsText.empty() ? "" : ", options " + o.optionsText));
+  lines.push_back("units mm, feeds mm/min, spindle rev/min, workpiece coordinates (set the work offset to the "
+                  "workpiece origin)");
+  if (p.toolsFromTable)
+    lines.push_back("tool numbers and lengths from the tool table");
+  else
+    lines.push_back("no tool table: tools numbered in order of first use");
+  for (const ToolCall &t : p.tools)
+    lines.push_back(word("T", std::to_string(t.number)) + " " + t.label + ", diameter " + formatFixed(t.diameter, 3) +
+                    " mm" + (t.length ? ", length " + formatFixed(*t.length, 3) + " mm" : ""));
+  return lines;
+}
+
+std::optional<std::string> IsoEmitter::run(const Program &p) {
+  program_ = &p;
+  header(p);
+  for (const Step &s : p.steps) {
+    switch (s.kind) {
+    case Step::Kind::Message:
+      message(s.label);
+      continue;
+    case Step::Kind::Stop:
+    case Step::Kind::OptionalStop:
+      stop(s.kind == Step::Kind::OptionalStop);
+      continue;
+    case Step::Kind::Moves:
+      break;
+    }
+    out_.block(comment(s.label));
+    if (s.tool >= 0 && s.tool != tool_) {
+      toolChange(p.tools[static_cast<size_t>(s.tool)]);
+      tool_ = s.tool;
+      spindle_ = 0;  // a tool change stops the spindle
+      // Where the tool change left the axes is the machine's business: the
+      // first move writes every axis and the feed again.
+      for (const char *w : {"G", "X", "Y", "Z", "F"})
+        modal_.forget(w);
+    }
+    if (s.spindle != 0 && s.spindle != spindle_) {
+      out_.block(spindle(s.spindle));
+      spindle_ = s.spindle;
+    }
+    if (s.coolant != coolant_) {
+      out_.block(coolant(s.coolant));
+      coolant_ = s.coolant;
+    }
+    if (s.cycle && d_.cycles.count(s.cycle->kind) && cycle(s, *s.cycle))
+      continue;
+    for (const Move &m : s.moves)
+      move(m);
+  }
+  footer(p);
+  for (size_t line : out_.overlong())
+    diags_.error(SourceLoc{}, "line " + std::to_string(line) + " of the " + d_.name + " program is longer than " +
+                 std::to_string(d_.maxLineLength) + " characters, the most the controller reads");
+  if (!out_.overlong().empty())
+    return std::nullopt;
+  return out_.text();
+}
+
+std::string IsoEmitter::spindle(double rpm) const {
+  return word("S", formatNumber(std::abs(rpm), {d_.speedDecimals, false, false})) + (rpm < 0 ? " M3" : " M4");
+}
+
+std::string IsoEmitter::coolant(const std::string &kind) const {
+  if (kind == "flood" || kind == "through_tool")
+    return "M8";
+  if (kind == "mist")
+    return "M7";
+  return "M9";
+}
+
+std::string IsoEmitter::radiusWord(double signedRadius) const { return word("R", num(signedRadius)); }
+
+void IsoEmitter::stop(bool optional) { out_.block(optional ? "M1" : "M0"); }
+
+std::string IsoEmitter::axes(const Vec3 &to, bool forceXY) {
+  std::string words;
+  const char *names[3] = {"X", "Y", "Z"};
+  for (int k = 0; k < 3; ++k) {
+    const std::string v = num(to[k]);
+    if (modal_.change(names[k], v) || (forceXY && k < 2)) {
+      if (!words.empty())
+        words += ' ';
+      words += names[k] + v;
+    }
+  }
+  return words;
+}
+
+std::string IsoEmitter::feedWord(double feed) {
+  const std::string f = formatNumber(feed, {d_.feedDecimals, false, true});
+  return modal_.change("F", f) ? " F" + f : "";
+}
+
+void IsoEmitter::assumeAt(const Vec3 &p) {
+  modal_.forget("G");
+  const char *names[3] = {"X", "Y", "Z"};
+  for (int k = 0; k < 3; ++k) {
+    modal_.forget(names[k]);
+    modal_.change(names[k], num(p[k]));
+  }
+}
+
+void IsoEmitter::positionFor(const Step &s) {
+  for (const Move &m : s.moves) {
+    if (m.role == "approach")
+      break;
+    move(m);
+  }
+}
+
+void IsoEmitter::move(const Move &m) {
+  if (m.kind == Move::Kind::Arc) {
+    arc(m);
+    return;
+  }
+  const std::string g = m.kind == Move::Kind::Rapid ? "G0" : "G1";
+  // Which axes change as printed; a move that prints as no motion is left out.
+  std::string words = axes(m.to);
+  if (words.empty())
+    return;
+  std::string text = modal_.change("G", g) ? g + " " + words : words;
+  if (m.kind == Move::Kind::Linear)
+    text += feedWord(m.feed);
+  out_.block(text);
+}
+
+void IsoEmitter::arc(const Move &m) {
+  const double sweep = m.sweep();
+  const Vec3 from(roundTo(m.from.x(), d_.coordDecimals), roundTo(m.from.y(), d_.coordDecimals), m.from.z());
+  // Pieces: the radius form takes less than half a turn per block; a target
+  // without multi-turn helices takes at most one turn per block.
+  int pieces = 1;
+  if (d_.arcs == ArcForm::Radius)
+    pieces = static_cast<int>(std::floor(sweep / std::numbers::pi + 1e-9)) + 1;
+  else if (!d_.helixTurns && m.turns > 0)
+    pieces = static_cast<int>(m.turns) + 1;
+  const bool oneBlockTurns = pieces == 1 && m.turns > 0;
+  std::vector<geom::Vec2> ends = arcSplitPoints(m.from.head<2>(), m.centre, m.ccw, sweep, pieces);
+  ends.back() = m.to.head<2>();
+  geom::Vec2 start = from.head<2>();
+  for (int k = 0; k < pieces; ++k) {
+    const double z = m.from.z() + (m.to.z() - m.from.z()) * (k + 1) / pieces;
+    const Vec3 to(ends[k].x(), ends[k].y(), z);
+    const geom::Vec2 printedTo(roundTo(to.x(), d_.coordDecimals), roundTo(to.y(), d_.coordDecimals));
+    const std::string g = m.ccw ? "G3" : "G2";
+    std::string text = modal_.change("G", g) ? g + " " : "";
+    text += axes(to, /*forceXY=*/true);
+    if (d_.arcs == ArcForm::Radius) {
+      const double r = (m.centre - m.from.head<2>()).norm();
+      const double pieceSweep = sweep / pieces;
+      text += ' ';
+      text += radiusWord(pieceSweep > std::numbers::pi ? -r : r);
+    } else {
+      const geom::Vec2 c = balancedCentre(start, printedTo, m.centre);
+      text += word(" I", num(c.x() - start.x())) + word(" J", num(c.y() - start.y()));
+    }
+    if (oneBlockTurns) {
+      const std::string w = turnsWord(m.turns);
+      if (!w.empty())
+        text += word(" ", w);
+    }
+    text += feedWord(m.feed);
+    out_.block(text);
+    start = printedTo;
+  }
+}
+
+} // namespace stepnc::backends

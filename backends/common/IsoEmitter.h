@@ -1,0 +1,81 @@
+// The emitter core for ISO 6983-style dialects (RS274/LinuxCNC, Siemens
+// 840D): G0/G1/G2/G3 with axis words, written only when they change, arcs by
+// the descriptor's centre form (split where the form cannot take them whole),
+// helices, tool calls, spindle, coolant and canned cycles through hooks that
+// each dialect fills in with its own words.
+#pragma once
+
+#include "backends/Backend.h"
+#include "backends/common/Program.h"
+#include "backends/common/Words.h"
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace stepnc::backends {
+
+/// The comment lines every program starts with: the source, the target and
+/// its options, how tools were numbered, and the tools. No dates.
+std::vector<std::string> headerLines(const Program &p, const EmitOptions &o, const TargetDescriptor &d);
+
+class IsoEmitter {
+public:
+  IsoEmitter(const TargetDescriptor &d, const EmitOptions &o, DiagnosticEngine &diags)
+      : d_(d), o_(o), diags_(diags), out_(d) {}
+  virtual ~IsoEmitter() = default;
+
+  /// The program text; nullopt after reporting errors.
+  std::optional<std::string> run(const Program &p);
+
+protected:
+  // --- The dialect's words -----------------------------------------------------
+  virtual void header(const Program &p) = 0;
+  virtual void footer(const Program &p) = 0;
+  /// A comment block.
+  virtual std::string comment(const std::string &text) const = 0;
+  virtual void toolChange(const ToolCall &t) = 0;
+  /// "S.. M3" for a signed speed (negative: clockwise, M3).
+  virtual std::string spindle(double rpm) const;
+  /// "M8", "M7", "M9"...
+  virtual std::string coolant(const std::string &kind) const;
+  /// The word that makes an arc block turn `turns` more full turns (toolpath
+  /// IR rule), or "" when the target has none (helixTurns false).
+  virtual std::string turnsWord(int64_t turns) const = 0;
+  /// The radius word of the radius arc form ("R-12.5", "CR=12.5").
+  virtual std::string radiusWord(double signedRadius) const;
+  /// Writes `c` as the controller's canned cycle; false when the cycle would
+  /// not make exactly the planned moves (the moves are written instead).
+  virtual bool cycle(const Step &s, const HoleCycle &c) = 0;
+  virtual void message(const std::string &text) = 0;
+  virtual void stop(bool optional);
+
+  // --- Shared machinery ------------------------------------------------------------
+  void move(const Move &m);
+  /// Axis words for the coordinates that changed, e.g. "X10.5 Z-2.".
+  std::string axes(const Vec3 &to, bool forceXY = false);
+  std::string num(double v) const { return formatNumber(v, {d_.coordDecimals, false, true}); }
+  std::string feedWord(double feed);
+  /// Tells the modal state where the tool is after something it did not see
+  /// (a cycle), and that the motion word must be written again.
+  void assumeAt(const Vec3 &p);
+  double tolerance() const { return o_.tolerance.value_or(d_.tolerance); }
+  /// Writes the position moves of a cycle step (to the hole at the security
+  /// plane), before the cycle block.
+  void positionFor(const Step &s);
+
+  const TargetDescriptor &d_;
+  const EmitOptions &o_;
+  DiagnosticEngine &diags_;
+  BlockWriter out_;
+  ModalState modal_;
+  const Program *program_ = nullptr;
+
+private:
+  void arc(const Move &m);
+  int tool_ = -1;
+  double spindle_ = 0;
+  std::string coolant_ = "off";
+};
+
+} // namespace stepnc::backends

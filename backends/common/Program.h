@@ -1,0 +1,85 @@
+// The program every backend writes, flattened from the toolpath IR: the tools
+// with their numbers, and in execution order each step's tool, spindle,
+// coolant and moves, with hole-making steps also described as a canned cycle
+// when their moves are one. Emitters only choose words; what to do was
+// decided by the passes.
+#pragma once
+
+#include "backends/Target.h"
+#include "backends/common/ToolTable.h"
+#include "geom/Geometry.h"
+#include "ir/Node.h"
+#include "support/Diagnostics.h"
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace stepnc::backends {
+
+using Vec3 = ir::Vec3;
+
+struct ToolCall {
+  const ir::Node *node = nullptr;
+  std::string label;  ///< its STEP-NC id (or symbol)
+  int number = 0;     ///< T number: from the tool table, else order of first use
+  std::optional<double> length;  ///< length offset from the tool table, mm
+  double diameter = 0;
+};
+
+struct Move {
+  enum class Kind { Rapid, Linear, Arc } kind = Kind::Rapid;
+  Vec3 from = Vec3::Zero();  ///< where the tool is before the move
+  Vec3 to = Vec3::Zero();
+  geom::Vec2 centre = geom::Vec2::Zero();  ///< arcs: the axis through the centre, parallel to z
+  bool ccw = false;
+  int64_t turns = 0;  ///< arcs: full turns before the last arc (toolpath IR rule)
+  double feed = 0;    ///< mm/min; 0 for rapids
+  std::string role;
+  const ir::Node *node = nullptr;
+
+  /// The whole angle an arc sweeps (radians, > 0), full turns included; a
+  /// last arc ending over its start is a whole turn.
+  double sweep() const;
+};
+
+/// A hole-making step whose moves are one axial cycle on one position.
+struct HoleCycle {
+  CycleKind kind = CycleKind::Drill;
+  geom::Vec2 at = geom::Vec2::Zero();
+  double initialZ = 0;  ///< where the tool is before and after (the security plane)
+  double retractZ = 0;  ///< the reference plane R: where feeding starts (clearance height)
+  double surfaceZ = 0;  ///< the top of the hole
+  double depthZ = 0;    ///< the lowest point of the tool tip
+  std::vector<double> pecks;  ///< the bottom of each feed in (the last is depthZ)
+  double feed = 0;      ///< in, mm/min
+  double feedOut = 0;   ///< out (bore, tap), mm/min; 0 for drills (rapid out)
+};
+
+struct Step {
+  enum class Kind { Moves, Message, Stop, OptionalStop } kind = Kind::Moves;
+  const ir::Node *exec = nullptr;
+  std::string label;    ///< the workingstep's id, or the message
+  std::string operation;  ///< the operation's kind ("drilling"), or empty
+  int tool = -1;          ///< index into Program::tools
+  double spindle = 0;     ///< rev/min, negative clockwise (M3); 0 on a rapid movement: keep
+  std::string coolant;    ///< off, flood, mist, through_tool
+  double secplane = 0;
+  std::vector<Move> moves;
+  std::optional<HoleCycle> cycle;
+};
+
+struct Program {
+  std::string name;  ///< the project's id
+  std::vector<ToolCall> tools;
+  bool toolsFromTable = false;
+  std::vector<Step> steps;
+  /// The block raw piece of the (first) workpiece, workpiece coordinates.
+  std::optional<std::pair<Vec3, Vec3>> blank;
+};
+
+/// The program of `module` (toolpath IR). Errors: an executable without
+/// moves, a tool missing from the table. Returns nullopt after reporting.
+std::optional<Program> buildProgram(const ir::Module &module, const ToolTable *table, DiagnosticEngine &diags);
+
+} // namespace stepnc::backends

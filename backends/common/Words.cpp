@@ -1,0 +1,97 @@
+#include "backends/common/Words.h"
+
+#include "support/Format.h"
+
+#include <cmath>
+
+namespace stepnc::backends {
+
+std::string word(std::string_view address, std::string_view value) {
+  std::string s;
+  s.reserve(address.size() + value.size());
+  s.append(address).append(value);
+  return s;
+}
+
+double roundTo(double value, int decimals) {
+  const double scale = std::pow(10.0, decimals);
+  const double r = std::round(value * scale) / scale;
+  return r == 0 ? 0.0 : r;  // no -0
+}
+
+std::string formatNumber(double value, const NumberStyle &style) {
+  std::string s = formatFixed(roundTo(value, style.decimals), style.decimals);
+  if (s.find('.') != std::string::npos) {
+    while (s.back() == '0')
+      s.pop_back();
+    if (s.back() == '.' && !style.keepPoint)
+      s.pop_back();
+  } else if (style.keepPoint) {
+    s += '.';
+  }
+  if (s == "-0" || s == "-0.")
+    s.erase(0, 1);
+  if (style.plusSign && s.front() != '-')
+    s.insert(s.begin(), '+');
+  return s;
+}
+
+void BlockWriter::block(const std::string &text) {
+  switch (d_.numbering) {
+  case Numbering::None:
+    put(text);
+    break;
+  case Numbering::Every:
+    put(word("N", std::to_string((blocks_ + 1) * d_.numberStep)) + " " + text);
+    break;
+  case Numbering::FromZero:
+    put(std::to_string(blocks_) + " " + text);
+    break;
+  }
+  ++blocks_;
+}
+
+void BlockWriter::raw(const std::string &text) { put(text); }
+
+void BlockWriter::put(const std::string &line) {
+  ++lines_;
+  if (d_.maxLineLength > 0 && line.size() > d_.maxLineLength)
+    overlong_.push_back(lines_);
+  text_ += line;
+  text_ += '\n';
+}
+
+bool ModalState::change(const std::string &word, const std::string &value) {
+  auto [it, inserted] = last_.try_emplace(word, value);
+  if (inserted)
+    return true;
+  if (it->second == value)
+    return false;
+  it->second = value;
+  return true;
+}
+
+geom::Vec2 balancedCentre(const geom::Vec2 &from, const geom::Vec2 &to, const geom::Vec2 &centre) {
+  const geom::Vec2 chord = to - from;
+  const double len = chord.norm();
+  if (len < 1e-12)
+    return centre;
+  // Project the centre onto the chord's perpendicular bisector.
+  const geom::Vec2 mid = (from + to) / 2;
+  const geom::Vec2 along = chord / len;
+  return centre - along * (centre - mid).dot(along);
+}
+
+std::vector<geom::Vec2> arcSplitPoints(const geom::Vec2 &from, const geom::Vec2 &centre, bool ccw, double sweep,
+                                       int pieces) {
+  std::vector<geom::Vec2> out;
+  const geom::Vec2 r = from - centre;
+  for (int k = 1; k <= pieces; ++k) {
+    const double a = (ccw ? 1 : -1) * sweep * k / pieces;
+    out.emplace_back(centre + geom::Vec2(r.x() * std::cos(a) - r.y() * std::sin(a),
+                                         r.x() * std::sin(a) + r.y() * std::cos(a)));
+  }
+  return out;
+}
+
+} // namespace stepnc::backends

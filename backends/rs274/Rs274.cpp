@@ -1,0 +1,143 @@
+// RS274NGC as LinuxCNC's interpreter reads it (LinuxCNC 2.9). The program is
+// checked in the test suite by LinuxCNC's own `rs274`: it must run without
+// error and make the planned moves (backends/rs274/README.md).
+#include "backends/Backend.h"
+#include "backends/common/IsoEmitter.h"
+
+#include <cmath>
+
+namespace stepnc::backends {
+
+namespace {
+
+TargetDescriptor rs274Descriptor() {
+  TargetDescriptor d;
+  d.name = "rs274";
+  d.description = "RS274NGC as LinuxCNC reads it";
+  d.extension = ".ngc";
+  d.arcs = ArcForm::IncrementalCentre;
+  d.helix = true;
+  d.helixTurns = true;  // P: number of turns
+  d.cycles = {CycleKind::Drill, CycleKind::Peck, CycleKind::Bore};
+  d.numbering = Numbering::None;
+  d.maxLineLength = 254;  // LinuxCNC rejects lines of 255 characters or more
+  d.coordDecimals = 4;
+  d.feedDecimals = 1;
+  d.speedDecimals = 0;
+  d.tolerance = 0.01;
+  return d;
+}
+
+/// LinuxCNC's G83 backs off this far above the previous peck before feeding again (0.010 in).
+constexpr double kG83Delta = 0.254;
+
+class Rs274Emitter final : public IsoEmitter {
+public:
+  using IsoEmitter::IsoEmitter;
+
+private:
+  std::string comment(const std::string &text) const override {
+    // Parentheses end a comment: keep the text to what a comment may hold.
+    std::string t;
+    for (char c : text)
+      t += c == '(' || c == ')' ? '_' : c;
+    return "(" + t + ")";
+  }
+
+  void header(const Program &p) override {
+    out_.raw("%");
+    for (const std::string &line : headerLines(p, o_, d_))
+      out_.block(comment(line));
+    out_.block("G17 G21 G90 G94 G40 G49 G80");
+    out_.block("G64 P" + num(tolerance()));
+  }
+
+  void footer(const Program &) override {
+    out_.block("M5 M9");
+    out_.block("M2");
+    out_.raw("%");
+  }
+
+  void toolChange(const ToolCall &t) override {
+    out_.block(word("T", std::to_string(t.number)) + " M6");
+    out_.block("G43 H" + std::to_string(t.number));
+  }
+
+  std::string turnsWord(int64_t turns) const override { return word("P", std::to_string(turns + 1)); }
+
+  void message(const std::string &text) override { out_.block(comment("MSG," + text)); }
+
+  bool cycle(const Step &s, const HoleCycle &c) override {
+    // G98: back to the height before the cycle, the security plane.
+    std::string words;
+    const std::string xyzr = word("X", num(c.at.x())) + " Y" + num(c.at.y()) + " Z" + num(c.depthZ) + " R" +
+                             num(c.retractZ);
+    switch (c.kind) {
+    case CycleKind::Drill:
+      words = "G98 G81 " + xyzr;
+      break;
+    case CycleKind::Bore:
+      // G85 feeds out at the feed in.
+      if (std::abs(c.feedOut - c.feed) > 1e-9)
+        return false;
+      words = "G98 G85 " + xyzr;
+      break;
+    case CycleKind::Peck: {
+      // G83 pecks Q deep from R, each time out to R and back to just above
+      // the last depth: only when the plan pecks the same way.
+      if (c.pecks.size() < 2)
+        return false;
+      const double q = c.retractZ - c.pecks.front();
+      for (size_t k = 0; k < c.pecks.size(); ++k) {
+        const double expected = std::max(c.retractZ - q * static_cast<double>(k + 1), c.depthZ);
+        if (std::abs(expected - c.pecks[k]) > 1e-6)
+          return false;
+      }
+      if (!pecksReapproach(s, c))
+        return false;
+      words = "G98 G83 " + xyzr + " Q" + num(q);
+      break;
+    }
+    case CycleKind::Tap:
+      return false;
+    }
+    positionFor(s);
+    modal_.forget("F");
+    out_.block(words + feedWord(c.feed));
+    out_.block("G80");
+    assumeAt(Vec3(c.at.x(), c.at.y(), c.initialZ));
+    return true;
+  }
+
+  /// Whether the plan goes back down between pecks to where G83 does.
+  static bool pecksReapproach(const Step &s, const HoleCycle &c) {
+    size_t peck = 0;
+    for (size_t i = 1; i < s.moves.size(); ++i)
+      if (s.moves[i].role == "approach" && s.moves[i - 1].role == "retract" &&
+          s.moves[i - 1].kind == Move::Kind::Rapid) {
+        if (peck >= c.pecks.size() || std::abs(s.moves[i].to.z() - (c.pecks[peck] + kG83Delta)) > 1e-6)
+          return false;
+        ++peck;
+      }
+    return true;
+  }
+};
+
+class Rs274Backend final : public Backend {
+public:
+  Rs274Backend() : Backend(rs274Descriptor()) {}
+
+  std::optional<std::string> emit(const ir::Module &module, const EmitOptions &options,
+                                   DiagnosticEngine &diags) override {
+    auto program = buildProgram(module, options.toolTable, diags);
+    if (!program)
+      return std::nullopt;
+    return Rs274Emitter(descriptor(), options, diags).run(*program);
+  }
+};
+
+} // namespace
+
+std::unique_ptr<Backend> createRs274Backend() { return std::make_unique<Rs274Backend>(); }
+
+} // namespace stepnc::backends
