@@ -33,6 +33,16 @@ else:
         "sample corpus not found at %s: tests that need it are UNSUPPORTED (skipped); "
         "set STEPNC_CORPUS or -DSTEPNC_CORPUS_DIR to run them" % corpus)
 
+# LinuxCNC's standalone interpreter checks the rs274 target's programs.
+import shutil
+if shutil.which("rs274"):
+    config.available_features.add("rs274")
+else:
+    lit_config.warning("LinuxCNC's rs274 interpreter is not installed: the rs274 target's checks are "
+                       "UNSUPPORTED (skipped); scripts/install-deps.sh installs it (linuxcnc-uspace)")
+config.substitutions.append(("%check-rs274", "python3 %s --stepnc %s" % (
+    os.path.join(config.test_source_root, "backends", "check-rs274.py"),
+    os.path.join(config.stepnc_tools_dir, "stepnc"))))
 config.substitutions.append(("%stepnc", os.path.join(config.stepnc_tools_dir, "stepnc")))
 config.substitutions.append(("%corpus", corpus))
 config.substitutions.append(("%inputs", os.path.join(config.test_source_root, "Inputs")))

@@ -11,8 +11,8 @@ std::vector<std::string> headerLines(const Program &p, const EmitOptions &o, con
   std::vector<std::string> lines;
   lines.push_back("stepnc: " + p.name + " from " + o.source);
   lines.push_back("target " + d.name + (o.optionsText.empty() ? "" : ", options " + o.optionsText));
-  lines.push_back("units mm, feeds mm/min, spindle rev/min, workpiece coordinates (set the work offset to the "
-                  "workpiece origin)");
+  lines.push_back("units mm, feeds mm/min, spindle rev/min; coordinates are the workpiece's: set the work "
+                  "offset to its origin");
   if (p.toolsFromTable)
     lines.push_back("tool numbers and lengths from the tool table");
   else
@@ -47,6 +47,7 @@ std::optional<std::string> IsoEmitter::run(const Program &p) {
       // first move writes every axis and the feed again.
       for (const char *w : {"G", "X", "Y", "Z", "F"})
         modal_.forget(w);
+      afterToolChange_ = true;
     }
     if (s.spindle != 0 && s.spindle != spindle_) {
       out_.block(spindle(s.spindle));
@@ -58,6 +59,15 @@ std::optional<std::string> IsoEmitter::run(const Program &p) {
     }
     if (s.cycle && d_.cycles.count(s.cycle->kind) && cycle(s, *s.cycle))
       continue;
+    if (s.operation == "tapping" || s.operation == "thread_drilling") {
+      // Written as moves, a tap would be driven out without the spindle reversed.
+      diags_.error(s.exec->origin.loc, "workingstep " + s.exec->symbol + " (" + s.operation +
+                                           ") can only be written as the controller's tapping cycle, which " +
+                                           (d_.cycles.count(CycleKind::Tap) ? "does not make its planned moves"
+                                                                             : "is off (--no-cycles)"))
+          .entity(s.exec->origin.entityId);
+      continue;
+    }
     for (const Move &m : s.moves)
       move(m);
   }
@@ -65,7 +75,7 @@ std::optional<std::string> IsoEmitter::run(const Program &p) {
   for (size_t line : out_.overlong())
     diags_.error(SourceLoc{}, "line " + std::to_string(line) + " of the " + d_.name + " program is longer than " +
                  std::to_string(d_.maxLineLength) + " characters, the most the controller reads");
-  if (!out_.overlong().empty())
+  if (!out_.overlong().empty() || diags_.hasErrors())
     return std::nullopt;
   return out_.text();
 }
@@ -127,6 +137,13 @@ void IsoEmitter::move(const Move &m) {
     arc(m);
     return;
   }
+  if (afterToolChange_ && m.kind == Move::Kind::Rapid) {
+    // From the tool change position: across at that height first, then down.
+    modal_.change("X", num(m.to.x()));
+    modal_.change("Y", num(m.to.y()));
+    out_.block((modal_.change("G", "G0") ? "G0 " : "") + word("X", num(m.to.x())) + word(" Y", num(m.to.y())));
+  }
+  afterToolChange_ = false;
   const std::string g = m.kind == Move::Kind::Rapid ? "G0" : "G1";
   // Which axes change as printed; a move that prints as no motion is left out.
   std::string words = axes(m.to);

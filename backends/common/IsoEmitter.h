@@ -74,6 +74,7 @@ protected:
 private:
   void arc(const Move &m);
   int tool_ = -1;
+  bool afterToolChange_ = false;
   double spindle_ = 0;
   std::string coolant_ = "off";
 };

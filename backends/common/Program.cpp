@@ -144,8 +144,8 @@ private:
     const ir::Node *moves = e.child("moves");
     if (!moves) {
       diags_.error(e.origin.loc, e.kind + " " + e.symbol +
-                                     " has no moves: run expand-strategies first (it reports why a workingstep "
-                                     "is not expanded)")
+                                     " has no moves to write: expand-strategies made none (its warning says "
+                                     "why)")
           .entity(e.origin.entityId);
       ok_ = false;
       return;

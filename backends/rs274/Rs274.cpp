@@ -18,7 +18,7 @@ TargetDescriptor rs274Descriptor() {
   d.arcs = ArcForm::IncrementalCentre;
   d.helix = true;
   d.helixTurns = true;  // P: number of turns
-  d.cycles = {CycleKind::Drill, CycleKind::Peck, CycleKind::Bore};
+  d.cycles = {CycleKind::Drill, CycleKind::Peck, CycleKind::Bore, CycleKind::Tap};
   d.numbering = Numbering::None;
   d.maxLineLength = 254;  // LinuxCNC rejects lines of 255 characters or more
   d.coordDecimals = 4;
@@ -99,13 +99,25 @@ private:
       break;
     }
     case CycleKind::Tap:
-      return false;
+      // G84 feeds in, reverses the spindle and feeds out at the same feed
+      // (which must be the pitch times the speed: the plan's feed is).
+      if (std::abs(c.feedOut - c.feed) > 1e-9)
+        return false;
+      // LinuxCNC's G84 under G98 feeds out all the way to the first height:
+      // G99 stops at R, and the plan's rapid up follows the cycle.
+      words = "G99 G84 " + xyzr;
+      break;
     }
     positionFor(s);
     modal_.forget("F");
     out_.block(words + feedWord(c.feed));
     out_.block("G80");
-    assumeAt(Vec3(c.at.x(), c.at.y(), c.initialZ));
+    if (c.kind == CycleKind::Tap) {
+      assumeAt(Vec3(c.at.x(), c.at.y(), c.retractZ));
+      move(s.moves.back());
+    } else {
+      assumeAt(Vec3(c.at.x(), c.at.y(), c.initialZ));
+    }
     return true;
   }
 

@@ -1,0 +1,572 @@
+// HEIDENHAIN TNC conversational programs (Klartext, `.h` files): numbered
+// blocks from 0 between BEGIN PGM and END PGM, the raw block as BLK FORM,
+// `L` lines with signed coordinates, arcs about a modal centre (`CC` then
+// `C`, helices as `CP IPA.. IZ..`), drilling as cycle 200 called per hole
+// with M99. Klartext is not ISO G-code, so this target has its own emitter
+// over the shared program model and word helpers; the facts it relies on,
+// and the conservative forms taken where a fact is unverified, are listed
+// in backends/heidenhain-tnc/README.md. The structural checker
+// tests/backends/check-heidenhain-tnc.py reads these programs back.
+#include "backends/Backend.h"
+#include "backends/common/IsoEmitter.h"
+#include "backends/common/Program.h"
+#include "backends/common/Words.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace stepnc::backends {
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kTwoPi = 2 * kPi;
+/// Decimals of the incremental polar angle (degrees): 0.0001 deg moves the
+/// end of a 100 mm radius by under 0.0002 mm.
+constexpr int kAngleDecimals = 4;
+
+TargetDescriptor tncDescriptor() {
+  TargetDescriptor d;
+  d.name = "heidenhain-tnc";
+  d.description = "HEIDENHAIN TNC conversational (Klartext)";
+  d.extension = ".h";
+  d.arcs = ArcForm::ModalCentre;
+  d.helix = true;       // CP with IZ
+  d.helixTurns = true;  // CP IPA beyond 360 deg
+  d.cycles = {CycleKind::Drill, CycleKind::Peck};
+  d.numbering = Numbering::FromZero;
+  // No line limit among the dialect facts; --target-opt max-line-length=N
+  // makes the emitter report longer lines.
+  d.maxLineLength = 0;
+  d.coordDecimals = 3;
+  d.feedDecimals = 0;
+  d.speedDecimals = 0;
+  d.tolerance = 0.01;
+  return d;
+}
+
+bool isAsciiAlnum(char c) { return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9'); }
+
+/// The program name as BEGIN PGM and END PGM carry it: letters, digits and
+/// underscores (the file name may hold characters the name may not).
+std::string sanitizedName(const std::string &wanted) {
+  std::string name;
+  for (char c : wanted)
+    name += isAsciiAlnum(c) ? c : '_';
+  return name.empty() ? "PGM" : name;
+}
+
+/// Text that stays one comment: printable ASCII only (one `?` for each
+/// other character), and no `~`, which at the end of a line would continue
+/// the block on the next.
+std::string commentText(std::string_view text) {
+  std::string t;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c >= 0x80) {
+      // One mark for a whole UTF-8 sequence: skip its continuation bytes.
+      while (i + 1 < text.size() && (static_cast<unsigned char>(text[i + 1]) & 0xC0) == 0x80)
+        ++i;
+      t += '?';
+    } else if (c < 0x20 || c == 0x7F) {
+      t += ' ';
+    } else {
+      t += c == '~' ? '-' : static_cast<char>(c);
+    }
+  }
+  return t;
+}
+
+/// The angle (radians, in [0, 2 pi)) from `a` to `b` turning ccw or cw.
+double turnAngle(const geom::Vec2 &a, const geom::Vec2 &b, bool ccw) {
+  double angle = std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));
+  if (!ccw)
+    angle = -angle;
+  if (angle < 0)
+    angle += kTwoPi;
+  return angle;
+}
+
+class KlartextEmitter {
+public:
+  KlartextEmitter(const TargetDescriptor &d, const EmitOptions &o, DiagnosticEngine &diags)
+      : d_(d), o_(o), diags_(diags), out_(d) {}
+
+  std::optional<std::string> run(const Program &p) {
+    const std::string name = sanitizedName(o_.programName);
+    if (name != o_.programName)
+      diags_.warning(SourceLoc{}, "the program name '" + o_.programName + "' is written as '" + name +
+                                      "' (letters, digits and underscores): name the file " + name + d_.extension +
+                                      ", as the TNC expects the file to carry the program's name");
+    out_.block("BEGIN PGM " + name + " MM");
+    blankForm(p);
+    for (const std::string &line : headerLines(p, o_, d_))
+      out_.block(comment(line));
+    // Cycle 32 is active from its definition on: one contour tolerance for
+    // the whole program, reset at the end.
+    out_.block("CYCL DEF 32.0 TOLERANCE");
+    out_.block("CYCL DEF 32.1 T" + formatNumber(tolerance(), {6, false, false}));
+    for (const Step &s : p.steps) {
+      switch (s.kind) {
+      case Step::Kind::Message:
+        out_.block(comment("MESSAGE: " + s.label));
+        continue;
+      case Step::Kind::Stop:
+      case Step::Kind::OptionalStop:
+        stop(s.kind == Step::Kind::OptionalStop);
+        continue;
+      case Step::Kind::Moves:
+        break;
+      }
+      step(p, s);
+    }
+    flushM();
+    if (spindleRunning_)
+      mBlock("M5");
+    if (coolantCode_ != "M9")
+      mBlock("M9");
+    out_.block("CYCL DEF 32.0 TOLERANCE");
+    out_.block("CYCL DEF 32.1");
+    mBlock("M30");
+    out_.block("END PGM " + name + " MM");
+    for (size_t line : out_.overlong())
+      diags_.error(SourceLoc{}, "line " + std::to_string(line) + " of the " + d_.name + " program is longer than " +
+                                    std::to_string(d_.maxLineLength) + " characters (--target-opt max-line-length)");
+    if (!ok_ || !out_.overlong().empty())
+      return std::nullopt;
+    return out_.text();
+  }
+
+private:
+  // --- Words ---------------------------------------------------------------------
+
+  /// Coordinates always carry their sign; no trailing point, as the control
+  /// writes its own numbers ("X+10", "Z-2.5").
+  std::string num(double v) const { return formatNumber(v, {d_.coordDecimals, true, false}); }
+  double rounded(double v) const { return roundTo(v, d_.coordDecimals); }
+  double unit() const { return std::pow(10.0, -d_.coordDecimals); }
+  double tolerance() const { return o_.tolerance.value_or(d_.tolerance); }
+  std::string comment(const std::string &text) const { return "; " + commentText(text); }
+
+  /// The feed in mm/min as an unsigned number; a feed that would print as 0
+  /// keeps more decimals rather than read as no feed.
+  std::string feedNumber(double feed) const {
+    std::string f = formatNumber(feed, {d_.feedDecimals, false, false});
+    if (f == "0")
+      f = formatNumber(feed, {3, false, false});
+    return f;
+  }
+
+  /// " F.." when the feed changed since the last feed word.
+  std::string feedWord(double feed) {
+    const std::string f = feedNumber(feed);
+    return modal_.change("F", f) ? " F" + f : "";
+  }
+
+  /// Axis words for the coordinates that change as printed ("X+10 Z-2");
+  /// records where the control then is.
+  std::string axes(const Vec3 &to, bool forceXY = false) {
+    std::string words;
+    static const char *names[3] = {"X", "Y", "Z"};
+    for (int k = 0; k < 3; ++k) {
+      const std::string v = num(to[k]);
+      if (modal_.change(names[k], v) || (forceXY && k < 2)) {
+        if (!words.empty())
+          words += ' ';
+        words += names[k] + v;
+      }
+      at_[k] = rounded(to[k]);
+    }
+    return words;
+  }
+
+  /// Forgets where the axes are: the next block writes every axis it names.
+  void forgetPosition() {
+    for (const char *w : {"X", "Y", "Z"})
+      modal_.forget(w);
+    at_ = {};
+  }
+
+  /// BLK FORM from the raw block: MIN point (with the tool axis), then MAX.
+  void blankForm(const Program &p) {
+    if (!p.blank) {
+      out_.block(comment("no block raw piece in the input: no BLK FORM (the control's graphics need one)"));
+      return;
+    }
+    const auto &[lo, hi] = *p.blank;
+    for (int k = 0; k < 3; ++k)
+      if (!(rounded(lo[k]) < rounded(hi[k]))) {
+        out_.block(comment("the raw piece is flat as printed: no BLK FORM"));
+        return;
+      }
+    out_.block("BLK FORM 0.1 Z X" + num(lo.x()) + " Y" + num(lo.y()) + " Z" + num(lo.z()));
+    out_.block("BLK FORM 0.2 X" + num(hi.x()) + " Y" + num(hi.y()) + " Z" + num(hi.z()));
+  }
+
+  // --- M functions ------------------------------------------------------------------
+  // M functions ride on L blocks, one per block (the form every TNC reads).
+  // Spindle and coolant starts wait for the next L block; where no motion
+  // comes to carry one, a block repeats the current height.
+
+  std::string takeM() {
+    if (pendingM_.empty())
+      return "";
+    const std::string m = " " + pendingM_.front();
+    pendingM_.erase(pendingM_.begin());
+    return m;
+  }
+
+  void mBlock(const std::string &m) {
+    if (at_[2])
+      out_.block("L Z" + num(*at_[2]) + " R0 FMAX " + m);
+    else
+      out_.block("L " + m);  // no height known yet: only before the first motion
+  }
+
+  void flushM() {
+    while (!pendingM_.empty())
+      mBlock(takeM().substr(1));
+  }
+
+  void stop(bool optional) {
+    flushM();
+    mBlock(optional ? "M1" : "M0");
+    // M0 (and M1 where it stops) switch the spindle and the coolant off: the
+    // next step starts them again.
+    spindleRunning_ = false;
+    coolantCode_.clear();
+  }
+
+  // --- Steps --------------------------------------------------------------------
+
+  void step(const Program &p, const Step &s) {
+    out_.block("* - " + commentText(s.label));
+    if (s.operation == "tapping" || s.operation == "thread_drilling") {
+      // Plain moves would feed the tap out with the spindle still turning
+      // forward: it would break.
+      diags_.error(s.exec->origin.loc, "workingstep " + s.exec->symbol + " (" + s.operation + "): " + d_.name +
+                                           " has no tapping cycle (cycle 207 needs the thread pitch and is not "
+                                           "among the dialect facts), and tapping written as plain moves would "
+                                           "break the tap")
+          .entity(s.exec->origin.entityId);
+      ok_ = false;
+      return;
+    }
+    const bool newTool = s.tool >= 0 && s.tool != tool_;
+    if (newTool || (s.spindle != 0 && s.spindle != spindle_)) {
+      if (s.tool >= 0)
+        toolCall(p.tools[static_cast<size_t>(s.tool)], s);
+    } else if (s.spindle != 0 && !spindleRunning_) {
+      pendingM_.push_back(s.spindle < 0 ? "M3" : "M4");
+      spindleRunning_ = true;
+    }
+    const std::string coolant = coolantCode(s.coolant);
+    if (coolant != coolantCode_) {
+      pendingM_.push_back(coolant);
+      coolantCode_ = coolant;
+    }
+    if (s.cycle && d_.cycles.count(s.cycle->kind) && cycle(s, *s.cycle)) {
+      flushM();
+      return;
+    }
+    for (const Move &m : s.moves)
+      move(m);
+    flushM();
+  }
+
+  static std::string coolantCode(const std::string &kind) {
+    if (kind == "flood" || kind == "through_tool")
+      return "M8";
+    if (kind == "mist")
+      return "M7";
+    return "M9";
+  }
+
+  /// TOOL CALL with the speed, then up to a safe height along the tool axis
+  /// starting the spindle: where the tool change left the tool is unknown,
+  /// and going straight to the security plane is safe from above or below.
+  void toolCall(const ToolCall &t, const Step &s) {
+    std::string text = "TOOL CALL " + std::to_string(t.number) + " Z";
+    if (s.spindle != 0)
+      text += " S" + formatNumber(std::abs(s.spindle), {d_.speedDecimals, false, false});
+    out_.block(text);
+    tool_ = s.tool;
+    spindle_ = s.spindle;
+    // The control may move the axes and change the feed in the tool change;
+    // a pole set before it is not relied on.
+    forgetPosition();
+    modal_.forget("F");
+    modal_.forget("CC");
+    cc_.reset();
+    double safeZ = s.secplane;
+    if (!s.moves.empty() && s.moves.front().kind == Move::Kind::Rapid)
+      safeZ = std::max(safeZ, s.moves.front().to.z());
+    text = "L Z" + num(safeZ) + " R0 FMAX";
+    modal_.change("Z", num(safeZ));
+    at_[2] = rounded(safeZ);
+    if (s.spindle != 0) {
+      text += s.spindle < 0 ? " M3" : " M4";
+      spindleRunning_ = true;
+    } else {
+      spindleRunning_ = false;
+    }
+    out_.block(text);
+  }
+
+  // --- Moves -------------------------------------------------------------------
+
+  void move(const Move &m) {
+    if (m.kind == Move::Kind::Arc) {
+      arc(m);
+      return;
+    }
+    line(m.to, m.kind == Move::Kind::Rapid, m.feed);
+  }
+
+  void line(const Vec3 &to, bool rapid, double feed) {
+    const std::string words = axes(to);
+    if (words.empty())
+      return;  // no motion as printed
+    std::string text = "L " + words + " R0";
+    if (rapid) {
+      text += " FMAX";
+      // FMAX holds for its block only; the next feed block states its feed
+      // again so that no reader has to look back across a rapid.
+      modal_.forget("F");
+    } else {
+      text += feedWord(feed);
+    }
+    out_.block(text + takeM());
+  }
+
+  void arc(const Move &m) {
+    flushM();
+    const geom::Vec2 from = at_[0] && at_[1] ? geom::Vec2(*at_[0], *at_[1])
+                                             : geom::Vec2(rounded(m.from.x()), rounded(m.from.y()));
+    const double fromZ = at_[2] ? *at_[2] : rounded(m.from.z());
+    if (num(m.to.z()) != num(fromZ) || m.turns > 0)
+      helix(m, from, fromZ);
+    else
+      flatArc(from, m.to.head<2>(), m, m.sweep(), 0);
+  }
+
+  /// The printed centre for an arc from `from` to `to` (both as the control
+  /// has them) about `centre`: on the grid of printed numbers, as near the
+  /// perpendicular bisector as the grid allows, so that start and end radius
+  /// agree to the printed decimals; the centre in force is kept when it does
+  /// as well.
+  geom::Vec2 pickCentre(const geom::Vec2 &from, const geom::Vec2 &to, const geom::Vec2 &centre) const {
+    const double u = unit();
+    auto mismatch = [&](const geom::Vec2 &c) { return std::abs((from - c).norm() - (to - c).norm()); };
+    if ((to - from).norm() < u / 2) {
+      // A whole turn: every centre has equal radii; keep the one in force
+      // when it prints as this one.
+      const geom::Vec2 c(rounded(centre.x()), rounded(centre.y()));
+      if (cc_ && (*cc_ - c).norm() < u / 2)
+        return *cc_;
+      return c;
+    }
+    const geom::Vec2 b = balancedCentre(from, to, centre);
+    const geom::Vec2 base(rounded(b.x()), rounded(b.y()));
+    geom::Vec2 best = base;
+    double bestMismatch = mismatch(base), bestDistance = (base - b).norm();
+    for (int i = -2; i <= 2; ++i)
+      for (int j = -2; j <= 2; ++j) {
+        const geom::Vec2 c(rounded(base.x() + i * u), rounded(base.y() + j * u));
+        const double e = mismatch(c), dist = (c - b).norm();
+        if (e < bestMismatch - 1e-12 || (e <= bestMismatch + 1e-12 && dist < bestDistance - 1e-12)) {
+          best = c;
+          bestMismatch = e;
+          bestDistance = dist;
+        }
+      }
+    if (cc_ && (*cc_ - b).norm() <= 2 * u && mismatch(*cc_) <= std::max(bestMismatch, u / 2) + 1e-12)
+      return *cc_;
+    return best;
+  }
+
+  void centreBlock(const geom::Vec2 &c) {
+    const std::string text = "CC X" + num(c.x()) + " Y" + num(c.y());
+    if (modal_.change("CC", text))
+      out_.block(text);
+    cc_ = c;
+  }
+
+  /// An arc in the plane: CC (when it changes), then C to the end point. An
+  /// arc whose printed numbers would turn the other way round (a near-whole
+  /// circle whose end rounds past its start) is written in two halves.
+  void flatArc(const geom::Vec2 &from, const geom::Vec2 &toExact, const Move &m, double sweep, int depth) {
+    const double u = unit();
+    const geom::Vec2 to(rounded(toExact.x()), rounded(toExact.y()));
+    const double fromZ = at_[2] ? *at_[2] : m.to.z();
+    if ((m.centre - from).norm() < u) {
+      // A radius below the printed resolution: a line does as well.
+      line(Vec3(toExact.x(), toExact.y(), fromZ), false, m.feed);
+      return;
+    }
+    if ((to - from).norm() < u / 2 && sweep < kPi)
+      return;  // a sliver that prints as no motion
+    const geom::Vec2 c = pickCentre(from, to, m.centre);
+    const bool whole = (to - from).norm() < u / 2;
+    const double printedSweep = whole ? kTwoPi : turnAngle(from - c, to - c, m.ccw);
+    if (!whole && std::abs(printedSweep - sweep) > kPi / 2 && depth < 2) {
+      const geom::Vec2 mid = arcSplitPoints(from, m.centre, m.ccw, sweep, 2).front();
+      flatArc(from, mid, m, sweep / 2, depth + 1);
+      const geom::Vec2 next = at_[0] && at_[1] ? geom::Vec2(*at_[0], *at_[1]) : mid;
+      flatArc(next, toExact, m, sweep / 2, depth + 1);
+      return;
+    }
+    centreBlock(c);
+    const std::string text = "C " + axes(Vec3(to.x(), to.y(), fromZ), /*forceXY=*/true) + " DR" +
+                             (m.ccw ? "+" : "-") + feedWord(m.feed);
+    out_.block(text);
+  }
+
+  /// A helix (or an arc of more than one turn): CC, then CP with the whole
+  /// incremental angle (full turns included) and the incremental height.
+  /// The control ends where the start turned by that angle lands, which
+  /// the next block's coordinates then take as the position.
+  void helix(const Move &m, const geom::Vec2 &from, double fromZ) {
+    const geom::Vec2 to(rounded(m.to.x()), rounded(m.to.y()));
+    const geom::Vec2 c = pickCentre(from, to, m.centre);
+    centreBlock(c);
+    const double sweep = m.sweep();
+    // The printed angle, with as many whole turns as brings it nearest the
+    // planned sweep.
+    double angle = (to - from).norm() < unit() / 2 ? 0.0 : turnAngle(from - c, to - c, m.ccw);
+    angle += kTwoPi * std::round((sweep - angle) / kTwoPi);
+    const double degrees = roundTo((m.ccw ? 1 : -1) * angle * 180 / kPi, kAngleDecimals);
+    const std::string ipa = formatNumber(degrees, {kAngleDecimals, true, false});
+    const double toZ = rounded(m.to.z());
+    const double dz = rounded(toZ - fromZ);
+    std::string text = "CP IPA" + ipa;
+    if (dz != 0)
+      text += " IZ" + num(dz);
+    text += std::string(" DR") + (m.ccw ? "+" : "-") + feedWord(m.feed);
+    out_.block(text);
+    // Where the control is: the start turned by the printed angle.
+    const double a = degrees * kPi / 180;
+    const geom::Vec2 r = from - c;
+    at_[0] = c.x() + r.x() * std::cos(a) - r.y() * std::sin(a);
+    at_[1] = c.y() + r.x() * std::sin(a) + r.y() * std::cos(a);
+    at_[2] = toZ;
+    modal_.forget("X");
+    modal_.forget("Y");
+    modal_.forget("Z");
+    modal_.change("Z", num(toZ));
+  }
+
+  // --- Cycle 200 ------------------------------------------------------------------
+
+  /// Drilling as cycle 200 when it makes the planned moves: down at rapid to
+  /// the set-up clearance, in at the feed (one infeed, or equal infeeds from
+  /// the surface with rapids out to the set-up clearance and back down to
+  /// the set-up clearance above the last depth), out at rapid to the second
+  /// set-up clearance, the security plane. False: the moves are written.
+  bool cycle(const Step &s, const HoleCycle &c) {
+    if (c.kind != CycleKind::Drill && c.kind != CycleKind::Peck)
+      return false;
+    const double surface = rounded(c.surfaceZ), retract = rounded(c.retractZ), depth = rounded(c.depthZ),
+                 initial = rounded(c.initialZ);
+    const double clearance = retract - surface, depthQ = depth - surface, second = initial - surface;
+    if (clearance < unit() / 2 || depthQ > -unit() / 2 || initial < retract || c.feed <= 0)
+      return false;
+    double plunging = -depthQ;
+    if (c.pecks.size() > 1) {
+      // Unverified beyond DIALECTS.md: infeeds counted from the surface, and
+      // the return down to the set-up clearance above the last depth
+      // (README.md). Only a plan that does exactly this is written as one.
+      const double q = c.surfaceZ - c.pecks.front();
+      for (size_t k = 0; k < c.pecks.size(); ++k)
+        if (std::abs(std::max(c.surfaceZ - q * static_cast<double>(k + 1), c.depthZ) - c.pecks[k]) > 1e-6)
+          return false;
+      size_t peck = 0;
+      for (size_t i = 1; i < s.moves.size(); ++i)
+        if (s.moves[i].role == "approach" && s.moves[i - 1].role == "retract" &&
+            s.moves[i - 1].kind == Move::Kind::Rapid) {
+          if (peck >= c.pecks.size() ||
+              std::abs(s.moves[i].to.z() - (c.pecks[peck] + (c.retractZ - c.surfaceZ))) > 1e-6)
+            return false;
+          ++peck;
+        }
+      plunging = rounded(q);
+    }
+    // To the hole at the security plane, as planned.
+    for (const Move &m : s.moves) {
+      if (m.role == "approach")
+        break;
+      move(m);
+    }
+    flushM();
+    if (!at_[2] || *at_[2] < initial) {
+      // Up along the tool axis first: the call moves in the plane.
+      out_.block("L Z" + num(initial) + " R0 FMAX");
+      modal_.forget("Z");
+      modal_.change("Z", num(initial));
+      at_[2] = initial;
+    }
+    out_.block("CYCL DEF 200 DRILLING ~");
+    const std::vector<std::pair<std::string, std::string>> q = {
+        {"Q200=" + num(clearance), "SET-UP CLEARANCE"},
+        {"Q201=" + num(depthQ), "DEPTH"},
+        {"Q206=+" + feedNumber(c.feed), "FEED RATE FOR PLNGNG"},
+        {"Q202=" + num(plunging), "PLUNGING DEPTH"},
+        {"Q210=+0", "DWELL TIME AT TOP"},
+        {"Q203=" + num(surface), "SURFACE COORDINATE"},
+        {"Q204=" + num(second), "2ND SET-UP CLEARANCE"},
+        {"Q211=+0", "DWELL TIME AT DEPTH"},
+    };
+    for (size_t i = 0; i < q.size(); ++i)
+      out_.raw("  " + q[i].first + " ;" + q[i].second + (i + 1 < q.size() ? " ~" : ""));
+    // The call moves in the plane at the security plane, then the cycle runs.
+    out_.block("L " + axes(Vec3(c.at.x(), c.at.y(), *at_[2]), /*forceXY=*/true) + " R0 FMAX M99");
+    // The cycle ends at the second set-up clearance; the feed it used and
+    // the pole are not relied on.
+    at_[2] = initial;
+    modal_.forget("Z");
+    modal_.change("Z", num(initial));
+    modal_.forget("F");
+    modal_.forget("CC");
+    cc_.reset();
+    return true;
+  }
+
+  const TargetDescriptor &d_;
+  const EmitOptions &o_;
+  DiagnosticEngine &diags_;
+  BlockWriter out_;
+  ModalState modal_;
+  /// Where the control has the tool, per axis, when known.
+  std::array<std::optional<double>, 3> at_;
+  std::optional<geom::Vec2> cc_;  ///< the pole in force, as printed
+  std::vector<std::string> pendingM_;
+  int tool_ = -1;
+  double spindle_ = 0;
+  bool spindleRunning_ = false;
+  std::string coolantCode_ = "M9";  ///< assumed off at the start
+  bool ok_ = true;
+};
+
+class HeidenhainTncBackend final : public Backend {
+public:
+  HeidenhainTncBackend() : Backend(tncDescriptor()) {}
+
+  std::optional<std::string> emit(const ir::Module &module, const EmitOptions &options,
+                                   DiagnosticEngine &diags) override {
+    auto program = buildProgram(module, options.toolTable, diags);
+    if (!program)
+      return std::nullopt;
+    return KlartextEmitter(descriptor(), options, diags).run(*program);
+  }
+};
+
+} // namespace
+
+std::unique_ptr<Backend> createHeidenhainTncBackend() { return std::make_unique<HeidenhainTncBackend>(); }
+
+} // namespace stepnc::backends

@@ -1,0 +1,276 @@
+// SINUMERIK 840D / 840D sl main programs (.MPF), written on the ISO emitter
+// core: the transfer header and program name, G71 metric blocks, tool calls
+// whose length comes from the tool's D offset, I/J (or CR=) arcs and TURN=
+// helices, the CYCLE832 path settings, and drilling as modal CYCLE81 / CYCLE83
+// / CYCLE84 calls. The facts behind each word are in /work/shared/DIALECTS.md;
+// the choices it leaves open, and the forms taken where it says "unverified",
+// are in backends/siemens-840d/README.md. The structure of what is written is
+// checked by tests/backends/check-siemens-840d.py.
+#include "backends/Backend.h"
+#include "backends/common/IsoEmitter.h"
+
+#include <cctype>
+#include <cmath>
+
+namespace stepnc::backends {
+
+namespace {
+
+TargetDescriptor siemensDescriptor() {
+  TargetDescriptor d;
+  d.name = "siemens-840d";
+  d.description = "Siemens SINUMERIK 840D / 840D sl";
+  d.extension = ".mpf";
+  d.arcs = ArcForm::IncrementalCentre;
+  d.helix = true;
+  d.helixTurns = true;  // TURN=
+  d.cycles = {CycleKind::Drill, CycleKind::Peck, CycleKind::Tap};
+  d.numbering = Numbering::None;
+  d.maxLineLength = 512;  // conservative: the controller's own limit is not in DIALECTS.md
+  d.coordDecimals = 3;
+  d.feedDecimals = 1;
+  d.speedDecimals = 0;
+  d.tolerance = 0.01;
+  return d;
+}
+
+/// Names longer than this are cut: the older 840D limit (unverified, README).
+constexpr size_t kMaxNameLength = 24;
+
+/// CYCLE832's machining type: finishing, the mode that keeps to the tolerance
+/// rather than favouring speed (README: why one mode for the whole program).
+constexpr int kTolmFinishing = 1;
+
+/// A program name as the control files it: letters, digits and underscores,
+/// upper case, starting with two letters.
+std::string siemensProgramName(const std::string &from) {
+  std::string name;
+  for (char c : from) {
+    const auto u = static_cast<unsigned char>(c);
+    if (u < 0x80 && std::isalnum(u))
+      name += static_cast<char>(std::toupper(u));
+    else
+      name += '_';
+  }
+  auto letter = [](char c) { return c >= 'A' && c <= 'Z'; };
+  if (name.size() < 2 || !letter(name[0]) || !letter(name[1]))
+    name = name.empty() ? "NC" : "NC_" + name;
+  if (name.size() > kMaxNameLength)
+    name.resize(kMaxNameLength);
+  return name;
+}
+
+/// Text a comment or a message can carry: printable ASCII only (the program
+/// is an ASCII file), no double quote (it would end an MSG string).
+std::string printable(const std::string &text, size_t most) {
+  std::string out;
+  for (char c : text) {
+    const auto u = static_cast<unsigned char>(c);
+    out += u >= 0x20 && u < 0x7f ? (c == '"' ? '\'' : c) : '_';
+  }
+  if (out.size() > most)
+    out.resize(most);
+  return out;
+}
+
+/// The longest message text written: the display line is short (its length
+/// is not in DIALECTS.md), and a longer text says no more at the machine.
+constexpr size_t kMaxMessage = 120;
+
+bool isTapping(const std::string &operation) { return operation == "tapping" || operation == "thread_drilling"; }
+
+/// A cycle call for a hole, or why the cycle would not make the planned moves.
+struct CycleCall {
+  std::string text;    ///< "CYCLE81(...)"; empty when not possible
+  std::string whyNot;  ///< when text is empty
+  bool usesFeed = true;  ///< F is the feed in (CYCLE84 feeds by the pitch)
+};
+
+/// The cycle for `c` in step `s`, by the documented parameters.
+CycleCall cycleCall(const Program &p, const Step &s, const HoleCycle &c, const TargetDescriptor &d) {
+  const auto num = [&](double v) { return formatNumber(v, {d.coordDecimals, false, true}); };
+  CycleCall call;
+  auto no = [&](std::string why) {
+    call.whyNot = std::move(why);
+    return call;
+  };
+  // RTP, RFP, SDIS, DP, DPR: the cycle starts at RTP (the security plane),
+  // goes at rapid to RFP + SDIS (the plan's R), feeds to DP and leaves back
+  // to RTP. SDIS is unsigned: R must be on or above the surface.
+  const double sdis = c.retractZ - c.surfaceZ;
+  if (sdis < -1e-9)
+    return no("its reference plane R (z=" + num(c.retractZ) + ") is below the top of the hole (z=" +
+              num(c.surfaceZ) + "), and SDIS is unsigned");
+  if (c.initialZ < c.retractZ - 1e-9)
+    return no("its security plane is below its reference plane R");
+  if (c.depthZ >= c.retractZ)
+    return no("its depth is not below its reference plane R");
+  const std::string common = num(c.initialZ) + "," + num(c.surfaceZ) + "," + num(std::max(sdis, 0.0)) + "," +
+                             num(c.depthZ) + ",";  // DPR empty: the depth is DP
+  switch (c.kind) {
+  case CycleKind::Drill:
+    call.text = "CYCLE81(" + common + ")";
+    return call;
+  case CycleKind::Peck: {
+    if (c.pecks.size() == 1) {
+      // One feed down and out at rapid: exactly what CYCLE81 does.
+      call.text = "CYCLE81(" + common + ")";
+      return call;
+    }
+    // CYCLE83 with no degression (DAM 0) makes strokes as long as the
+    // first, measured from RFP, the last one shorter; VARI 1 leaves each
+    // time at rapid to RFP + SDIS. Only a plan that pecks so is written so.
+    const double stroke = c.surfaceZ - c.pecks.front();
+    if (stroke <= 1e-6)
+      return no("its first peck does not go below the top of the hole");
+    for (size_t k = 1; k < c.pecks.size(); ++k) {
+      const double expected = std::max(c.pecks.front() - stroke * static_cast<double>(k), c.depthZ);
+      if (std::abs(expected - c.pecks[k]) > 1e-6)
+        return no("its pecks are not equal strokes from the top of the hole, the only pecking CYCLE83 "
+                  "makes without degression");
+    }
+    // FDEP, FDPR (empty), DAM 0, DTB 0, DTS 0, FRF 1, VARI 1.
+    call.text = "CYCLE83(" + common + "," + num(c.pecks.front()) + ",,0.,0.,0.,1.,1)";
+    return call;
+  }
+  case CycleKind::Tap: {
+    // Rigid tapping: the feed follows from the pitch and the speed, and
+    // the spindle reverses at the bottom; out at SST1.
+    const ToolCall *tool = s.tool >= 0 ? &p.tools[static_cast<size_t>(s.tool)] : nullptr;
+    const std::optional<double> pitch = tool && tool->node ? tool->node->number("thread_pitch") : std::nullopt;
+    if (!pitch || *pitch <= 0)
+      return no("its tool has no thread_pitch, which CYCLE84 needs");
+    if (s.spindle == 0)
+      return no("it has no spindle speed");
+    const double rpm = std::abs(s.spindle);
+    if (std::abs(c.feed - *pitch * rpm) > 0.01 * c.feed)
+      return no("its feed " + formatNumber(c.feed, {1, false, false}) + " mm/min is not the thread pitch " +
+                num(*pitch) + " mm times the spindle speed " + formatNumber(rpm, {0, false, false}) + " rev/min");
+    const double rpmOut = rpm * c.feedOut / c.feed;
+    // DTB 0, SDAC: the spindle turns on as before (3 = M3, 4 = M4); MPIT
+    // empty; PIT signed, positive for a right-hand thread cut with M3;
+    // POSS 0; SST, SST1.
+    const bool clockwise = s.spindle < 0;
+    const auto rpmText = [&](double v) { return formatNumber(v, {d.speedDecimals, false, false}); };
+    call.text = "CYCLE84(" + common + ",0.," + std::string(clockwise ? "3" : "4") + ",," +
+                num(clockwise ? *pitch : -*pitch) + ",0.," + rpmText(rpm) + "," + rpmText(rpmOut) + ")";
+    call.usesFeed = false;
+    return call;
+  }
+  case CycleKind::Bore:
+    return no("boring cycles are not written for this target");
+  }
+  return no("unknown cycle");
+}
+
+class SiemensEmitter final : public IsoEmitter {
+public:
+  using IsoEmitter::IsoEmitter;
+
+private:
+  std::string comment(const std::string &text) const override {
+    // Room for a block number and "; " within the line limit.
+    const size_t room = d_.maxLineLength > 32 ? d_.maxLineLength - 16 : std::string::npos;
+    return "; " + printable(text, room);
+  }
+
+  void header(const Program &p) override {
+    const std::string name = siemensProgramName(o_.programName);
+    out_.raw(word("%_N_", name) + "_MPF");
+    out_.raw(";$PATH=/_N_MPF_DIR");
+    for (const std::string &line : headerLines(p, o_, d_))
+      out_.block(comment(line));
+    // Tool-centre paths: radius compensation off.
+    out_.block("G90 G94 G71 G17 G40");
+    // Continuous path with the contour tolerance, finishing settings.
+    out_.block("G642");
+    out_.block("CYCLE832(" + formatNumber(tolerance(), {6, false, true}) + "," + std::to_string(kTolmFinishing) +
+               ",1)");
+  }
+
+  void footer(const Program &) override {
+    out_.block("M5");
+    out_.block("M9");
+    out_.block("CYCLE832(0.,0,1)");  // _TOLM 0: the high speed settings off again
+    out_.block("M30");
+  }
+
+  void toolChange(const ToolCall &t) override {
+    // The length is the controller's: offset D1 of the tool, never a G43/H.
+    out_.block(word("T", std::to_string(t.number)));
+    out_.block("M6");
+    out_.block("D1");
+  }
+
+  std::string turnsWord(int64_t turns) const override { return word("TURN=", std::to_string(turns)); }
+
+  std::string radiusWord(double signedRadius) const override { return word("CR=", num(signedRadius)); }
+
+  void message(const std::string &text) override { out_.block("MSG(\"" + printable(text, kMaxMessage) + "\")"); }
+
+  bool cycle(const Step &s, const HoleCycle &c) override {
+    const CycleCall call = cycleCall(*program_, s, c, d_);
+    if (call.text.empty())
+      return false;
+    positionFor(s);
+    if (call.usesFeed) {
+      modal_.forget("F");
+      const std::string f = feedWord(c.feed);
+      out_.block(f.substr(1));  // " F..": the feed the cycle drills at
+    }
+    out_.block("MCALL " + call.text);
+    // The position block: the modal cycle runs after it, at the hole.
+    const std::string g = modal_.change("G", "G0") ? "G0 " : "";
+    out_.block(g + word("X", num(c.at.x())) + word(" Y", num(c.at.y())));
+    out_.block("MCALL");
+    assumeAt(Vec3(c.at.x(), c.at.y(), c.initialZ));
+    return true;
+  }
+};
+
+class SiemensBackend final : public Backend {
+public:
+  SiemensBackend() : Backend(siemensDescriptor()) {}
+
+  std::optional<std::string> emit(const ir::Module &module, const EmitOptions &options,
+                                   DiagnosticEngine &diags) override {
+    auto program = buildProgram(module, options.toolTable, diags);
+    if (!program)
+      return std::nullopt;
+    if (!tapsAsCycles(*program, diags))
+      return std::nullopt;
+    return SiemensEmitter(descriptor(), options, diags).run(*program);
+  }
+
+private:
+  /// A tap written as moves would feed out without reversing the spindle and
+  /// break: every tapping step must be a CYCLE84, else nothing is written.
+  bool tapsAsCycles(const Program &p, DiagnosticEngine &diags) const {
+    bool ok = true;
+    for (const Step &s : p.steps) {
+      if (s.kind != Step::Kind::Moves || !isTapping(s.operation))
+        continue;
+      std::string why;
+      if (!descriptor().cycles.count(CycleKind::Tap))
+        why = "cycles are off (--no-cycles or cycles=off)";
+      else if (!s.cycle)
+        why = "its moves are not one tapping cycle (to the hole, feed down, feed out)";
+      else
+        why = cycleCall(p, s, *s.cycle, descriptor()).whyNot;
+      if (why.empty())
+        continue;
+      diags.error(s.exec->origin.loc, "workingstep " + s.exec->symbol + " (" + s.operation +
+                                          ") cannot be written as CYCLE84: " + why +
+                                          "; as plain moves the spindle would not reverse at the bottom")
+          .entity(s.exec->origin.entityId);
+      ok = false;
+    }
+    return ok;
+  }
+};
+
+} // namespace
+
+std::unique_ptr<Backend> createSiemens840dBackend() { return std::make_unique<SiemensBackend>(); }
+
+} // namespace stepnc::backends

@@ -1,0 +1,607 @@
+#!/usr/bin/env python3
+"""Structural checker for the HEIDENHAIN TNC conversational (Klartext)
+programs stepnc writes (backends/heidenhain-tnc). No Heidenhain checker is
+packaged for this machine, so this script reads the program back the way the
+control would, for the subset of Klartext the backend writes, and reports
+what the control would reject or do differently:
+
+  * frame: block numbers from 0, consecutive, on every line (the indented
+    `Qnnn=` lines of a CYCL DEF are continuations of its block: the line
+    before ends in `~`); `BEGIN PGM NAME MM` first and `END PGM NAME MM` last
+    with the same name; `M30` (or `M2`) in the block before `END PGM`;
+  * words: every block of a known form; coordinates signed, no exponent, no
+    `-0`; `L` blocks made of X/Y/Z, R0/RL/RR, F or FMAX and one M function
+    from a whitelist; `TOOL CALL n Z S..`; `BLK FORM 0.1 Z` then `0.2` with
+    MIN below MAX; cycle 32 and cycle 200 with all their Q parameters;
+  * motion: no motion before a TOOL CALL, no feed move without a feed or
+    with the spindle stopped; a `C` needs a `CC` and the tracked position and
+    the end as far from it within --arc-tol (default 0.001 mm); `CP` has IPA
+    and DR of the same sign; `M99` needs a cycle 200 and the tool at or above
+    its second set-up clearance (the security plane).
+
+With --ir TOOLPATH.IR the moves the program makes (cycle 200 expanded as the
+TNC manual describes it: README.md) are also compared with the toolpath
+IR's moves: runs of rapids by where they end, feed moves by end point and
+feed, arcs by end point, centre, direction and swept angle.
+
+Exit status 0 when clean, 1 listing each problem with its block number.
+"""
+import argparse
+import math
+import re
+import sys
+
+NUM_SIGNED = r"[+-]\d+(?:\.\d+)?"
+NUM_UNSIGNED = r"\d+(?:\.\d+)?"
+M_ALLOWED = {0, 1, 2, 3, 4, 5, 7, 8, 9, 30, 99}
+CYCLE_200_Q = [200, 201, 206, 202, 210, 203, 204, 211]
+END_TOL = 0.002     # a CP ends where the control turns the start: printed angle and pole
+CENTRE_TOL = 0.005  # printed poles are moved along the grid to balance the radii
+FEED_TOL = 0.5 + 1e-6  # feeds are printed as whole mm/min
+
+
+class Problems:
+    def __init__(self):
+        self.items = []
+
+    def add(self, where, text):
+        self.items.append("%s: %s" % (where, text))
+
+
+def signed(text, where, problems, what):
+    """The value of a signed coordinate word's number, or None (reported)."""
+    if not re.fullmatch(NUM_SIGNED, text):
+        problems.add(where, "%s '%s' is not a signed decimal number (sign, digits, '.' decimals)" % (what, text))
+        return None
+    value = float(text)
+    if value == 0 and text.startswith("-"):
+        problems.add(where, "%s '%s' is a negative zero" % (what, text))
+    return value
+
+
+def unsigned(text, where, problems, what):
+    if not re.fullmatch(NUM_UNSIGNED, text):
+        problems.add(where, "%s '%s' is not an unsigned decimal number" % (what, text))
+        return None
+    return float(text)
+
+
+def read_blocks(text, problems):
+    """[(number or None, first line text, [continuation lines], line number)]."""
+    blocks = []
+    expected = 0
+    continuing = False
+    if text and not text.endswith("\n"):
+        problems.add("end of file", "the last line has no line end")
+    for lineno, line in enumerate(text.split("\n")[:-1] if text.endswith("\n") else text.split("\n"), 1):
+        if any(ord(c) > 126 or (ord(c) < 32 and c != "\t") for c in line) or "\t" in line:
+            problems.add("line %d" % lineno, "characters other than printable ASCII")
+        if line != line.rstrip():
+            problems.add("line %d" % lineno, "trailing spaces")
+        if continuing:
+            if blocks:
+                blocks[-1][2].append(line.strip())
+            continuing = line.rstrip().endswith("~")
+            continue
+        m = re.fullmatch(r"(\d+) (\S.*)", line)
+        if not m:
+            problems.add("line %d" % lineno, "no block number: '%s'" % line)
+            continue
+        number = int(m.group(1))
+        if number != expected:
+            problems.add("block %d" % number, "block number %d where %d was due (line %d)" % (number, expected, lineno))
+        expected = number + 1
+        blocks.append((number, m.group(2), [], lineno))
+        continuing = m.group(2).rstrip().endswith("~")
+    if continuing:
+        problems.add("end of file", "the last block ends in '~' (continued) but nothing follows")
+    return blocks
+
+
+class Machine:
+    """What the control has after each block: position, pole, feed, spindle,
+    defined cycle; and the motions it made (for --ir)."""
+
+    def __init__(self, problems, arc_tol):
+        self.p = problems
+        self.arc_tol = arc_tol
+        self.pos = [None, None, None]
+        self.cc = None
+        self.feed = None
+        self.tool = None
+        self.spindle = False
+        self.cycle = None
+        self.motions = []
+
+    def where(self):
+        return tuple(self.pos)
+
+    def need_tool(self, where):
+        if self.tool is None:
+            self.p.add(where, "motion before any TOOL CALL")
+
+    def feed_move(self, where, feed):
+        if feed is not None:
+            self.feed = feed
+        if self.feed is None:
+            self.p.add(where, "feed move without a feed programmed since the TOOL CALL")
+        if not self.spindle:
+            self.p.add(where, "feed move with the spindle stopped (no M3/M4 since the TOOL CALL or a stop)")
+
+    def m_function(self, where, m, before_motion):
+        """M functions effective at the start of the block (before_motion) or
+        at its end."""
+        if before_motion and m in (3, 4):
+            if self.tool is None:
+                self.p.add(where, "M%d before any TOOL CALL" % m)
+            self.spindle = True
+        if not before_motion and m in (0, 1, 2, 5, 30):
+            self.spindle = False
+
+    def line(self, where, axes, rapid, feed):
+        self.need_tool(where)
+        if not rapid and axes:
+            self.feed_move(where, feed)
+        target = list(self.pos)
+        for k, v in axes.items():
+            target["XYZ".index(k)] = v
+        if axes:
+            self.motions.append({"kind": "rapid" if rapid else "linear", "to": tuple(target),
+                                 "feed": None if rapid else self.feed, "where": where})
+        self.pos = target
+
+    def arc(self, where, end_xy, ccw, feed):
+        self.need_tool(where)
+        self.feed_move(where, feed)
+        if self.cc is None:
+            self.p.add(where, "C without a CC before it")
+            return
+        if self.pos[0] is None or self.pos[1] is None:
+            self.p.add(where, "C from an unknown position")
+            return
+        x = end_xy[0] if end_xy[0] is not None else self.pos[0]
+        y = end_xy[1] if end_xy[1] is not None else self.pos[1]
+        r1 = math.hypot(self.pos[0] - self.cc[0], self.pos[1] - self.cc[1])
+        r2 = math.hypot(x - self.cc[0], y - self.cc[1])
+        if abs(r1 - r2) > self.arc_tol + 1e-9:
+            self.p.add(where, "arc radius from the start %.4f and to the end %.4f differ by %.4f mm (more than %g)"
+                       % (r1, r2, abs(r1 - r2), self.arc_tol))
+        if r1 < 1e-9:
+            self.p.add(where, "arc of zero radius")
+        a = (self.pos[0] - self.cc[0], self.pos[1] - self.cc[1])
+        b = (x - self.cc[0], y - self.cc[1])
+        sweep = turn_angle(a, b, ccw)
+        if math.hypot(x - self.pos[0], y - self.pos[1]) < 1e-9:
+            sweep = 2 * math.pi
+        self.motions.append({"kind": "arc", "to": (x, y, self.pos[2]), "centre": self.cc, "ccw": ccw,
+                             "sweep": sweep, "radius": r1, "feed": self.feed, "where": where})
+        self.pos = [x, y, self.pos[2]]
+
+    def polar_arc(self, where, ipa_deg, iz, ccw, feed):
+        self.need_tool(where)
+        self.feed_move(where, feed)
+        if self.cc is None:
+            self.p.add(where, "CP without a CC before it")
+            return
+        if None in self.pos:
+            self.p.add(where, "CP from an unknown position")
+            return
+        a = math.radians(ipa_deg)
+        rx, ry = self.pos[0] - self.cc[0], self.pos[1] - self.cc[1]
+        x = self.cc[0] + rx * math.cos(a) - ry * math.sin(a)
+        y = self.cc[1] + rx * math.sin(a) + ry * math.cos(a)
+        z = self.pos[2] + iz
+        self.motions.append({"kind": "arc", "to": (x, y, z), "centre": self.cc, "ccw": ccw, "sweep": abs(a),
+                             "radius": math.hypot(rx, ry), "feed": self.feed, "where": where})
+        self.pos = [x, y, z]
+
+    def call_cycle(self, where):
+        """M99 at the end of an L block: cycle 200 at the position."""
+        q = self.cycle
+        if q is None:
+            self.p.add(where, "M99 without a CYCL DEF 200 before it")
+            return
+        if None in self.pos:
+            self.p.add(where, "M99 at an unknown position")
+            return
+        if not self.spindle:
+            self.p.add(where, "cycle called with the spindle stopped")
+        surface, clearance, depth = q[203], q[200], q[201]
+        second = max(q[204], clearance)
+        if self.pos[2] < surface + q[204] - 1e-6:
+            self.p.add(where, "cycle called at Z%.4f, below its 2nd set-up clearance Z%.4f (the security plane): "
+                              "the move to the hole is not safe" % (self.pos[2], surface + q[204]))
+        x, y = self.pos[0], self.pos[1]
+        bottom = surface + depth
+        self.motions.append({"kind": "rapid", "to": (x, y, surface + clearance), "where": where})
+        reached = surface
+        k = 1
+        while True:
+            target = max(surface - q[202] * k, bottom) if q[202] < -depth else bottom
+            if reached < surface:
+                self.motions.append({"kind": "rapid", "to": (x, y, surface + clearance), "where": where})
+                self.motions.append({"kind": "rapid", "to": (x, y, reached + clearance), "where": where})
+            self.motions.append({"kind": "linear", "to": (x, y, target), "feed": q[206], "where": where})
+            reached = target
+            if target <= bottom + 1e-9:
+                break
+            k += 1
+        self.motions.append({"kind": "rapid", "to": (x, y, surface + second), "where": where})
+        self.pos = [x, y, surface + second]
+        # The feed the cycle used is not the program's: a feed move must state one again.
+        self.feed = None
+
+
+def turn_angle(a, b, ccw):
+    angle = math.atan2(a[0] * b[1] - a[1] * b[0], a[0] * b[0] + a[1] * b[1])
+    if not ccw:
+        angle = -angle
+    if angle < 0:
+        angle += 2 * math.pi
+    return angle
+
+
+def check_l(words, where, mach, problems, is_last_before_end):
+    """An L block: X Y Z (signed, in order), R0/RL/RR, F<n> or FMAX, one M."""
+    axes = {}
+    order = "XYZ"
+    state = 0  # 0 axes, 1 after R, 2 after F, 3 after M
+    rapid = False
+    feed = None
+    ms = []
+    for w in words:
+        m = re.fullmatch(r"([XYZ])(.*)", w)
+        if m and state == 0:
+            axis = m.group(1)
+            if axis in axes or (axes and order.index(axis) < order.index(list(axes)[-1])):
+                problems.add(where, "axis %s repeated or out of X Y Z order" % axis)
+            v = signed(m.group(2), where, problems, "coordinate " + axis)
+            if v is not None:
+                axes[axis] = v
+            continue
+        if w in ("R0", "RL", "RR") and state < 1:
+            state = 1
+            if w != "R0":
+                problems.add(where, "radius compensation %s: stepnc writes tool-centre paths (R0)" % w)
+            continue
+        if w == "FMAX" and state < 2:
+            rapid, state = True, 2
+            continue
+        m = re.fullmatch(r"F(.*)", w)
+        if m and state < 2:
+            feed = unsigned(m.group(1), where, problems, "feed")
+            if feed is not None and feed <= 0:
+                problems.add(where, "feed F%s is not positive" % m.group(1))
+            state = 2
+            continue
+        m = re.fullmatch(r"M(\d+)", w)
+        if m:
+            state = 3
+            n = int(m.group(1))
+            if n not in M_ALLOWED:
+                problems.add(where, "M%d is not among the M functions stepnc writes %s" % (n, sorted(M_ALLOWED)))
+            ms.append(n)
+            continue
+        problems.add(where, "word '%s' is not valid here in an L block" % w)
+    if len(ms) > 1:
+        problems.add(where, "%d M functions in one block (stepnc writes one)" % len(ms))
+    if axes and feed is None and not rapid:
+        pass  # modal feed: checked by the machine
+    for n in ms:
+        mach.m_function(where, n, before_motion=True)
+    mach.line(where, axes, rapid, feed)
+    for n in ms:
+        mach.m_function(where, n, before_motion=False)
+        if n == 99:
+            mach.call_cycle(where)
+    if (2 in ms or 30 in ms) and not is_last_before_end:
+        problems.add(where, "program end M%d before the block before END PGM" % ms[0])
+    return ms
+
+
+def check_program(text, arc_tol):
+    problems = Problems()
+    mach = Machine(problems, arc_tol)
+    blocks = read_blocks(text, problems)
+    if not blocks:
+        problems.add("file", "no blocks")
+        return problems, mach
+    begin = re.fullmatch(r"BEGIN PGM (\S+) (\S+)", blocks[0][1])
+    end = re.fullmatch(r"END PGM (\S+) (\S+)", blocks[-1][1])
+    if not begin:
+        problems.add("block %d" % blocks[0][0], "the program does not start with BEGIN PGM NAME MM")
+    if not end:
+        problems.add("block %d" % blocks[-1][0], "the program does not end with END PGM NAME MM")
+    if begin and end:
+        if begin.group(1) != end.group(1):
+            problems.add("block %d" % blocks[-1][0], "END PGM %s does not match BEGIN PGM %s"
+                         % (end.group(1), begin.group(1)))
+        if not re.fullmatch(r"[A-Za-z0-9_]+", begin.group(1)):
+            problems.add("block 0", "program name '%s' has characters other than letters, digits and _"
+                         % begin.group(1))
+        for m, b in ((begin, blocks[0]), (end, blocks[-1])):
+            if m.group(2) != "MM":
+                problems.add("block %d" % b[0], "units '%s' where MM was expected" % m.group(2))
+    ended = False
+    blk01 = None
+    last = len(blocks) - 1
+    for i, (number, first, cont, lineno) in enumerate(blocks):
+        where = "block %d" % number
+        body = first
+        if i in (0, last) and ((i == 0 and begin) or (i == last and end)):
+            continue
+        if re.match(r"(BEGIN|END) PGM", body):
+            problems.add(where, "BEGIN PGM / END PGM inside the program")
+            continue
+        if body.startswith(";") or body.startswith("* - "):
+            if body.rstrip().endswith("~"):
+                problems.add(where, "a comment ending in '~' continues the block")
+            continue
+        if cont and not body.startswith("CYCL DEF 200 "):
+            problems.add(where, "continuation lines after a block that is not a cycle definition")
+        words = body.split()
+        if ended:
+            problems.add(where, "block after the program end (M30/M2)")
+        if body.startswith("BLK FORM"):
+            m = re.fullmatch(r"BLK FORM 0\.1 Z X(\S+) Y(\S+) Z(\S+)", body)
+            m2 = re.fullmatch(r"BLK FORM 0\.2 X(\S+) Y(\S+) Z(\S+)", body)
+            if m:
+                blk01 = ([signed(v, where, problems, "BLK FORM coordinate") for v in m.groups()], number)
+            elif m2:
+                if blk01 is None or blk01[1] != number - 1:
+                    problems.add(where, "BLK FORM 0.2 not right after a BLK FORM 0.1")
+                else:
+                    hi = [signed(v, where, problems, "BLK FORM coordinate") for v in m2.groups()]
+                    for k, (a, b) in enumerate(zip(blk01[0], hi)):
+                        if a is not None and b is not None and not a < b:
+                            problems.add(where, "BLK FORM MIN %s%g is not below MAX %s%g" % ("XYZ"[k], a, "XYZ"[k], b))
+                blk01 = None
+            else:
+                problems.add(where, "BLK FORM block not of the form 'BLK FORM 0.1 Z X.. Y.. Z..' / "
+                                    "'BLK FORM 0.2 X.. Y.. Z..'")
+            continue
+        if blk01 is not None and blk01[1] == number - 1:
+            problems.add(where, "BLK FORM 0.1 without its BLK FORM 0.2 after it")
+            blk01 = None
+        if body.startswith("TOOL CALL"):
+            m = re.fullmatch(r"TOOL CALL (\d+) Z(?: S(\S+))?", body)
+            if not m:
+                problems.add(where, "TOOL CALL not of the form 'TOOL CALL n Z S..'")
+                continue
+            if int(m.group(1)) <= 0:
+                problems.add(where, "TOOL CALL %s: tool 0 empties the spindle" % m.group(1))
+            if m.group(2) is not None:
+                unsigned(m.group(2), where, problems, "spindle speed")
+            mach.tool = int(m.group(1))
+            mach.spindle = False
+            mach.feed = None
+            mach.pos = [None, None, None]
+            continue
+        if body == "CYCL DEF 32.0 TOLERANCE":
+            nxt = blocks[i + 1][1] if i + 1 < len(blocks) else ""
+            if not re.fullmatch(r"CYCL DEF 32\.1(?: T\S+)?", nxt):
+                problems.add(where, "CYCL DEF 32.0 not followed by CYCL DEF 32.1")
+            continue
+        m = re.fullmatch(r"CYCL DEF 32\.1(?: T(\S+))?", body)
+        if m:
+            if i == 0 or blocks[i - 1][1] != "CYCL DEF 32.0 TOLERANCE":
+                problems.add(where, "CYCL DEF 32.1 not right after CYCL DEF 32.0 TOLERANCE")
+            if m.group(1) is not None:
+                t = unsigned(m.group(1), where, problems, "tolerance")
+                if t is not None and t <= 0:
+                    problems.add(where, "tolerance T%s is not positive" % m.group(1))
+            continue
+        if body.startswith("CYCL DEF 200"):
+            check_cycle_200(body, cont, where, mach, problems)
+            continue
+        if words[0] == "L":
+            ms = check_l(words[1:], where, mach, problems, i == last - 1)
+            if 2 in ms or 30 in ms:
+                ended = True
+            continue
+        if words[0] == "CC":
+            m = re.fullmatch(r"CC X(\S+) Y(\S+)", body)
+            if not m:
+                problems.add(where, "CC not of the form 'CC X.. Y..'")
+                continue
+            x, y = (signed(v, where, problems, "pole coordinate") for v in m.groups())
+            if x is not None and y is not None:
+                mach.cc = (x, y)
+            continue
+        if words[0] == "C":
+            m = re.fullmatch(r"C(?: X(\S+))?(?: Y(\S+))? DR([+-])(?: F(\S+))?", body)
+            if not m or (m.group(1) is None and m.group(2) is None):
+                problems.add(where, "C not of the form 'C X.. Y.. DR+/- [F..]'")
+                continue
+            x = signed(m.group(1), where, problems, "coordinate X") if m.group(1) else None
+            y = signed(m.group(2), where, problems, "coordinate Y") if m.group(2) else None
+            feed = unsigned(m.group(4), where, problems, "feed") if m.group(4) else None
+            mach.arc(where, (x, y), m.group(3) == "+", feed)
+            continue
+        if words[0] == "CP":
+            m = re.fullmatch(r"CP IPA(\S+)(?: IZ(\S+))? DR([+-])?(?: F(\S+))?", body) if " DR" in body else None
+            if not m:
+                problems.add(where, "CP not of the form 'CP IPA.. [IZ..] DR+/- [F..]' (IPA and DR are needed)")
+                continue
+            ipa = signed(m.group(1), where, problems, "IPA")
+            iz = signed(m.group(2), where, problems, "IZ") if m.group(2) else 0.0
+            feed = unsigned(m.group(4), where, problems, "feed") if m.group(4) else None
+            if ipa is None or iz is None:
+                continue
+            ccw = m.group(3) == "+"
+            if ipa == 0 or (ipa > 0) != ccw:
+                problems.add(where, "IPA%s and DR%s do not turn the same way" % (m.group(1), m.group(3)))
+            mach.polar_arc(where, ipa, iz, ccw, feed)
+            continue
+        problems.add(where, "unknown block '%s'" % body)
+    if len(blocks) >= 2 and end:
+        before = blocks[-2][1].split()
+        if not (before and before[0] == "L" and ("M30" in before or "M2" in before)):
+            problems.add("block %d" % blocks[-2][0], "the block before END PGM is not the program end (M30 or M2)")
+    return problems, mach
+
+
+def check_cycle_200(body, cont, where, mach, problems):
+    if body != "CYCL DEF 200 DRILLING ~":
+        problems.add(where, "cycle 200 not written as 'CYCL DEF 200 DRILLING ~'")
+    q = {}
+    order = []
+    for k, line in enumerate(cont):
+        last = k == len(cont) - 1
+        m = re.fullmatch(r"Q(\d+)=(\S+) ;([^~;]*?)( ~)?", line)
+        if not m:
+            problems.add(where, "cycle parameter line '%s' not of the form 'Qnnn=value ;TEXT ~'" % line)
+            continue
+        if bool(m.group(4)) == last:
+            problems.add(where, "cycle parameter Q%s: '~' must end every line but the last" % m.group(1))
+        n = int(m.group(1))
+        v = signed(m.group(2), where, problems, "Q%d" % n)
+        if v is not None:
+            q[n] = v
+        order.append(n)
+    if order != CYCLE_200_Q:
+        problems.add(where, "cycle 200 parameters %s where %s were expected" %
+                     (" ".join("Q%d" % n for n in order), " ".join("Q%d" % n for n in CYCLE_200_Q)))
+        return
+    if len(q) != len(CYCLE_200_Q):
+        return
+    if not q[200] > 0:
+        problems.add(where, "Q200 (set-up clearance) is not positive")
+    if not q[201] < 0:
+        problems.add(where, "Q201 (depth) is not negative: the cycle would not drill")
+    if not q[202] > 0:
+        problems.add(where, "Q202 (plunging depth) is not positive")
+    if not q[206] > 0:
+        problems.add(where, "Q206 (feed) is not positive")
+    if q[204] < q[200]:
+        problems.add(where, "Q204 (2nd set-up clearance) is below Q200: the cycle ends at Q200 instead")
+    mach.cycle = q
+
+
+# --- Comparison with the toolpath IR ---------------------------------------------------
+
+IR_MOVE = re.compile(r"^\s*(rapid|linear|arc)\s+(.*)$")
+IR_ATTR = re.compile(r"(\w+)=(\([^)]*\)|\S+)")
+
+
+def ir_vec(text):
+    return tuple(float(v) for v in text.split(")")[0].strip("(").split(","))
+
+
+def ir_moves(path):
+    out = []
+    pos = (0.0, 0.0, 0.0)  # the program model's start (backends/common/Program.cpp)
+    with open(path) as f:
+        for lineno, line in enumerate(f, 1):
+            m = IR_MOVE.match(line.split(";")[0])
+            if not m:
+                continue
+            attrs = dict(IR_ATTR.findall(m.group(2)))
+            to = ir_vec(attrs["to"])
+            move = {"kind": m.group(1), "to": to, "where": "IR line %d" % lineno}
+            if "feed" in attrs:
+                move["feed"] = float(attrs["feed"].replace("mm/min", ""))
+            if m.group(1) == "arc":
+                c = ir_vec(attrs["center"])
+                ccw = attrs.get("dir") == "ccw"
+                turns = int(attrs.get("turns", "0"))
+                a = (pos[0] - c[0], pos[1] - c[1])
+                b = (to[0] - c[0], to[1] - c[1])
+                sweep = turn_angle(a, b, ccw)
+                if math.hypot(to[0] - pos[0], to[1] - pos[1]) <= 1e-9:
+                    sweep = 2 * math.pi
+                move.update(centre=(c[0], c[1]), ccw=ccw, sweep=sweep + 2 * math.pi * turns,
+                            radius=math.hypot(*a), start=pos)
+            else:
+                move["start"] = pos
+            out.append(move)
+            pos = to
+    return out
+
+
+def normalise(moves, decimals):
+    """Leaves out moves that go nowhere as printed (not whole circles) and
+    merges runs of rapids into their end."""
+    out = []
+    for mv in moves:
+        start = mv.get("start")
+        if start is not None:
+            same = all(round(a, decimals) == round(b, decimals) for a, b in zip(start, mv["to"]))
+            if same and not (mv["kind"] == "arc" and mv["sweep"] > math.pi):
+                continue
+        if mv["kind"] == "rapid" and out and out[-1]["kind"] == "rapid":
+            merged = dict(out[-1])
+            merged["to"] = tuple(b if b is not None else a for a, b in zip(out[-1]["to"], mv["to"]))
+            merged["where"] = mv["where"]
+            out[-1] = merged
+            continue
+        out.append(mv)
+    return out
+
+
+def program_moves(motions):
+    out = []
+    pos = (None, None, None)
+    for mv in motions:
+        mv = dict(mv)
+        mv["start"] = pos if None not in pos else None
+        if None in mv["to"]:
+            mv["start"] = None
+        out.append(mv)
+        pos = mv["to"]
+    return out
+
+
+def compare(prog, ir, problems):
+    n = min(len(prog), len(ir))
+    for a, b in zip(prog, ir):
+        where = "%s (%s)" % (a["where"], b["where"])
+        if a["kind"] != b["kind"]:
+            problems.add(where, "the program makes a %s where the IR has a %s" % (a["kind"], b["kind"]))
+            return
+        for k in range(3):
+            if a["to"][k] is not None and abs(a["to"][k] - b["to"][k]) > END_TOL:
+                problems.add(where, "%s ends at %s where the IR ends at %s" % (a["kind"], fmt(a["to"]), fmt(b["to"])))
+                return
+        if a["kind"] != "rapid" and abs((a.get("feed") or 0) - b.get("feed", 0)) > FEED_TOL:
+            problems.add(where, "feed %s where the IR has %s" % (a.get("feed"), b.get("feed")))
+        if a["kind"] == "arc":
+            if a["ccw"] != b["ccw"]:
+                problems.add(where, "arc turns the other way")
+            if math.hypot(a["centre"][0] - b["centre"][0], a["centre"][1] - b["centre"][1]) > CENTRE_TOL:
+                problems.add(where, "arc centre %s where the IR has %s" % (fmt(a["centre"]), fmt(b["centre"])))
+            if abs(a["sweep"] - b["sweep"]) * max(b["radius"], 1e-9) > CENTRE_TOL:
+                problems.add(where, "arc sweeps %.4f deg where the IR sweeps %.4f deg"
+                             % (math.degrees(a["sweep"]), math.degrees(b["sweep"])))
+    if len(prog) != len(ir):
+        problems.add("end", "the program makes %d moves and the IR has %d (first %d compared)" % (len(prog), len(ir), n))
+
+
+def fmt(v):
+    return "(" + ", ".join("?" if x is None else "%.4f" % x for x in v) + ")"
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("program", help="the Klartext program (.h)")
+    ap.add_argument("--ir", help="the toolpath IR it was written from: compare the moves")
+    ap.add_argument("--arc-tol", type=float, default=0.001,
+                    help="most a C arc's start and end radius may differ, mm (default 0.001)")
+    ap.add_argument("--decimals", type=int, default=3, help="coordinate decimals of the program (default 3)")
+    args = ap.parse_args()
+    with open(args.program, encoding="ascii", errors="replace") as f:
+        text = f.read()
+    problems, mach = check_program(text, args.arc_tol)
+    if args.ir:
+        compare(normalise(program_moves(mach.motions), args.decimals),
+                normalise(ir_moves(args.ir), args.decimals), problems)
+    if problems.items:
+        for item in problems.items:
+            print("%s: %s" % (args.program, item))
+        print("%s: %d problem(s)" % (args.program, len(problems.items)))
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,203 @@
+#!/usr/bin/env python3
+"""Runs LinuxCNC's rs274 interpreter on stepnc's rs274 programs and checks
+that the moves it makes are the planned ones.
+
+For each input (a STEP-NC file or IR text) the script compiles the toolpath
+IR and the rs274 program (as the options say), writes a tool table for
+rs274 (in inches, as that tool reads it, with zero length offsets), runs
+`rs274 -g` with a strict arc tolerance, and compares its canonical moves
+(STRAIGHT_TRAVERSE, STRAIGHT_FEED, ARC_FEED) with the IR's moves, one by
+one, within 0.001 mm:
+
+  * rapids: a run of consecutive rapids is compared by where it ends (a
+    backend may split a rapid, e.g. XY then Z after a tool change);
+  * feed moves: end point, and feed rate within the program's rounding;
+  * arcs: end point, centre, direction and number of turns.
+Moves that go nowhere are left out on both sides. With canned cycles on,
+the cycles' own rapids are the controller's: only the feed moves must match
+(--cycles); with --no-cycles everything must.
+
+Exit status 0 when every input matches, 1 otherwise (each difference is
+printed with the IR move and the canonical line).
+"""
+import argparse
+import fcntl
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+TOL = 1e-3
+
+MOVE_RE = re.compile(r"^\s*(rapid|linear|arc)\s+(.*)$")
+ATTR_RE = re.compile(r"(\w+)=(\([^)]*\)|\S+)")
+CANON_RE = re.compile(r"(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED|SET_FEED_RATE)\(([^)]*)\)")
+
+
+def vec(text):
+    return tuple(float(v) for v in text.split(")")[0].strip("(").split(","))
+
+
+def ir_moves(path):
+    """The moves of every `moves` block, in order: (kind, end, extra)."""
+    out = []
+    with open(path) as f:
+        for line in f:
+            code = line.split(";")[0]
+            m = MOVE_RE.match(code)
+            if not m:
+                continue
+            attrs = dict(ATTR_RE.findall(m.group(2)))
+            move = {"kind": m.group(1), "to": vec(attrs["to"]), "text": code.strip()}
+            if "feed" in attrs:
+                move["feed"] = float(attrs["feed"].replace("mm/min", ""))
+            if m.group(1) == "arc":
+                move["center"] = vec(attrs["center"])
+                move["ccw"] = attrs["dir"] == "ccw"
+                move["turns"] = int(attrs.get("turns", "0"))
+            out.append(move)
+    return out
+
+
+def canon_moves(path):
+    out = []
+    feed = 0.0
+    with open(path) as f:
+        for n, line in enumerate(f, 1):
+            m = CANON_RE.search(line)
+            if not m:
+                continue
+            args = [a.strip() for a in m.group(2).split(",")]
+            if m.group(1) == "SET_FEED_RATE":
+                feed = float(args[0])
+                continue
+            if m.group(1) == "ARC_FEED":
+                e1, e2, c1, c2, turn, e3 = (float(a) for a in args[:6])
+                out.append({"kind": "arc", "to": (e1, e2, e3), "center": (c1, c2), "ccw": turn > 0,
+                            "turns": abs(int(turn)) - 1, "feed": feed, "text": "canon line %d: %s" % (n, line.strip())})
+            else:
+                kind = "rapid" if m.group(1) == "STRAIGHT_TRAVERSE" else "linear"
+                move = {"kind": kind, "to": tuple(float(a) for a in args[:3]),
+                        "text": "canon line %d: %s" % (n, line.strip())}
+                if kind == "linear":
+                    move["feed"] = feed
+                out.append(move)
+    return out
+
+
+def close(a, b):
+    return all(abs(x - y) <= TOL for x, y in zip(a, b))
+
+
+def normalise(moves, feeds_only):
+    """Leaves out moves that go nowhere and keeps the end of each run of rapids."""
+    out = []
+    at = None
+    for mv in moves:
+        if mv["kind"] != "arc" and at is not None and close(mv["to"], at):
+            continue
+        at = mv["to"]
+        if feeds_only and mv["kind"] == "rapid":
+            continue
+        if out and mv["kind"] == "rapid" and out[-1]["kind"] == "rapid":
+            out[-1] = mv
+        else:
+            out.append(mv)
+    return out
+
+
+def compare(ir, canon, feeds_only, feed_tol):
+    a = normalise(ir, feeds_only)
+    b = normalise(canon, feeds_only)
+    problems = []
+    for i, (x, y) in enumerate(zip(a, b)):
+        why = None
+        if x["kind"] != y["kind"]:
+            why = "kind %s != %s" % (x["kind"], y["kind"])
+        elif not close(x["to"], y["to"]):
+            why = "end point differs"
+        elif x["kind"] != "rapid" and abs(x["feed"] - y["feed"]) > feed_tol:
+            why = "feed %.3f != %.3f" % (x["feed"], y["feed"])
+        elif x["kind"] == "arc" and (not close(x["center"][:2], y["center"]) or x["ccw"] != y["ccw"]
+                                     or x["turns"] != y["turns"]):
+            why = "arc centre, direction or turns differ"
+        if why:
+            problems.append("move %d: %s\n    IR:    %s\n    %s" % (i + 1, why, x["text"], y["text"]))
+            if len(problems) >= 5:
+                break
+    if len(a) != len(b) and len(problems) < 5:
+        problems.append("the IR has %d moves, rs274 made %d" % (len(a), len(b)))
+    return problems, len(a)
+
+
+def run(cmd, **kw):
+    return subprocess.run(cmd, capture_output=True, text=True, **kw)
+
+
+def check(stepnc, path, cycles, extra, workdir, program=None):
+    base = os.path.join(workdir, "prog")
+    ir_path, ngc_path, canon_path = base + ".ir", base + ".ngc", base + ".canon"
+    r = run([stepnc, "compile", path, "--emit=toolpath-ir", "-o", ir_path] + extra)
+    if r.returncode != 0:
+        return ["stepnc could not make the toolpath IR:\n" + r.stderr]
+    if program:
+        ngc_path = program
+    else:
+        opts = ([] if cycles else ["--no-cycles"]) + extra
+        r = run([stepnc, "compile", path, "--target=rs274", "-o", ngc_path] + opts)
+        if r.returncode != 0:
+            return ["stepnc could not write the rs274 program:\n" + r.stderr]
+    # The tool table: every T number the program calls, length 0, with the
+    # diameter the header gives (0.25 in otherwise), in inches.
+    tools, diameters = {}, {}
+    with open(ngc_path) as f:
+        for line in f:
+            m = re.match(r"\(T(\d+) .*diameter ([0-9.]+) mm", line)
+            if m:
+                diameters[int(m.group(1))] = float(m.group(2)) / 25.4
+            for t in re.findall(r"\bT(\d+)\b", line.split("(")[0]):
+                tools[int(t)] = None
+    for t in tools:
+        tools[t] = diameters.get(t, 0.25)
+    table = os.path.join(workdir, "tools.tbl")
+    with open(table, "w") as f:
+        for t, d in sorted(tools.items()):
+            f.write("T%d P%d Z0 D%.6f ;\n" % (t, t, d))
+    ini = os.path.join(workdir, "strict.ini")
+    with open(ini, "w") as f:
+        f.write("[RS274NGC]\nCENTER_ARC_RADIUS_TOLERANCE_MM = 0.001\n")
+    # rs274 keeps its tool data in a memory-mapped file (/tmp/.tool.mmap) shared by every rs274
+    # running on the machine: two at once read each other's tools. One at a time.
+    with open("/tmp/stepnc-rs274.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        r = run(["rs274", "-g", "-t", table, "-i", ini, "-v", os.path.join(workdir, "vars.var"), ngc_path,
+                 canon_path], cwd=workdir, stdin=subprocess.DEVNULL)
+    if r.returncode != 0:
+        return ["rs274 rejected the program (exit %d):\n%s%s" % (r.returncode, r.stdout, r.stderr)]
+    problems, n = compare(ir_moves(ir_path), canon_moves(canon_path), cycles, 0.05 + 1e-9)
+    if not problems:
+        print("ok: %s%s: %d moves match" % (os.path.basename(path), "" if cycles else " (--no-cycles)", n))
+    return problems
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--stepnc", required=True, help="the stepnc executable")
+    ap.add_argument("--no-cycles", action="store_true", help="compile with --no-cycles and compare every move")
+    ap.add_argument("--program", help="check this program against the (single) input's IR instead of "
+                    "compiling one (to show that the check can fail)")
+    ap.add_argument("inputs", nargs="+")
+    args, extra = ap.parse_known_args()
+    failed = False
+    for path in args.inputs:
+        with tempfile.TemporaryDirectory() as work:
+            problems = check(args.stepnc, path, not args.no_cycles, extra, work, args.program)
+        for p in problems:
+            print("FAIL: %s: %s" % (path, p))
+        failed = failed or bool(problems)
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
