@@ -16,8 +16,16 @@ std::optional<ToolTable> ToolTable::parse(const SourceFile &file, DiagnosticEngi
     if (lineEnd == std::string_view::npos)
       lineEnd = text.size();
     std::string_view line = text.substr(lineStart, lineEnd - lineStart);
-    if (size_t hash = line.find('#'); hash != std::string_view::npos && line.find('"') > hash)
-      line = line.substr(0, hash);
+    // A '#' outside quotes starts a comment.
+    bool quoted = false;
+    for (size_t k = 0; k < line.size(); ++k) {
+      if (line[k] == '"')
+        quoted = !quoted;
+      else if (line[k] == '#' && !quoted) {
+        line = line.substr(0, k);
+        break;
+      }
+    }
     // Split into fields; a quoted field may hold spaces.
     std::vector<std::pair<std::string, size_t>> fields;  // text, offset in the file
     size_t i = 0;

@@ -1,0 +1,213 @@
+// The G-code words every target shares: numbers, modal state, balanced arc
+// centres, arc splitting and sweeps, tool tables, and the canned cycles
+// recognised in a hole-making step's moves.
+#include "backends/Target.h"
+#include "backends/common/Program.h"
+#include "backends/common/ToolTable.h"
+#include "backends/common/Words.h"
+
+#include "../ir/SampleModule.h"
+
+#include <catch2/catch.hpp>
+
+#include <numbers>
+
+using namespace stepnc;
+using namespace stepnc::backends;
+
+TEST_CASE("numbers are written without exponent or -0, with the point", "[backends]") {
+  const NumberStyle iso{3, false, true};
+  CHECK(formatNumber(10, iso) == "10.");
+  CHECK(formatNumber(10.5, iso) == "10.5");
+  CHECK(formatNumber(-0.0001, iso) == "0.");  // rounds to -0
+  CHECK(formatNumber(-0.0, iso) == "0.");
+  CHECK(formatNumber(1e-7, iso) == "0.");
+  CHECK(formatNumber(123456789.0, iso) == "123456789.");
+  CHECK(formatNumber(0.0005, iso) == "0.001");  // half away from zero
+  CHECK(formatNumber(-2.25, {1, false, true}) == "-2.3");
+  const NumberStyle tnc{3, true, false};
+  CHECK(formatNumber(25, tnc) == "+25");
+  CHECK(formatNumber(-7.5, tnc) == "-7.5");
+  CHECK(formatNumber(-0.0002, tnc) == "+0");
+}
+
+TEST_CASE("modal words are written only when they change", "[backends]") {
+  ModalState m;
+  CHECK(m.change("G", "G1"));
+  CHECK_FALSE(m.change("G", "G1"));
+  CHECK(m.change("G", "G0"));
+  m.forget("G");
+  CHECK(m.change("G", "G0"));
+}
+
+TEST_CASE("arc centres are balanced between the endpoints as printed", "[backends]") {
+  // A quarter arc of radius 10 about the origin, its end rounded off the circle.
+  const geom::Vec2 from(10, 0), to(0.0004, 10.0004), centre(0, 0);
+  const geom::Vec2 c = balancedCentre(from, to, centre);
+  CHECK(std::abs((c - from).norm() - (c - to).norm()) < 1e-12);
+  CHECK((c - centre).norm() < 1e-3);
+  // A whole circle keeps its centre.
+  CHECK((balancedCentre(from, from, centre) - centre).norm() == 0);
+}
+
+TEST_CASE("arc sweeps count full turns; split points divide them equally", "[backends]") {
+  Move m;
+  m.kind = Move::Kind::Arc;
+  m.from = {10, 0, 0};
+  m.to = {0, 10, 0};
+  m.centre = {0, 0};
+  m.ccw = true;
+  CHECK(m.sweep() == Approx(std::numbers::pi / 2));
+  m.ccw = false;
+  CHECK(m.sweep() == Approx(3 * std::numbers::pi / 2));
+  m.to = {10, 0, -5};  // over the start: a whole turn, plus one more
+  m.turns = 1;
+  CHECK(m.sweep() == Approx(4 * std::numbers::pi));
+  const auto ends = arcSplitPoints({10, 0}, {0, 0}, true, std::numbers::pi, 2);
+  REQUIRE(ends.size() == 2);
+  CHECK((ends[0] - geom::Vec2(0, 10)).norm() < 1e-12);
+  CHECK((ends[1] - geom::Vec2(-10, 0)).norm() < 1e-12);
+}
+
+TEST_CASE("numbered blocks and overlong lines", "[backends]") {
+  TargetDescriptor d;
+  d.numbering = Numbering::Every;
+  d.numberStep = 10;
+  d.maxLineLength = 12;
+  BlockWriter w(d);
+  w.raw("%");
+  w.block("G0 X1.");
+  w.block("G1 X123.456 Y7.");
+  CHECK(w.text() == "%\nN10 G0 X1.\nN20 G1 X123.456 Y7.\n");
+  REQUIRE(w.overlong().size() == 1);
+  CHECK(w.overlong()[0] == 3);
+  TargetDescriptor z;
+  z.numbering = Numbering::FromZero;
+  BlockWriter tnc(z);
+  tnc.block("BEGIN PGM A MM");
+  tnc.block("END PGM A MM");
+  CHECK(tnc.text() == "0 BEGIN PGM A MM\n1 END PGM A MM\n");
+}
+
+TEST_CASE("capability overrides are checked", "[backends]") {
+  TargetDescriptor d;
+  d.name = "t";
+  d.cycles = {CycleKind::Drill};
+  CHECK(applyOverrides(d, {"decimals=4", "arcs=radius", "cycles=off", "max-line-length=80"}).empty());
+  CHECK(d.coordDecimals == 4);
+  CHECK(d.arcs == ArcForm::Radius);
+  CHECK(d.cycles.empty());
+  CHECK(d.maxLineLength == 80);
+  CHECK_FALSE(applyOverrides(d, {"decimals=7"}).empty());
+  CHECK_FALSE(applyOverrides(d, {"arcs"}).empty());
+  CHECK_FALSE(applyOverrides(d, {"colour=red"}).empty());
+  d.numbering = Numbering::FromZero;
+  CHECK(applyOverrides(d, {"line-numbers=none"}).find("cannot be changed") != std::string::npos);
+}
+
+TEST_CASE("tool tables: entries by id or symbol, errors at line and column", "[backends]") {
+  auto file = SourceFile::fromString("tools.txt", "# comment\n\"T2 ENDMILL\"  12  85.5 # the rougher\n"
+                                                  "%t3 7\n");
+  DiagnosticCollector collector;
+  DiagnosticEngine diags(collector);
+  auto table = ToolTable::parse(*file, diags);
+  REQUIRE(table);
+  ir::Node t2("tool");
+  t2.symbol = "%t2";
+  t2.label = "T2 ENDMILL";
+  ir::Node t3("tool");
+  t3.symbol = "%t3";
+  ir::Node t4("tool");
+  t4.symbol = "%t4";
+  REQUIRE(table->find(t2));
+  CHECK(table->find(t2)->number == 12);
+  CHECK(*table->find(t2)->length == 85.5);
+  REQUIRE(table->find(t3));
+  CHECK(table->find(t3)->number == 7);
+  CHECK_FALSE(table->find(t3)->length);
+  CHECK(table->find(t4) == nullptr);
+
+  for (const char *bad : {"\"T2 ENDMILL 12\n", "T2 12\n", "%t2 0\n", "%t2 5 -1\n", "%t2 5 1 2\n", "%t2\n"}) {
+    DiagnosticCollector collector;
+    DiagnosticEngine d(collector);
+    auto f = SourceFile::fromString("bad.txt", bad);
+    CHECK_FALSE(ToolTable::parse(*f, d));
+    CHECK(d.errorCount() == 1);
+  }
+}
+
+namespace {
+
+/// A drilled hole's workingstep with the given moves, in IR text.
+std::optional<Program> holeProgram(const std::string &op, const std::string &moves) {
+  auto parsed = ir::test::parse(
+      "project \"P\"\n"
+      "  workpiece %wp \"WP\"\n"
+      "    round_hole %h \"H\" at=(10.0000,10.0000,0.0000)mm axis=(0.000000,0.000000,1.000000) "
+      "ref=(1.000000,0.000000,0.000000) depth=12.0000mm diameter=8.0000mm bottom=flat\n"
+      "  tool %d \"DRILL\" type=twist_drill diameter=8.0000mm\n"
+      "  workplan @plan \"PLAN\"\n"
+      "    workingstep @ws \"WS\" feature=%h secplane=20.0000mm\n"
+      "      " + op + " \"OP\" tool=%d\n"
+      "      moves tool=%d spindle=-1000.0rev/min coolant=off secplane=20.0000mm\n" + moves);
+  REQUIRE(parsed.errors.empty());
+  static std::unique_ptr<ir::Module> keep;
+  keep = std::move(parsed.module);
+  DiagnosticCollector collector;
+  DiagnosticEngine diags(collector);
+  return buildProgram(*keep, nullptr, diags);
+}
+
+const std::string kIn = "        rapid to=(10.0000,10.0000,20.0000)mm role=position\n"
+                        "        rapid to=(10.0000,10.0000,2.0000)mm role=approach\n";
+
+} // namespace
+
+TEST_CASE("hole cycles are recognised from the moves, and only from them", "[backends]") {
+  auto drill = holeProgram("drilling", kIn +
+                                           "        linear to=(10.0000,10.0000,-12.0000)mm feed=100.0mm/min role=plunge\n"
+                                           "        rapid to=(10.0000,10.0000,20.0000)mm role=retract\n");
+  REQUIRE(drill);
+  REQUIRE(drill->steps.size() == 1);
+  REQUIRE(drill->steps[0].cycle);
+  const HoleCycle &c = *drill->steps[0].cycle;
+  CHECK(c.kind == CycleKind::Drill);
+  CHECK(c.initialZ == 20);
+  CHECK(c.retractZ == 2);
+  CHECK(c.surfaceZ == 0);
+  CHECK(c.depthZ == -12);
+  CHECK(c.feed == 100);
+  CHECK(c.feedOut == 0);
+
+  auto peck = holeProgram("multistep_drilling",
+                          kIn + "        linear to=(10.0000,10.0000,-5.0000)mm feed=100.0mm/min role=plunge\n"
+                                "        rapid to=(10.0000,10.0000,2.0000)mm role=retract\n"
+                                "        rapid to=(10.0000,10.0000,-4.5000)mm role=approach\n"
+                                "        linear to=(10.0000,10.0000,-12.0000)mm feed=100.0mm/min role=plunge\n"
+                                "        rapid to=(10.0000,10.0000,20.0000)mm role=retract\n");
+  REQUIRE(peck);
+  REQUIRE(peck->steps[0].cycle);
+  CHECK(peck->steps[0].cycle->pecks == std::vector<double>{-5, -12});
+
+  auto ream = holeProgram("reaming", kIn +
+                                         "        linear to=(10.0000,10.0000,-12.0000)mm feed=100.0mm/min role=plunge\n"
+                                         "        linear to=(10.0000,10.0000,2.0000)mm feed=50.0mm/min role=retract\n"
+                                         "        rapid to=(10.0000,10.0000,20.0000)mm role=retract\n");
+  REQUIRE(ream);
+  REQUIRE(ream->steps[0].cycle);
+  CHECK(ream->steps[0].cycle->kind == CycleKind::Bore);
+  CHECK(ream->steps[0].cycle->feedOut == 50);
+
+  // A move off the axis, or a drill that leaves at feed: no cycle.
+  auto off = holeProgram("drilling", kIn +
+                                         "        linear to=(10.5000,10.0000,-12.0000)mm feed=100.0mm/min role=plunge\n"
+                                         "        rapid to=(10.5000,10.0000,20.0000)mm role=retract\n");
+  REQUIRE(off);
+  CHECK_FALSE(off->steps[0].cycle);
+  auto slow = holeProgram("drilling", kIn +
+                                          "        linear to=(10.0000,10.0000,-12.0000)mm feed=100.0mm/min role=plunge\n"
+                                          "        linear to=(10.0000,10.0000,2.0000)mm feed=100.0mm/min role=retract\n"
+                                          "        rapid to=(10.0000,10.0000,20.0000)mm role=retract\n");
+  REQUIRE(slow);
+  CHECK_FALSE(slow->steps[0].cycle);
+}
