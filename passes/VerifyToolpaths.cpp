@@ -422,12 +422,24 @@ private:
     // leave the rule they are reported as warnings, to be read, not refused.
     const bool explicitRapids = s.exec->kind == "rapid_movement";
     std::vector<Offence> rapids;
-    for (const Move &m : s.moves)
-      if (m.kind == MoveKind::Rapid && m.from && !rapidSafe(s, m))
+    // Bores this step has cut along the tool axis, by position: their lowest point.
+    std::vector<std::pair<Vec2, double>> bores;
+    for (const Move &m : s.moves) {
+      if (m.isFeed() && m.from && (m.to.head<2>() - m.from->head<2>()).norm() <= s.tol && m.to.z() < m.from->z()) {
+        auto bore = std::find_if(bores.begin(), bores.end(), [&](const auto &b) {
+          return (b.first - m.to.head<2>()).norm() <= s.tol;
+        });
+        if (bore == bores.end())
+          bores.emplace_back(m.to.head<2>(), m.to.z());
+        else
+          bore->second = std::min(bore->second, m.to.z());
+      }
+      if (m.kind == MoveKind::Rapid && m.from && !rapidSafe(s, m, bores))
         rapids.push_back({m.node, "rapid from " + pointText(*m.from) + " to " + pointText(m.to) +
                                       " below the security plane z=" + mm(s.secplane) +
                                       (s.shape ? " and not along the tool axis above " + s.shape->symbol
                                                : " and not along the tool axis")});
+    }
     if (explicitRapids) {
       report(s, rapids, "explicit rapids below the security plane", /*warning=*/true);
     } else {
@@ -438,8 +450,9 @@ private:
 
   /// At or above the security plane, or along the tool axis: upwards (the
   /// tool leaves through the space its own body fills) or downwards ending in
-  /// the free space above the feature.
-  bool rapidSafe(const Step &s, const Move &m) const {
+  /// the free space above the feature, or above the bottom of a bore this
+  /// step has already cut there (back into a drilled hole between pecks).
+  bool rapidSafe(const Step &s, const Move &m, const std::vector<std::pair<Vec2, double>> &bores) const {
     const double low = std::min(m.from->z(), m.to.z());
     if (low >= s.secplane - s.tol)
       return true;
@@ -447,6 +460,9 @@ private:
       return false;
     if (m.to.z() >= m.from->z() || !s.shape)
       return true;
+    for (const auto &[xy, bottom] : bores)
+      if ((xy - m.to.head<2>()).norm() <= s.tol && m.to.z() >= bottom)
+        return true;
     return m.to.z() >= clearHeight(s, m.to.head<2>()) - s.tol;
   }
 

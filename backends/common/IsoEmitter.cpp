@@ -182,8 +182,9 @@ void IsoEmitter::arc(const Move &m) {
       text += ' ';
       text += radiusWord(pieceSweep > std::numbers::pi ? -r : r);
     } else {
-      const geom::Vec2 c = balancedCentre(start, printedTo, m.centre);
-      text += word(" I", num(c.x() - start.x())) + word(" J", num(c.y() - start.y()));
+      const geom::Vec2 ij = roundedCentreOffset(start, printedTo, balancedCentre(start, printedTo, m.centre),
+                                                d_.coordDecimals);
+      text += word(" I", num(ij.x())) + word(" J", num(ij.y()));
     }
     if (oneBlockTurns) {
       const std::string w = turnsWord(m.turns);

@@ -82,6 +82,23 @@ geom::Vec2 balancedCentre(const geom::Vec2 &from, const geom::Vec2 &to, const ge
   return centre - along * (centre - mid).dot(along);
 }
 
+geom::Vec2 roundedCentreOffset(const geom::Vec2 &from, const geom::Vec2 &to, const geom::Vec2 &centre, int decimals) {
+  const double unit = std::pow(10.0, -decimals);
+  const geom::Vec2 nearest(roundTo(centre.x() - from.x(), decimals), roundTo(centre.y() - from.y(), decimals));
+  auto mismatch = [&](const geom::Vec2 &ij) { return std::abs(ij.norm() - (from + ij - to).norm()); };
+  geom::Vec2 best = nearest;
+  double bestMismatch = mismatch(nearest);
+  for (int di = -1; di <= 1; ++di)
+    for (int dj = -1; dj <= 1; ++dj) {
+      const geom::Vec2 ij(roundTo(nearest.x() + di * unit, decimals), roundTo(nearest.y() + dj * unit, decimals));
+      if (const double e = mismatch(ij); e < bestMismatch - 1e-12) {
+        best = ij;
+        bestMismatch = e;
+      }
+    }
+  return best;
+}
+
 std::vector<geom::Vec2> arcSplitPoints(const geom::Vec2 &from, const geom::Vec2 &centre, bool ccw, double sweep,
                                        int pieces) {
   std::vector<geom::Vec2> out;

@@ -71,6 +71,13 @@ private:
 /// centre itself. A whole circle (from == to) keeps its centre.
 geom::Vec2 balancedCentre(const geom::Vec2 &from, const geom::Vec2 &to, const geom::Vec2 &centre);
 
+/// The centre's offset from `from` (I J), rounded to `decimals`, choosing
+/// among the neighbouring rounded values the one whose start and end radius
+/// (to the printed `from` and `to`) differ least: rounding I and J alone
+/// can leave them about 1.4 units of the last decimal apart, the best
+/// neighbour at most 1 unit (a half circle whose chord ends on half a unit).
+geom::Vec2 roundedCentreOffset(const geom::Vec2 &from, const geom::Vec2 &to, const geom::Vec2 &centre, int decimals);
+
 /// Points that cut an arc of `sweep` radians (turning ccw or cw about
 /// `centre` from `from`) into `pieces` equal parts: the end of each part.
 std::vector<geom::Vec2> arcSplitPoints(const geom::Vec2 &from, const geom::Vec2 &centre, bool ccw, double sweep,

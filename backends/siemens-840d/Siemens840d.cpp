@@ -9,8 +9,11 @@
 #include "backends/Backend.h"
 #include "backends/common/IsoEmitter.h"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <optional>
+#include <string>
 
 namespace stepnc::backends {
 
@@ -47,6 +50,8 @@ std::string siemensProgramName(const std::string &from) {
   std::string name;
   for (char c : from) {
     const auto u = static_cast<unsigned char>(c);
+    if ((u & 0xc0) == 0x80)
+      continue;  // the rest of a UTF-8 character: one '_' for the character
     if (u < 0x80 && std::isalnum(u))
       name += static_cast<char>(std::toupper(u));
     else
@@ -66,6 +71,8 @@ std::string printable(const std::string &text, size_t most) {
   std::string out;
   for (char c : text) {
     const auto u = static_cast<unsigned char>(c);
+    if ((u & 0xc0) == 0x80)
+      continue;  // the rest of a UTF-8 character: one '_' for the character
     out += u >= 0x20 && u < 0x7f ? (c == '"' ? '\'' : c) : '_';
   }
   if (out.size() > most)
@@ -196,10 +203,10 @@ private:
   }
 
   void toolChange(const ToolCall &t) override {
-    // The length is the controller's: offset D1 of the tool, never a G43/H.
-    out_.block(word("T", std::to_string(t.number)));
+    // The length is the controller's: offset D1 of the tool, taken on with
+    // the tool at M6; there is no G43/H on this controller.
+    out_.block(word("T", std::to_string(t.number)) + " D1");
     out_.block("M6");
-    out_.block("D1");
   }
 
   std::string turnsWord(int64_t turns) const override { return word("TURN=", std::to_string(turns)); }
@@ -224,6 +231,9 @@ private:
     out_.block(g + word("X", num(c.at.x())) + word(" Y", num(c.at.y())));
     out_.block("MCALL");
     assumeAt(Vec3(c.at.x(), c.at.y(), c.initialZ));
+    // Whether a cycle leaves the feed as it found it is the cycle's
+    // business (CYCLE83 scales it by FRF): the next feed move writes F again.
+    modal_.forget("F");
     return true;
   }
 };

@@ -1,0 +1,803 @@
+#!/usr/bin/env python3
+"""Checks SINUMERIK 840D main programs written by stepnc.
+
+No Sinumerik interpreter is packaged for this machine, so this script reads
+a program as the facts in /work/shared/DIALECTS.md describe the controller
+and reports what would be wrong there:
+
+  * the frame: `%_N_NAME_MPF` first (NAME: letters, digits, underscores,
+    upper case, two letters first, at most 24 characters), `;$PATH=/_N_MPF_DIR`
+    second, M30 last;
+  * every block's words: G and M codes from short lists of the ones stepnc
+    may write, address letters X Y Z I J K F S T D with well-formed numbers
+    (decimal point on lengths and feeds, no exponent, no -0), `CR=`, `TURN=`,
+    `MSG("...")`, `MCALL`, `CYCLE81/82/83/84(...)` with their argument counts
+    and the documented signs (RTP/RFP/DP absolute, SDIS/DPR unsigned), and
+    `CYCLE832(tol, mode, 1)`;
+  * block numbers, when there are any, strictly increasing; lines no longer
+    than the limit;
+  * the modal state a move needs: G90 G71 G17 set, a tool changed in with
+    its D offset (`T5 D1` then `M6`, or `T5`, `M6`, `D1`), the spindle on and
+    a feed for feed moves;
+  * arcs, from the position tracked through the printed numbers: with I/J the
+    radius at the start and at the end agree within 0.001 mm (whole circles
+    too); with CR= the radius reaches across the chord; TURN= only with I/J;
+  * modal cycles: `MCALL CYCLE..` then position blocks (X/Y only, from above
+    the reference plane) then a bare `MCALL`, nothing else in between.
+
+With --ir (one program) the moves the program makes are also compared with
+the toolpath IR's, within the rounding of 3 decimals: feed moves one by one
+(an arc may be written in several pieces, a CR= arc's centre may move with
+its rounded end points), runs of rapids by where they end. A drilling cycle
+makes the moves its documented parameters describe (CYCLE83: strokes as long
+as the first, no degression; CYCLE84: feed pitch times SST in, times SST1
+out); its rapids are the controller's, so in a program with cycles only the
+feed moves are compared.
+
+With --stepnc, each argument is an input (STEP-NC or IR text) that the script
+first compiles with that stepnc (extra options after --option), into a
+program and its toolpath IR, and checks both ways.
+
+Exit 0 when every program is clean (one `ok:` line each), 1 listing each
+problem as `FILE:LINE: problem`.
+"""
+import argparse
+import math
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+RADIUS_TOL = 1e-3
+MAX_NAME = 24
+
+G_CODES = {0, 1, 2, 3, 17, 40, 64, 71, 90, 94, 642}
+MOTION = {0, 1, 2, 3}
+M_CODES = {0, 1, 3, 4, 5, 6, 7, 8, 9, 30}
+LENGTH_WORDS = set("XYZIJK") | {"CR", "F"}
+INTEGER_WORDS = {"S", "T", "D", "TURN"}
+# Cycle: (fewest arguments, most arguments or None).
+CYCLES = {"CYCLE81": (5, 5), "CYCLE82": (6, 6), "CYCLE83": (12, None), "CYCLE84": (12, None)}
+
+NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+TOKEN_RE = re.compile(
+    r'\s*(?:(?P<msg>MSG\("[^"]*"\))'
+    r"|(?P<call>(?:CYCLE\d+)\([^()]*\))"
+    r"|(?P<mcall>MCALL)(?![A-Z0-9_])"
+    r"|(?P<assign>(?:CR|TURN)=(?P<avalue>" + NUMBER + r"))"
+    r"|(?P<letter>[A-Z])(?P<value>" + NUMBER + r"))")
+
+
+def split_comment(line):
+    """The block's code and its comment (after a ';' outside quotes)."""
+    quoted = False
+    for i, c in enumerate(line):
+        if c == '"':
+            quoted = not quoted
+        elif c == ";" and not quoted:
+            return line[:i], line[i + 1:]
+    return line, None
+
+
+def number_problem(address, text):
+    if re.search(r"[eE]", text):
+        return "%s%s: exponent notation" % (address, text)
+    if re.fullmatch(r"-0*\.?0*", text):
+        return "%s%s: negative zero" % (address, text)
+    if address in LENGTH_WORDS and "." not in text:
+        return "%s%s: no decimal point (an integer may be read otherwise)" % (address, text)
+    if address in INTEGER_WORDS and not re.fullmatch(r"\d+", text):
+        return "%s%s: not a whole number" % (address, text)
+    return None
+
+
+def cycle_args(call):
+    name, inside = call.split("(", 1)
+    return name, [a.strip() for a in inside[:-1].split(",")]
+
+
+def arg_number(text):
+    if text == "":
+        return None
+    if not re.fullmatch(NUMBER, text) or re.search(r"[eE]", text):
+        raise ValueError(text)
+    return float(text)
+
+
+# How far (along the arc, mm) the program's sweep may differ from the plan's:
+# the printed centre may sit up to a unit of the last decimal off the plan's
+# (it is chosen so that start and end radius agree), which turns the angle a
+# little; a wrong direction or a missing turn is far beyond this.
+ARC_LENGTH_TOL = 0.01
+
+
+def arc_sweep(start, end, centre, ccw):
+    """The angle from start to end about centre (radians, in (0, 2 pi]); end over start is a whole turn."""
+    if math.dist(start, end) < 1e-9:
+        return 2 * math.pi
+    a = math.atan2(start[1] - centre[1], start[0] - centre[0])
+    b = math.atan2(end[1] - centre[1], end[0] - centre[0])
+    angle = (b - a) if ccw else (a - b)
+    while angle <= 0:
+        angle += 2 * math.pi
+    while angle > 2 * math.pi:
+        angle -= 2 * math.pi
+    return angle
+
+
+IR_MOVE_RE = re.compile(r"^\s*(rapid|linear|arc)\s+(.*)$")
+IR_ATTR_RE = re.compile(r"(\w+)=(\([^)]*\)|\S+)")
+
+
+def ir_point(text):
+    return tuple(float(v) for v in text.split(")")[0].strip("(").split(","))
+
+
+def planned_moves(path):
+    """The moves of every `moves` block of a toolpath IR file, in order."""
+    out = []
+    where = None
+    with open(path) as f:
+        for n, line in enumerate(f, 1):
+            m = IR_MOVE_RE.match(line.split(";")[0])
+            if not m:
+                continue
+            attrs = dict(IR_ATTR_RE.findall(m.group(2)))
+            move = dict(kind=m.group(1), to=ir_point(attrs["to"]), line=n,
+                        feed=float(attrs.get("feed", "0").replace("mm/min", "")))
+            if move["kind"] == "arc":
+                centre = ir_point(attrs["center"])[:2]
+                ccw = attrs["dir"] == "ccw"
+                start = where[:2] if where else move["to"][:2]
+                move.update(centre=centre, ccw=ccw, radius=math.dist(start, centre),
+                            sweep=arc_sweep(start, move["to"][:2], centre, ccw)
+                            + 2 * math.pi * int(attrs.get("turns", "0")))
+            where = move["to"]
+            out.append(move)
+    return out
+
+
+def on_circle(piece, centre, radius, tol):
+    """Whether an arc of the program lies on the planned circle. With I/J its centre is the plan's; a CR=
+    arc's centre moves with the rounding of its end points (far, on a short arc), so it is enough that it
+    has the radius and that its middle lies on the circle."""
+    if math.dist(piece["centre"], centre) <= tol:
+        return True
+    if not piece.get("cr") or abs(piece["radius"] - radius) > tol:
+        return False
+    a = math.atan2(piece["start"][1] - piece["centre"][1], piece["start"][0] - piece["centre"][0])
+    a += (1 if piece["ccw"] else -1) * piece["sweep"] / 2
+    middle = (piece["centre"][0] + piece["radius"] * math.cos(a), piece["centre"][1] + piece["radius"] * math.sin(a))
+    return abs(math.dist(middle, centre) - radius) <= tol
+
+
+def arc_text(m):
+    return "about (%.4f, %.4f) %s" % (m["centre"][0], m["centre"][1], "ccw" if m["ccw"] else "cw")
+
+
+def compare_moves(planned, made, feeds_only, decimals=3):
+    """Differences between the planned moves and the program's: feed moves one by one (an arc may be
+    written in pieces), runs of rapids by where they end; moves that print as no motion are left out.
+    With feeds_only (canned cycles, whose own rapids are the controller's) rapids are not compared."""
+    # Each axis is rounded by up to half a unit of the last decimal: a point
+    # moves by up to 0.87 units; a little room above that.
+    tol = 1.2 * 10 ** -decimals
+
+    def printed(p):
+        return tuple(round(v, decimals) for v in p)
+
+    def squeeze(moves):
+        out, last = [], None
+        for m in moves:
+            if None in m["to"]:
+                continue
+            if m["kind"] != "arc" and last is not None and printed(m["to"]) == printed(last):
+                continue
+            last = m["to"]
+            if m["kind"] == "rapid" and out and out[-1]["kind"] == "rapid":
+                out[-1] = m  # a run of rapids: where it ends
+            else:
+                out.append(m)
+        return [m for m in out if not (feeds_only and m["kind"] == "rapid")]
+
+    want, got = squeeze(planned), squeeze(made)
+    problems = []
+    j = 0
+    for w in want:
+        if j >= len(got):
+            problems.append("IR line %d: %s to %s: the program has no more moves" % (w["line"], w["kind"], w["to"]))
+            break
+        g = got[j]
+        where = "IR line %d, program line %d" % (w["line"], g["line"])
+        if g["kind"] != w["kind"]:
+            problems.append("%s: the plan has a %s, the program a %s" % (where, w["kind"], g["kind"]))
+            break
+        if w["kind"] == "arc":
+            # Pieces about the same centre, the same way, until the sweep is made.
+            sweep, end = 0.0, None
+            while j < len(got) and got[j]["kind"] == "arc" and got[j]["ccw"] == w["ccw"] and \
+                    on_circle(got[j], w["centre"], w["radius"], 2 * tol):
+                sweep += got[j]["sweep"]
+                end = got[j]
+                j += 1
+                if abs(sweep - w["sweep"]) * w["radius"] <= ARC_LENGTH_TOL or sweep > w["sweep"]:
+                    break
+            if end is None:
+                problems.append("%s: the arc turns %s, the plan's %s" % (where, arc_text(g), arc_text(w)))
+                break
+            if abs(sweep - w["sweep"]) * w["radius"] > ARC_LENGTH_TOL:
+                problems.append("%s: the arc sweeps %.4f rad, the plan %.4f rad" % (where, sweep, w["sweep"]))
+            g = end
+        else:
+            j += 1
+        if math.dist(g["to"], w["to"]) > tol:
+            problems.append("%s: %s ends at %s, the plan at %s" % (where, w["kind"], g["to"], w["to"]))
+            break
+        if w["kind"] != "rapid" and abs(g["feed"] - w["feed"]) > 0.051:
+            problems.append("%s: feed %g, the plan's %g" % (where, g["feed"], w["feed"]))
+    if not problems and j < len(got):
+        problems.append("program line %d: a %s the plan does not have" % (got[j]["line"], got[j]["kind"]))
+    return problems, len(want)
+
+
+class Checker:
+    def __init__(self, name, lines, max_line):
+        self.name = name
+        self.lines = lines
+        self.max_line = max_line
+        self.problems = []
+        self.pos = {"X": None, "Y": None, "Z": None}
+        self.modal = {"absolute": False, "metric": False, "plane": False}
+        self.motion = None
+        self.feed = None
+        self.spindle_speed = 0
+        self.spindle_on = False
+        self.tool_selected = None
+        self.tool_in_spindle = None
+        self.offset = None
+        self.pending_offset = None
+        self.mcall = None
+        self.ended_at = None
+        self.last_number = None
+        self.counts = {"blocks": 0, "moves": 0, "ijk": 0, "cr": 0, "turn": 0, "holes": 0}
+        # What the program makes, for --ir: dicts with kind (rapid, linear,
+        # arc), to, feed, and for arcs centre, ccw, sweep (radians, turns
+        # included), radius; `line` is where it was written.
+        self.made = []
+        self.lacking = set()
+
+    def problem(self, n, text):
+        self.problems.append("%s:%d: %s" % (self.name, n, text))
+
+    # --- the frame -------------------------------------------------------------------
+
+    def check_frame(self):
+        if not self.lines:
+            self.problem(1, "empty program")
+            return
+        m = re.fullmatch(r"%_N_(\w+)_MPF", self.lines[0])
+        if not m:
+            self.problem(1, "first line is not %%_N_NAME_MPF: %r" % self.lines[0])
+        else:
+            name = m.group(1)
+            if not re.fullmatch(r"[A-Z]{2}[A-Z0-9_]*", name):
+                self.problem(1, "program name %s: letters, digits and underscores, upper case, two letters first"
+                             % name)
+            if len(name) > MAX_NAME:
+                self.problem(1, "program name %s is longer than %d characters" % (name, MAX_NAME))
+        if len(self.lines) < 2 or self.lines[1] != ";$PATH=/_N_MPF_DIR":
+            self.problem(2, "second line is not ;$PATH=/_N_MPF_DIR")
+
+    # --- blocks ---------------------------------------------------------------------
+
+    def run(self):
+        self.check_frame()
+        for n, line in enumerate(self.lines, 1):
+            if self.max_line and len(line) > self.max_line:
+                self.problem(n, "line of %d characters, over the limit of %d" % (len(line), self.max_line))
+            if n == 1:
+                continue
+            code, _ = split_comment(line)
+            code = code.strip()
+            m = re.match(r"N(\d+)(?:\s+|$)", code)
+            if m:
+                number = int(m.group(1))
+                if self.last_number is not None and number <= self.last_number:
+                    self.problem(n, "block number N%d after N%d" % (number, self.last_number))
+                if number == 0:
+                    self.problem(n, "block number N0")
+                self.last_number = number
+                code = code[m.end():]
+            elif self.last_number is not None and code:
+                self.problem(n, "block without a number among numbered blocks")
+            if not code:
+                continue
+            if self.ended_at is not None:
+                self.problem(n, "block after M30 (line %d)" % self.ended_at)
+            self.counts["blocks"] += 1
+            words = self.tokenize(n, code)
+            if words is not None:
+                self.block(n, words)
+        if self.ended_at is None:
+            self.problem(len(self.lines), "the program does not end with M30")
+        if self.mcall is not None:
+            self.problem(self.mcall["line"], "MCALL %s never cancelled by a bare MCALL" % self.mcall["cycle"])
+
+    def tokenize(self, n, code):
+        words = []
+        at = 0
+        while at < len(code):
+            m = TOKEN_RE.match(code, at)
+            if not m or m.end() == at:
+                rest = code[at:].strip()
+                if rest:
+                    self.problem(n, "not a word this target writes: %r" % rest)
+                    return None
+                break
+            at = m.end()
+            if m.group("msg"):
+                words.append(("MSG", m.group("msg")))
+            elif m.group("call"):
+                words.append(("CALL", m.group("call")))
+            elif m.group("mcall"):
+                words.append(("MCALL", ""))
+            elif m.group("assign"):
+                words.append((m.group("assign").split("=")[0], m.group("avalue")))
+            else:
+                words.append((m.group("letter"), m.group("value")))
+        return words
+
+    def block(self, n, words):
+        seen = {}
+        gs, ms = [], []
+        bad = False
+        for address, value in words:
+            if address in ("MSG", "CALL", "MCALL"):
+                continue
+            if address in LENGTH_WORDS or address in INTEGER_WORDS or address in "GM":
+                problem = number_problem(address, value)
+                if problem:
+                    self.problem(n, problem)
+                    bad = True
+            else:
+                self.problem(n, "address %s is not one this target writes" % address)
+                bad = True
+        if bad:
+            return
+        for address, value in words:
+            if address in ("MSG", "CALL", "MCALL"):
+                continue
+            if address == "G":
+                g = float(value)
+                if g != int(g) or int(g) not in G_CODES:
+                    self.problem(n, "G%s is not a G code this target writes" % value)
+                    return
+                gs.append(int(g))
+            elif address == "M":
+                m = float(value)
+                if m != int(m) or int(m) not in M_CODES:
+                    self.problem(n, "M%s is not an M code this target writes" % value)
+                    return
+                ms.append(int(m))
+            else:
+                if address in seen:
+                    self.problem(n, "%s written twice in one block" % address)
+                    return
+                seen[address] = float(value)
+        if len([g for g in gs if g in MOTION]) > 1:
+            self.problem(n, "two motion G codes in one block")
+        kinds = [a for a, _ in words]
+        if "MSG" in kinds and len(words) > 1:
+            self.problem(n, "MSG shares its block")
+
+        # MCALL: on with a cycle, off bare.
+        if "MCALL" in kinds:
+            self.mcall_block(n, words)
+            return
+        calls = [v for a, v in words if a == "CALL"]
+        for call in calls:
+            self.direct_call(n, call, len(words))
+
+        for g in gs:
+            if g in MOTION:
+                self.motion = g
+            elif g == 90:
+                self.modal["absolute"] = True
+            elif g == 71:
+                self.modal["metric"] = True
+            elif g == 17:
+                self.modal["plane"] = True
+        if "F" in seen:
+            if seen["F"] <= 0:
+                self.problem(n, "feed F%s" % seen["F"])
+            self.feed = seen["F"]
+        if "S" in seen:
+            self.spindle_speed = seen["S"]
+        if "T" in seen:
+            self.tool_selected = int(seen["T"])
+        for m in ms:
+            self.m_code(n, m)
+        if "D" in seen:
+            # D before the M6 that changes in the selected tool is that tool's
+            # offset, taken on by the M6; otherwise it applies at once.
+            if self.tool_selected is not None and self.tool_selected != self.tool_in_spindle:
+                self.pending_offset = int(seen["D"])
+            else:
+                self.offset = int(seen["D"])
+        if any(a in seen for a in "XYZ") or ("I" in seen or "J" in seen or "CR" in seen):
+            self.move(n, seen)
+        elif "TURN" in seen or "K" in seen:
+            self.problem(n, "TURN= or K without a move")
+
+    def m_code(self, n, m):
+        if m in (3, 4):
+            if self.spindle_speed <= 0:
+                self.problem(n, "spindle on (M%d) without a speed S" % m)
+            self.spindle_on = True
+        elif m == 5:
+            self.spindle_on = False
+        elif m == 6:
+            if self.mcall is not None:
+                self.problem(n, "tool change while MCALL %s is active" % self.mcall["cycle"])
+            if self.tool_selected is None:
+                self.problem(n, "M6 without a tool selected by T")
+            self.tool_in_spindle = self.tool_selected
+            self.offset = self.pending_offset
+            self.pending_offset = None
+            # The tool change position is the machine's: the axes are unknown
+            # until written again, and the spindle is stopped.
+            self.pos = {"X": None, "Y": None, "Z": None}
+            self.spindle_on = False
+        elif m == 30:
+            if self.mcall is not None:
+                self.problem(n, "M30 while MCALL %s is active" % self.mcall["cycle"])
+            self.ended_at = n
+
+    # --- moves ----------------------------------------------------------------------
+
+    def ready_to_move(self, n, feed_move, need_feed=True):
+        """Reports what a move lacks, each thing once until it is set again."""
+        lacking = []
+        if not self.modal["absolute"]:
+            lacking.append("a move before G90 (absolute positions)")
+        if not self.modal["metric"]:
+            lacking.append("a move before G71 (mm)")
+        if self.tool_in_spindle is None:
+            lacking.append("a move with no tool changed in (T.. M6)")
+        elif not self.offset:
+            lacking.append("a move without the tool's D offset (its length)")
+        if feed_move:
+            if need_feed and not self.feed:
+                lacking.append("a feed move with no feed F")
+            if not self.spindle_on:
+                lacking.append("a feed move with the spindle off")
+        for text in lacking:
+            if text not in self.lacking:
+                self.problem(n, text)
+        self.lacking = set(lacking)
+
+    def move(self, n, seen):
+        if self.motion is None:
+            self.problem(n, "axis words with no motion G code (G0 G1 G2 G3)")
+            return
+        self.counts["moves"] += 1
+        if self.mcall is not None:
+            self.cycle_position(n, seen)
+            return
+        self.ready_to_move(n, self.motion != 0)
+        if self.motion in (2, 3):
+            self.arc(n, seen)
+            return
+        for bad in ("I", "J", "K", "CR", "TURN"):
+            if bad in seen:
+                self.problem(n, "%s on a straight move" % bad)
+        for axis in "XYZ":
+            if axis in seen:
+                self.pos[axis] = seen[axis]
+        self.make(n, "rapid" if self.motion == 0 else "linear", self.feed if self.motion else 0)
+
+    def make(self, n, kind, feed, at=None, **arc):
+        to = at if at is not None else (self.pos["X"], self.pos["Y"], self.pos["Z"])
+        self.made.append(dict(kind=kind, to=to, feed=feed or 0, line=n, **arc))
+
+    def arc(self, n, seen):
+        if not self.modal["plane"]:
+            self.problem(n, "an arc before G17 (XY plane)")
+        if "K" in seen:
+            self.problem(n, "K on an arc in the XY plane")
+        start = (self.pos["X"], self.pos["Y"])
+        end = (seen.get("X", self.pos["X"]), seen.get("Y", self.pos["Y"]))
+        ccw = self.motion == 3
+        centre = None
+        if None in start or None in end:
+            self.problem(n, "an arc from an unknown position")
+        elif "CR" in seen:
+            self.counts["cr"] += 1
+            if "I" in seen or "J" in seen:
+                self.problem(n, "an arc with both CR= and I/J")
+            if "TURN" in seen:
+                self.problem(n, "TURN= with CR= (CR arcs are less than a whole turn)")
+            r = abs(seen["CR"])
+            chord = math.dist(start, end)
+            if chord < 1e-9:
+                self.problem(n, "a whole circle with CR= (it needs I/J)")
+            elif r == 0 or r < chord / 2 - RADIUS_TOL:
+                self.problem(n, "CR=%g is shorter than half the chord (%.4f mm)" % (seen["CR"], chord / 2))
+            else:
+                # The centre on the side the direction and the sign say: left
+                # of the chord for a ccw arc under half a turn.
+                h = math.sqrt(max(r * r - chord * chord / 4, 0.0))
+                left = (-(end[1] - start[1]) / chord, (end[0] - start[0]) / chord)
+                side = (1 if ccw else -1) * (1 if seen["CR"] > 0 else -1)
+                centre = ((start[0] + end[0]) / 2 + side * h * left[0], (start[1] + end[1]) / 2 + side * h * left[1])
+        elif "I" in seen or "J" in seen:
+            self.counts["ijk"] += 1
+            if "TURN" in seen:
+                self.counts["turn"] += 1
+            centre = (start[0] + seen.get("I", 0.0), start[1] + seen.get("J", 0.0))
+            r0, r1 = math.dist(start, centre), math.dist(end, centre)
+            if r0 < 1e-9:
+                centre = None
+            if r0 < 1e-9:
+                self.problem(n, "an arc of radius 0")
+            elif abs(r0 - r1) > RADIUS_TOL:
+                self.problem(n, "arc radius %.4f at the start and %.4f at the end differ by %.4f mm (more than %g)"
+                             % (r0, r1, abs(r0 - r1), RADIUS_TOL))
+        else:
+            self.problem(n, "an arc with neither I/J nor CR=")
+        for axis in "XYZ":
+            if axis in seen:
+                self.pos[axis] = seen[axis]
+        if centre is not None:
+            sweep = arc_sweep(start, end, centre, ccw) + 2 * math.pi * seen.get("TURN", 0)
+            self.make(n, "arc", self.feed, centre=centre, ccw=ccw, sweep=sweep, radius=math.dist(start, centre),
+                      start=start, cr="CR" in seen)
+
+    # --- cycles ---------------------------------------------------------------------
+
+    def cycle_parameters(self, n, call):
+        """RTP, RFP, SDIS, DP of a drilling cycle call, after checking its arguments; None when wrong."""
+        name, args = cycle_args(call)
+        if name == "CYCLE832":
+            self.problem(n, "CYCLE832 is not a drilling cycle")
+            return None
+        if name not in CYCLES:
+            self.problem(n, "%s is not a cycle this target writes" % name)
+            return None
+        low, high = CYCLES[name]
+        if len(args) < low or (high is not None and len(args) > high):
+            self.problem(n, "%s with %d arguments (it takes %s)" % (
+                name, len(args), low if high == low else "%d or more" % low))
+            return None
+        try:
+            values = [arg_number(a) for a in args]
+        except ValueError as e:
+            self.problem(n, "%s: argument %r is not a plain number" % (name, str(e)))
+            return None
+        for a in args:
+            if re.fullmatch(r"-0*\.?0*", a):
+                self.problem(n, "%s: argument %s is a negative zero" % (name, a))
+        rtp, rfp, sdis, dp, dpr = values[:5]
+        if None in (rtp, rfp, sdis) or (dp is None and dpr is None):
+            self.problem(n, "%s without RTP, RFP, SDIS and a depth" % name)
+            return None
+        if sdis < 0 or (dpr is not None and dpr < 0):
+            self.problem(n, "%s: SDIS and DPR are unsigned" % name)
+        depth = dp if dp is not None else rfp - dpr
+        if depth >= rfp + sdis:
+            self.problem(n, "%s: the depth %g is not below the reference plane RFP + SDIS = %g" % (
+                name, depth, rfp + sdis))
+        if rtp < rfp + sdis:
+            self.problem(n, "%s: the retract plane RTP %g is below RFP + SDIS = %g" % (name, rtp, rfp + sdis))
+        if name in ("CYCLE81", "CYCLE82", "CYCLE83") and not self.feed:
+            self.problem(n, "%s with no feed F set" % name)
+        if name == "CYCLE83":
+            fdep, fdpr, dam = values[5], values[6], values[7]
+            vari = values[11]
+            if fdep is None and fdpr is None:
+                self.problem(n, "CYCLE83 without a first depth (FDEP or FDPR)")
+            elif fdep is not None and not depth <= fdep < rfp + sdis:
+                self.problem(n, "CYCLE83: the first depth FDEP %g is not between the depth and RFP + SDIS" % fdep)
+            if (fdpr is not None and fdpr < 0) or (dam is not None and dam < 0):
+                self.problem(n, "CYCLE83: FDPR and DAM are unsigned")
+            if vari not in (0, 1):
+                self.problem(n, "CYCLE83: VARI is 0 (chip breaking) or 1 (full retract), not %s" % args[11])
+        if name == "CYCLE84":
+            sdac, mpit, pit, sst = values[6], values[7], values[8], values[10]
+            if sdac not in (3, 4, 5):
+                self.problem(n, "CYCLE84: SDAC (the spindle after the cycle) is 3, 4 or 5, not %s" % args[6])
+            if not mpit and not pit:
+                self.problem(n, "CYCLE84 without a thread pitch (MPIT or PIT)")
+            if not sst or sst <= 0:
+                self.problem(n, "CYCLE84 without a tapping speed SST")
+        return {"cycle": name, "rtp": rtp, "rfp": rfp, "r": rfp + sdis, "depth": depth, "values": values,
+                "line": n, "holes": 0}
+
+    def mcall_block(self, n, words):
+        if len(words) == 1:
+            if self.mcall is None:
+                self.problem(n, "bare MCALL with no modal call active")
+            elif self.mcall["holes"] == 0:
+                self.problem(n, "MCALL %s (line %d) cancelled before any position"
+                             % (self.mcall["cycle"], self.mcall["line"]))
+            self.mcall = None
+            return
+        if len(words) != 2 or words[1][0] != "CALL":
+            self.problem(n, "MCALL takes one cycle call and nothing else")
+            return
+        if self.mcall is not None:
+            self.problem(n, "MCALL while MCALL %s (line %d) is active" % (self.mcall["cycle"], self.mcall["line"]))
+        params = self.cycle_parameters(n, words[1][1])
+        if params is not None:
+            self.mcall = params
+
+    def cycle_position(self, n, seen):
+        c = self.mcall
+        if self.motion not in (0, 1):
+            self.problem(n, "an arc while MCALL %s is active" % c["cycle"])
+            return
+        if "Z" in seen or any(a in seen for a in ("I", "J", "K", "CR", "TURN")):
+            self.problem(n, "a position block under MCALL with more than X and Y")
+        z = self.pos["Z"]
+        if z is None or z < c["r"] - 1e-9:
+            self.problem(n, "a position under MCALL %s from %s, below the reference plane %g" % (
+                c["cycle"], "an unknown height" if z is None else "z=%g" % z, c["r"]))
+        self.ready_to_move(n, True, need_feed=c["cycle"] != "CYCLE84")
+        for axis in "XY":
+            if axis in seen:
+                self.pos[axis] = seen[axis]
+        self.make(n, "rapid", 0)
+        if self.pos["X"] is None or self.pos["Y"] is None:
+            self.problem(n, "a hole at an unknown position")
+        else:
+            self.drill(n, c)
+        c["holes"] += 1
+        self.counts["holes"] += 1
+
+    def drill(self, n, c):
+        """The moves a drilling cycle makes where the tool is, as its documented parameters say; the tool
+        ends at RTP."""
+        x, y = self.pos["X"], self.pos["Y"]
+        values = c["values"]
+
+        def at(z):
+            return (x, y, z)
+        self.make(n, "rapid", 0, at(c["r"]))
+        if c["cycle"] == "CYCLE83" and len(values) > 11 and values[11] == 1:
+            # Full retract (VARI 1) after each stroke; strokes as long as the
+            # first (no degression, DAM 0), the last one shorter. The way
+            # back down is the controller's: only the feed moves are compared.
+            first = values[5] if values[5] is not None else c["rfp"] - values[6]
+            stroke = c["rfp"] - first
+            if (values[7] or 0) != 0 or stroke <= 0:
+                self.problem(n, "CYCLE83 with degression or no first stroke: not modelled")
+                return
+            bottom = first
+            while True:
+                bottom = max(bottom, c["depth"])
+                self.make(n, "linear", self.feed, at(bottom))
+                if bottom <= c["depth"] + 1e-9:
+                    break
+                self.make(n, "rapid", 0, at(c["r"]))
+                bottom -= stroke
+        elif c["cycle"] == "CYCLE84":
+            pitch, sst, sst1 = abs(values[8] or 0), values[10] or 0, values[11] or values[10] or 0
+            self.make(n, "linear", pitch * sst, at(c["depth"]))
+            self.make(n, "linear", pitch * sst1, at(c["r"]))
+        elif c["cycle"] == "CYCLE81":
+            self.make(n, "linear", self.feed, at(c["depth"]))
+        else:
+            self.problem(n, "%s: its moves are not modelled" % c["cycle"])
+        self.pos["Z"] = c["rtp"]
+        self.make(n, "rapid", 0)
+
+    def direct_call(self, n, call, nwords):
+        name, args = cycle_args(call)
+        if name == "CYCLE832":
+            if nwords != 1:
+                self.problem(n, "CYCLE832 shares its block")
+            if len(args) != 3:
+                self.problem(n, "CYCLE832 with %d arguments (it takes 3: _TOL, _TOLM, _OTOL)" % len(args))
+                return
+            try:
+                tol, mode, otol = (arg_number(a) for a in args)
+            except ValueError as e:
+                self.problem(n, "CYCLE832: argument %r is not a plain number" % str(e))
+                return
+            if mode not in (0, 1, 2, 3):
+                self.problem(n, "CYCLE832: _TOLM is 0 (off), 1, 2 or 3, not %s" % args[1])
+            elif mode != 0 and not (tol and tol > 0):
+                self.problem(n, "CYCLE832: a tolerance above 0 is needed with _TOLM %s" % args[1])
+            if otol != 1:
+                self.problem(n, "CYCLE832: _OTOL is 1 on a 3-axis machine, not %s" % args[2])
+            return
+        # A direct (not modal) drilling cycle runs once where the tool is.
+        params = self.cycle_parameters(n, call)
+        if params is None:
+            return
+        if nwords != 1:
+            self.problem(n, "%s shares its block" % name)
+        z = self.pos["Z"]
+        if None in self.pos.values() or z < params["r"] - 1e-9:
+            self.problem(n, "%s called from an unknown position or below its reference plane" % name)
+        self.ready_to_move(n, True, need_feed=name != "CYCLE84")
+        if None not in self.pos.values():
+            self.drill(n, params)
+        self.counts["holes"] += 1
+
+
+def check_text(name, text, max_line):
+    """The checker after reading `text`, its problems in c.problems."""
+    lines = text.split("\n")
+    last_newline = lines and lines[-1] == ""
+    if last_newline:
+        lines.pop()
+    c = Checker(name, lines, max_line)
+    c.run()
+    if not last_newline:
+        c.problems.append("%s:%d: the last line has no newline" % (name, len(lines)))
+    return c
+
+
+def compile_input(stepnc, path, options, directory):
+    """The program and the toolpath IR stepnc makes of `path`, or the compiler's error text."""
+    stem = os.path.splitext(os.path.basename(path))[0]
+    os.makedirs(directory, exist_ok=True)
+    program = os.path.join(directory, stem + ".mpf")
+    ir = os.path.join(directory, stem + ".ir")
+    for output, extra in ((program, []), (ir, ["--emit=toolpath-ir"])):
+        r = subprocess.run([stepnc, "compile", path, "--target=siemens-840d", "-o", output] + options + extra,
+                           capture_output=True, text=True)
+        if r.returncode != 0:
+            return None, None, r.stderr.strip()
+    return program, ir, ""
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("files", nargs="+", help="programs (or, with --stepnc, inputs to compile)")
+    ap.add_argument("--max-line-length", type=int, default=512, help="longest line allowed (0: no limit)")
+    ap.add_argument("--ir", help="toolpath IR whose moves the (one) program must make")
+    ap.add_argument("--stepnc", help="compile each input with this stepnc first, and compare its moves with the "
+                    "toolpath IR")
+    ap.add_argument("--option", action="append", default=[],
+                    help="an option for stepnc compile (repeatable), e.g. --option=--no-cycles")
+    args = ap.parse_args()
+    if args.ir and (args.stepnc or len(args.files) != 1):
+        ap.error("--ir goes with one program and no --stepnc")
+
+    failed = False
+    suffix = " (%s)" % " ".join(args.option) if args.option else ""
+    with tempfile.TemporaryDirectory(prefix="check-siemens-840d.") as tmp:
+        for i, path in enumerate(args.files):
+            name, ir = os.path.basename(path), args.ir
+            if args.stepnc:
+                path, ir, error = compile_input(args.stepnc, path, args.option, os.path.join(tmp, str(i)))
+                if path is None:
+                    print("FAIL: %s%s: stepnc compile failed:\n%s" % (name, suffix, error))
+                    failed = True
+                    continue
+            with open(path, newline="") as f:
+                c = check_text(name, f.read(), args.max_line_length)
+            problems = list(c.problems)
+            compared = ""
+            if ir and not problems:
+                moves = planned_moves(ir)
+                differences, count = compare_moves(moves, c.made, feeds_only=c.counts["holes"] > 0)
+                problems += ["%s: %s" % (name, d) for d in differences]
+                compared = ", %d planned moves made" % count
+            if problems:
+                failed = True
+                print("FAIL: %s%s: %d problems" % (name, suffix, len(problems)))
+                for p in problems:
+                    print("  " + p)
+            else:
+                print("ok: %s%s: %d blocks, %d moves, %d I/J arcs (%d with TURN=), %d CR= arcs, %d cycle holes%s" % (
+                    name, suffix, c.counts["blocks"], c.counts["moves"], c.counts["ijk"], c.counts["turn"],
+                    c.counts["cr"], c.counts["holes"], compared))
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
