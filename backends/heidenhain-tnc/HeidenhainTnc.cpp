@@ -82,6 +82,13 @@ std::string commentText(std::string_view text) {
   return t;
 }
 
+/// `text` without the spaces at its end (a comment may end in one).
+std::string trimmed(std::string text) {
+  while (!text.empty() && text.back() == ' ')
+    text.pop_back();
+  return text;
+}
+
 /// The angle (radians, in [0, 2 pi)) from `a` to `b` turning ccw or cw.
 double turnAngle(const geom::Vec2 &a, const geom::Vec2 &b, bool ccw) {
   double angle = std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));
@@ -151,7 +158,7 @@ private:
   double rounded(double v) const { return roundTo(v, d_.coordDecimals); }
   double unit() const { return std::pow(10.0, -d_.coordDecimals); }
   double tolerance() const { return o_.tolerance.value_or(d_.tolerance); }
-  std::string comment(const std::string &text) const { return "; " + commentText(text); }
+  std::string comment(const std::string &text) const { return trimmed("; " + commentText(text)); }
 
   /// The feed in mm/min as an unsigned number; a feed that would print as 0
   /// keeps more decimals rather than read as no feed.
@@ -222,10 +229,12 @@ private:
   }
 
   void mBlock(const std::string &m) {
-    if (at_[2])
+    if (at_[2]) {
       out_.block("L Z" + num(*at_[2]) + " R0 FMAX " + m);
-    else
+      modal_.forget("F");  // as after every FMAX block
+    } else {
       out_.block("L " + m);  // no height known yet: only before the first motion
+    }
   }
 
   void flushM() {
@@ -245,14 +254,15 @@ private:
   // --- Steps --------------------------------------------------------------------
 
   void step(const Program &p, const Step &s) {
-    out_.block("* - " + commentText(s.label));
+    out_.block(trimmed("* - " + commentText(s.label)));
     if (s.operation == "tapping" || s.operation == "thread_drilling") {
       // Plain moves would feed the tap out with the spindle still turning
-      // forward: it would break.
+      // forward: it would break. Cycle 207 is left out until its facts are
+      // checked (README.md).
       diags_.error(s.exec->origin.loc, "workingstep " + s.exec->symbol + " (" + s.operation + "): " + d_.name +
-                                           " has no tapping cycle (cycle 207 needs the thread pitch and is not "
-                                           "among the dialect facts), and tapping written as plain moves would "
-                                           "break the tap")
+                                           " writes no tapping cycle (cycle 207's parameters are not among the "
+                                           "checked dialect facts), and as plain moves the tap would be fed out "
+                                           "with the spindle still turning forward and break")
           .entity(s.exec->origin.entityId);
       ok_ = false;
       return;
@@ -346,46 +356,62 @@ private:
 
   void arc(const Move &m) {
     flushM();
+    const double u = unit();
+    const double sweep = m.sweep();
+    const double radius = (m.from.head<2>() - m.centre).norm();
+    // An arc that keeps within half a unit of its chord is its chord as
+    // printed, and one of a radius under three units cannot be placed on
+    // the printed grid (as a line it strays less than the contour
+    // tolerance): both are written as lines.
+    if (m.turns == 0 && (radius < 3 * u || radius * (1 - std::cos(std::min(sweep, kPi) / 2)) <= u / 2)) {
+      line(m.to, false, m.feed);
+      return;
+    }
+    // Arcs start on the printed grid: after a CP the control stands where
+    // the turned start landed, a little off it, and a whole circle must end
+    // exactly where it starts.
+    auto offGrid = [&](const std::optional<double> &v) { return v && std::abs(*v - rounded(*v)) > 1e-9; };
+    if (offGrid(at_[0]) || offGrid(at_[1])) {
+      modal_.forget("X");
+      modal_.forget("Y");
+      line(m.from, false, m.feed);
+    }
     const geom::Vec2 from = at_[0] && at_[1] ? geom::Vec2(*at_[0], *at_[1])
                                              : geom::Vec2(rounded(m.from.x()), rounded(m.from.y()));
     const double fromZ = at_[2] ? *at_[2] : rounded(m.from.z());
     if (num(m.to.z()) != num(fromZ) || m.turns > 0)
       helix(m, from, fromZ);
     else
-      flatArc(from, m.to.head<2>(), m, m.sweep(), 0);
+      flatArc(from, m.from.head<2>(), m.to.head<2>(), m, sweep, 0);
   }
 
   /// The printed centre for an arc from `from` to `to` (both as the control
-  /// has them) about `centre`: on the grid of printed numbers, as near the
-  /// perpendicular bisector as the grid allows, so that start and end radius
-  /// agree to the printed decimals; the centre in force is kept when it does
-  /// as well.
-  geom::Vec2 pickCentre(const geom::Vec2 &from, const geom::Vec2 &to, const geom::Vec2 &centre) const {
+  /// has them), near `around`: on the grid of printed numbers within `reach`
+  /// units, the nearest point whose start and end radius differ by at most
+  /// half a unit of the last decimal (else the point where they differ
+  /// least). The pole in force is kept when it does as well and lies within
+  /// a unit.
+  geom::Vec2 gridCentre(const geom::Vec2 &from, const geom::Vec2 &to, const geom::Vec2 &around, int reach) const {
     const double u = unit();
+    const double enough = u / 2 + 1e-12;
     auto mismatch = [&](const geom::Vec2 &c) { return std::abs((from - c).norm() - (to - c).norm()); };
-    if ((to - from).norm() < u / 2) {
-      // A whole turn: every centre has equal radii; keep the one in force
-      // when it prints as this one.
-      const geom::Vec2 c(rounded(centre.x()), rounded(centre.y()));
-      if (cc_ && (*cc_ - c).norm() < u / 2)
-        return *cc_;
-      return c;
-    }
-    const geom::Vec2 b = balancedCentre(from, to, centre);
-    const geom::Vec2 base(rounded(b.x()), rounded(b.y()));
+    const geom::Vec2 base(rounded(around.x()), rounded(around.y()));
     geom::Vec2 best = base;
-    double bestMismatch = mismatch(base), bestDistance = (base - b).norm();
-    for (int i = -2; i <= 2; ++i)
-      for (int j = -2; j <= 2; ++j) {
+    double bestMismatch = mismatch(base), bestDistance = (base - around).norm();
+    for (int i = -reach; i <= reach; ++i)
+      for (int j = -reach; j <= reach; ++j) {
         const geom::Vec2 c(rounded(base.x() + i * u), rounded(base.y() + j * u));
-        const double e = mismatch(c), dist = (c - b).norm();
-        if (e < bestMismatch - 1e-12 || (e <= bestMismatch + 1e-12 && dist < bestDistance - 1e-12)) {
+        const double e = mismatch(c), dist = (c - around).norm();
+        const bool better = bestMismatch > enough
+                                ? e < bestMismatch - 1e-12 || (e <= bestMismatch + 1e-12 && dist < bestDistance)
+                                : e <= enough && dist < bestDistance - 1e-12;
+        if (better) {
           best = c;
           bestMismatch = e;
           bestDistance = dist;
         }
       }
-    if (cc_ && (*cc_ - b).norm() <= 2 * u && mismatch(*cc_) <= std::max(bestMismatch, u / 2) + 1e-12)
+    if (cc_ && (*cc_ - around).norm() <= u && mismatch(*cc_) <= std::max(bestMismatch, enough))
       return *cc_;
     return best;
   }
@@ -397,28 +423,38 @@ private:
     cc_ = c;
   }
 
-  /// An arc in the plane: CC (when it changes), then C to the end point. An
-  /// arc whose printed numbers would turn the other way round (a near-whole
-  /// circle whose end rounds past its start) is written in two halves.
-  void flatArc(const geom::Vec2 &from, const geom::Vec2 &toExact, const Move &m, double sweep, int depth) {
-    const double u = unit();
-    const geom::Vec2 to(rounded(toExact.x()), rounded(toExact.y()));
-    const double fromZ = at_[2] ? *at_[2] : m.to.z();
-    if ((m.centre - from).norm() < u) {
-      // A radius below the printed resolution: a line does as well.
-      line(Vec3(toExact.x(), toExact.y(), fromZ), false, m.feed);
-      return;
+  /// The farthest the arc the control makes (from `from` about `c` through
+  /// `printedSweep`) strays from the planned one (from `plannedFrom` about
+  /// `centre` through `sweep`), at its quarter points.
+  static double arcGap(const geom::Vec2 &from, const geom::Vec2 &c, double printedSweep,
+                       const geom::Vec2 &plannedFrom, const geom::Vec2 &centre, double sweep, bool ccw) {
+    double gap = 0;
+    for (int k = 1; k <= 3; ++k) {
+      const geom::Vec2 p = arcSplitPoints(from, c, ccw, printedSweep * k / 4, 1).front();
+      const geom::Vec2 q = arcSplitPoints(plannedFrom, centre, ccw, sweep * k / 4, 1).front();
+      gap = std::max(gap, (p - q).norm());
     }
-    if ((to - from).norm() < u / 2 && sweep < kPi)
-      return;  // a sliver that prints as no motion
-    const geom::Vec2 c = pickCentre(from, to, m.centre);
+    return gap;
+  }
+
+  /// An arc in the plane: CC (when it changes), then C to the end point,
+  /// with the centre balanced for the printed endpoints. Where that would
+  /// take the path more than three units of the last decimal off the plan
+  /// (a near-whole circle whose endpoints lie too close to fix the centre,
+  /// or whose end rounds past its start), the arc is written in halves.
+  void flatArc(const geom::Vec2 &from, const geom::Vec2 &plannedFrom, const geom::Vec2 &plannedTo, const Move &m,
+               double sweep, int depth) {
+    const double u = unit();
+    const geom::Vec2 to(rounded(plannedTo.x()), rounded(plannedTo.y()));
+    const double fromZ = at_[2] ? *at_[2] : m.to.z();
     const bool whole = (to - from).norm() < u / 2;
+    const geom::Vec2 c = gridCentre(from, to, whole ? m.centre : balancedCentre(from, to, m.centre), 2);
     const double printedSweep = whole ? kTwoPi : turnAngle(from - c, to - c, m.ccw);
-    if (!whole && std::abs(printedSweep - sweep) > kPi / 2 && depth < 2) {
-      const geom::Vec2 mid = arcSplitPoints(from, m.centre, m.ccw, sweep, 2).front();
-      flatArc(from, mid, m, sweep / 2, depth + 1);
+    if (depth < 4 && arcGap(from, c, printedSweep, plannedFrom, m.centre, sweep, m.ccw) > 3 * u) {
+      const geom::Vec2 mid = arcSplitPoints(plannedFrom, m.centre, m.ccw, sweep / 2, 1).front();
+      flatArc(from, plannedFrom, mid, m, sweep / 2, depth + 1);
       const geom::Vec2 next = at_[0] && at_[1] ? geom::Vec2(*at_[0], *at_[1]) : mid;
-      flatArc(next, toExact, m, sweep / 2, depth + 1);
+      flatArc(next, mid, plannedTo, m, sweep / 2, depth + 1);
       return;
     }
     centreBlock(c);
@@ -432,8 +468,11 @@ private:
   /// The control ends where the start turned by that angle lands, which
   /// the next block's coordinates then take as the position.
   void helix(const Move &m, const geom::Vec2 &from, double fromZ) {
+    // The pole within a unit of the planned centre: the radius comes from
+    // the start, the next block puts the tool on the planned end, and
+    // balancing for endpoints a turn apart could move the pole anywhere.
     const geom::Vec2 to(rounded(m.to.x()), rounded(m.to.y()));
-    const geom::Vec2 c = pickCentre(from, to, m.centre);
+    const geom::Vec2 c = gridCentre(from, to, m.centre, 1);
     centreBlock(c);
     const double sweep = m.sweep();
     // The printed angle, with as many whole turns as brings it nearest the
@@ -506,6 +545,7 @@ private:
     if (!at_[2] || *at_[2] < initial) {
       // Up along the tool axis first: the call moves in the plane.
       out_.block("L Z" + num(initial) + " R0 FMAX");
+      modal_.forget("F");
       modal_.forget("Z");
       modal_.change("Z", num(initial));
       at_[2] = initial;

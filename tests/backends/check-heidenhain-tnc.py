@@ -22,7 +22,9 @@ what the control would reject or do differently:
 With --ir TOOLPATH.IR the moves the program makes (cycle 200 expanded as the
 TNC manual describes it: README.md) are also compared with the toolpath
 IR's moves: runs of rapids by where they end, feed moves by end point and
-feed, arcs by end point, centre, direction and swept angle.
+feed, arcs also by direction, sweep and path (points at eighths of each
+written arc within 0.005 mm of the IR's circle; an arc that keeps that
+close to its chord may be a line).
 
 Exit status 0 when clean, 1 listing each problem with its block number.
 """
@@ -35,8 +37,8 @@ NUM_SIGNED = r"[+-]\d+(?:\.\d+)?"
 NUM_UNSIGNED = r"\d+(?:\.\d+)?"
 M_ALLOWED = {0, 1, 2, 3, 4, 5, 7, 8, 9, 30, 99}
 CYCLE_200_Q = [200, 201, 206, 202, 210, 203, 204, 211]
-END_TOL = 0.002     # a CP ends where the control turns the start: printed angle and pole
-CENTRE_TOL = 0.005  # printed poles are moved along the grid to balance the radii
+END_TOL = 0.002   # a CP ends where the control turns the start: printed angle and pole
+PATH_TOL = 0.005  # along arcs: printed endpoints, and poles moved on the grid to balance the radii
 FEED_TOL = 0.5 + 1e-6  # feeds are printed as whole mm/min
 
 
@@ -67,7 +69,8 @@ def unsigned(text, where, problems, what):
 
 
 def read_blocks(text, problems):
-    """[(number or None, first line text, [continuation lines], line number)]."""
+    """[(block number, first line's text, [continuation lines], line number)],
+    reporting lines without a number and numbers out of sequence."""
     blocks = []
     expected = 0
     continuing = False
@@ -112,9 +115,6 @@ class Machine:
         self.spindle = False
         self.cycle = None
         self.motions = []
-
-    def where(self):
-        return tuple(self.pos)
 
     def need_tool(self, where):
         if self.tool is None:
@@ -285,8 +285,6 @@ def check_l(words, where, mach, problems, is_last_before_end):
         problems.add(where, "word '%s' is not valid here in an L block" % w)
     if len(ms) > 1:
         problems.add(where, "%d M functions in one block (stepnc writes one)" % len(ms))
-    if axes and feed is None and not rapid:
-        pass  # modal feed: checked by the machine
     for n in ms:
         mach.m_function(where, n, before_motion=True)
     mach.line(where, axes, rapid, feed)
@@ -510,8 +508,8 @@ def ir_moves(path):
                 sweep = turn_angle(a, b, ccw)
                 if math.hypot(to[0] - pos[0], to[1] - pos[1]) <= 1e-9:
                     sweep = 2 * math.pi
-                move.update(centre=(c[0], c[1]), ccw=ccw, sweep=sweep + 2 * math.pi * turns,
-                            radius=math.hypot(*a), start=pos)
+                move.update(centre=(c[0], c[1]), ccw=ccw, sweep=sweep + 2 * math.pi * turns, turns=turns,
+                            start=pos)
             else:
                 move["start"] = pos
             out.append(move)
@@ -520,15 +518,29 @@ def ir_moves(path):
 
 
 def normalise(moves, decimals):
-    """Leaves out moves that go nowhere as printed (not whole circles) and
-    merges runs of rapids into their end."""
+    """Leaves out moves that go no farther than a unit of the last decimal
+    (save near-whole circles),
+    merges runs of rapids into their end and runs of flat arcs about one
+    centre into one arc."""
     out = []
     for mv in moves:
         start = mv.get("start")
-        if start is not None:
-            same = all(round(a, decimals) == round(b, decimals) for a, b in zip(start, mv["to"]))
-            if same and not (mv["kind"] == "arc" and mv["sweep"] > math.pi):
+        if start is not None and None not in mv["to"]:
+            near = math.dist(start, mv["to"]) <= 1.5 * 10.0 ** -decimals
+            if near and not (mv["kind"] == "arc" and mv["sweep"] > math.pi):
                 continue
+        prev = out[-1] if out else None
+        if (mv["kind"] == "arc" and prev and prev["kind"] == "arc" and prev["ccw"] == mv["ccw"]
+                and prev.get("feed") == mv.get("feed") and prev["start"] is not None and start is not None
+                and prev["start"][2] == prev["to"][2] == mv["to"][2]
+                and math.dist(prev["centre"], mv["centre"]) <= 2 * PATH_TOL):
+            # Arcs about one centre in a row are one arc (a backend may
+            # split an arc, e.g. a near-whole circle into halves).
+            merged = dict(prev)
+            merged["to"], merged["sweep"], merged["where"] = mv["to"], prev["sweep"] + mv["sweep"], mv["where"]
+            merged["pieces"] = arc_pieces(prev) + arc_pieces(mv)
+            out[-1] = merged
+            continue
         if mv["kind"] == "rapid" and out and out[-1]["kind"] == "rapid":
             merged = dict(out[-1])
             merged["to"] = tuple(b if b is not None else a for a, b in zip(out[-1]["to"], mv["to"]))
@@ -552,29 +564,90 @@ def program_moves(motions):
     return out
 
 
-def compare(prog, ir, problems):
-    n = min(len(prog), len(ir))
-    for a, b in zip(prog, ir):
+def arc_pieces(mv):
+    """An arc as the arcs it was merged from: (start, centre, ccw, sweep)."""
+    return mv.get("pieces") or [(mv["start"], mv["centre"], mv["ccw"], mv["sweep"])]
+
+
+def piece_point(piece, t):
+    """The point (x, y) a fraction t along one arc, at its start radius."""
+    (sx, sy, _), (cx, cy), ccw, sweep = piece
+    a = math.atan2(sy - cy, sx - cx) + (1 if ccw else -1) * t * sweep
+    r = math.hypot(sx - cx, sy - cy)
+    return (cx + r * math.cos(a), cy + r * math.sin(a))
+
+
+def chord_deviation(mv):
+    """How far an arc strays from its chord (a whole turn: its diameter)."""
+    r = math.hypot(mv["start"][0] - mv["centre"][0], mv["start"][1] - mv["centre"][1])
+    return r * (1 - math.cos(min(mv["sweep"], math.pi) / 2))
+
+
+def tiny(mv, decimals):
+    """A move too short to compare: a line or an arc (not a near-whole
+    circle) whose ends are within three units of the last decimal."""
+    start = mv.get("start")
+    if start is None or None in start or mv["kind"] == "rapid":
+        return False
+    if mv["kind"] == "arc" and mv["sweep"] > math.pi:
+        return False
+    return math.dist(start, mv["to"]) <= 3 * 10.0 ** -decimals
+
+
+def compare(prog, ir, problems, decimals):
+    """Move by move: the same kind (an arc within PATH_TOL of its chord may be
+    a line), the same end, the same feed; arcs also the same direction and
+    sweep, and the path (points at eighths of each written arc) within
+    PATH_TOL of the IR's circle. A move too short to compare on one side
+    may be missing on the other (rounding decides which side has it). The
+    sweep is compared coarsely (0.5 rad): ends and path are checked to the
+    micron, the sweep catches a turn too many or too few."""
+    i = j = 0
+    while i < len(prog) and j < len(ir):
+        a, b = prog[i], ir[j]
         where = "%s (%s)" % (a["where"], b["where"])
-        if a["kind"] != b["kind"]:
-            problems.add(where, "the program makes a %s where the IR has a %s" % (a["kind"], b["kind"]))
-            return
-        for k in range(3):
-            if a["to"][k] is not None and abs(a["to"][k] - b["to"][k]) > END_TOL:
-                problems.add(where, "%s ends at %s where the IR ends at %s" % (a["kind"], fmt(a["to"]), fmt(b["to"])))
-                return
-        if a["kind"] != "rapid" and abs((a.get("feed") or 0) - b.get("feed", 0)) > FEED_TOL:
-            problems.add(where, "feed %s where the IR has %s" % (a.get("feed"), b.get("feed")))
-        if a["kind"] == "arc":
-            if a["ccw"] != b["ccw"]:
-                problems.add(where, "arc turns the other way")
-            if math.hypot(a["centre"][0] - b["centre"][0], a["centre"][1] - b["centre"][1]) > CENTRE_TOL:
-                problems.add(where, "arc centre %s where the IR has %s" % (fmt(a["centre"]), fmt(b["centre"])))
-            if abs(a["sweep"] - b["sweep"]) * max(b["radius"], 1e-9) > CENTRE_TOL:
-                problems.add(where, "arc sweeps %.4f deg where the IR sweeps %.4f deg"
+        kind_a, kind_b = a["kind"], b["kind"]
+        if kind_a == "linear" and kind_b == "arc" and b.get("turns", 0) == 0 and chord_deviation(b) <= PATH_TOL:
+            kind_b = "linear"
+        ends = all(a["to"][k] is None or abs(a["to"][k] - b["to"][k]) <= END_TOL for k in range(3))
+        turns = kind_a != "arc" or kind_b != "arc" or abs(a["sweep"] - b["sweep"]) <= 0.5
+        if kind_a != kind_b or not ends or not turns:
+            if tiny(a, decimals):
+                i += 1
+                continue
+            if tiny(b, decimals):
+                j += 1
+                continue
+            if kind_a != kind_b:
+                problems.add(where, "the program makes a %s where the IR has a %s" % (a["kind"], b["kind"]))
+            elif not turns:
+                problems.add(where, "the arc sweeps %.4f deg where the IR sweeps %.4f deg"
                              % (math.degrees(a["sweep"]), math.degrees(b["sweep"])))
-    if len(prog) != len(ir):
-        problems.add("end", "the program makes %d moves and the IR has %d (first %d compared)" % (len(prog), len(ir), n))
+            else:
+                problems.add(where, "%s ends at %s where the IR ends at %s" % (a["kind"], fmt(a["to"]), fmt(b["to"])))
+            return
+        i += 1
+        j += 1
+        if kind_a != "rapid" and abs((a.get("feed") or 0) - b.get("feed", 0)) > FEED_TOL:
+            problems.add(where, "feed %s where the IR has %s" % (a.get("feed"), b.get("feed")))
+        if kind_a == "arc":
+            if a["start"] is None:
+                problems.add(where, "arc from an unknown position")
+                continue
+            centre = b["centre"]
+            radius = math.hypot(b["start"][0] - centre[0], b["start"][1] - centre[1])
+            if a["ccw"] != b["ccw"]:
+                problems.add(where, "the arc turns the other way")
+            for piece in arc_pieces(a):
+                off = max(abs(math.dist(piece_point(piece, t / 8), centre) - radius) for t in range(1, 8))
+                if off > PATH_TOL:
+                    problems.add(where, "the arc strays %.4f mm from the IR's circle about %s, radius %.4f"
+                                 % (off, fmt(centre), radius))
+                    break
+    rest = [mv for mv in prog[i:] if not tiny(mv, decimals)] + [mv for mv in ir[j:] if not tiny(mv, decimals)]
+    if rest:
+        problems.add(rest[0]["where"], "the program makes %d moves and the IR has %d: the rest do not pair up"
+                     % (len(prog), len(ir)))
 
 
 def fmt(v):
@@ -594,7 +667,7 @@ def main():
     problems, mach = check_program(text, args.arc_tol)
     if args.ir:
         compare(normalise(program_moves(mach.motions), args.decimals),
-                normalise(ir_moves(args.ir), args.decimals), problems)
+                normalise(ir_moves(args.ir), args.decimals), problems, args.decimals)
     if problems.items:
         for item in problems.items:
             print("%s: %s" % (args.program, item))
