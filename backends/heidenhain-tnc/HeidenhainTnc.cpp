@@ -517,7 +517,7 @@ private:
       return false;
     double plunging = -depthQ;
     if (c.pecks.size() > 1) {
-      // Unverified beyond DIALECTS.md: infeeds counted from the surface, and
+      // Unverified beyond the sources: infeeds counted from the surface, and
       // the return down to the set-up clearance above the last depth
       // (README.md). Only a plan that does exactly this is written as one.
       const double q = c.surfaceZ - c.pecks.front();

@@ -2,9 +2,9 @@
 // core: the transfer header and program name, G71 metric blocks, tool calls
 // whose length comes from the tool's D offset, I/J (or CR=) arcs and TURN=
 // helices, the CYCLE832 path settings, and drilling as modal CYCLE81 / CYCLE83
-// / CYCLE84 calls. The facts behind each word are in /work/shared/DIALECTS.md;
-// the choices it leaves open, and the forms taken where it says "unverified",
-// are in backends/siemens-840d/README.md. The structure of what is written is
+// / CYCLE84 calls. The facts behind each word come from the manuals in
+// docs/backends.md ("Sources"); the choices they leave open, and the forms
+// taken where a fact is unverified, are in backends/siemens-840d/README.md. The structure of what is written is
 // checked by tests/backends/check-siemens-840d.py.
 #include "backends/Backend.h"
 #include "backends/common/IsoEmitter.h"
@@ -29,7 +29,7 @@ TargetDescriptor siemensDescriptor() {
   d.helixTurns = true;  // TURN=
   d.cycles = {CycleKind::Drill, CycleKind::Peck, CycleKind::Tap};
   d.numbering = Numbering::None;
-  d.maxLineLength = 512;  // conservative: the controller's own limit is not in DIALECTS.md
+  d.maxLineLength = 512;  // conservative: the controller's own limit is not in the sources
   d.coordDecimals = 3;
   d.feedDecimals = 1;
   d.speedDecimals = 0;
@@ -81,7 +81,7 @@ std::string printable(const std::string &text, size_t most) {
 }
 
 /// The longest message text written: the display line is short (its length
-/// is not in DIALECTS.md), and a longer text says no more at the machine.
+/// is not in the sources), and a longer text says no more at the machine.
 constexpr size_t kMaxMessage = 120;
 
 bool isTapping(const std::string &operation) { return operation == "tapping" || operation == "thread_drilling"; }

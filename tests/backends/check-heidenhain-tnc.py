@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Structural checker for the HEIDENHAIN TNC conversational (Klartext)
 programs stepnc writes (backends/heidenhain-tnc). No Heidenhain checker is
-packaged for this machine, so this script reads the program back the way the
+packaged for Debian, so this script reads the program back the way the
 control would, for the subset of Klartext the backend writes, and reports
 what the control would reject or do differently:
 

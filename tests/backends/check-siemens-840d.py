@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Checks SINUMERIK 840D main programs written by stepnc.
 
-No Sinumerik interpreter is packaged for this machine, so this script reads
-a program as the facts in /work/shared/DIALECTS.md describe the controller
+No Sinumerik interpreter is packaged for Debian, so this script reads
+a program as the manuals in docs/backends.md ("Sources") describe the controller
 and reports what would be wrong there:
 
   * the frame: `%_N_NAME_MPF` first (NAME: letters, digits, underscores,
