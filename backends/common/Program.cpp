@@ -2,6 +2,7 @@
 
 #include "ir/Kinds.h"
 #include "passes/FeatureShape.h"
+#include "passes/MoveWalk.h"
 
 #include <cmath>
 #include <map>
@@ -160,28 +161,24 @@ private:
     s.spindle = moves->number("spindle").value_or(0);
     s.coolant = moves->text("coolant").value_or("off");
     s.secplane = moves->number("secplane").value_or(0);
-    Vec3 pos = position_;
-    for (const ir::Node &m : moves->children) {
+    // The moves as every reader of the toolpath IR sees them (passes/MoveWalk).
+    for (const passes::Move &m : passes::walkMoves(*moves, position_)) {
       Move mv;
-      mv.node = &m;
-      mv.from = pos;
-      mv.to = *m.vec("to");
-      mv.role = m.text("role").value_or("");
-      if (m.kind == "rapid") {
-        mv.kind = Move::Kind::Rapid;
-      } else {
-        mv.kind = m.kind == "arc" ? Move::Kind::Arc : Move::Kind::Linear;
-        mv.feed = m.number("feed").value_or(0);
-        if (m.kind == "arc") {
-          mv.centre = m.vec("center")->head<2>();
-          mv.ccw = m.text("dir") == "ccw";
-          mv.turns = m.count("turns").value_or(0);
-        }
-      }
-      pos = mv.to;
+      mv.node = m.node;
+      mv.from = m.from.value_or(position_);
+      mv.to = m.to;
+      mv.role = m.role;
+      mv.kind = m.kind == passes::MoveKind::Rapid   ? Move::Kind::Rapid
+                : m.kind == passes::MoveKind::Arc ? Move::Kind::Arc
+                                                  : Move::Kind::Linear;
+      mv.feed = m.feed;
+      mv.centre = m.center.head<2>();
+      mv.ccw = m.ccw;
+      mv.turns = m.turns;
       s.moves.push_back(std::move(mv));
     }
-    position_ = pos;
+    if (!s.moves.empty())
+      position_ = s.moves.back().to;
     if (auto kind = cycleKindOf(s.operation)) {
       const ir::Node *feature = passes::findFeature(module_, e.text("feature").value_or(""));
       auto frame = feature ? passes::planeFrame(*feature) : passes::FrameResult{};

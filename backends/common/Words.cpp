@@ -29,8 +29,6 @@ std::string formatNumber(double value, const NumberStyle &style) {
   } else if (style.keepPoint) {
     s += '.';
   }
-  if (s == "-0" || s == "-0.")
-    s.erase(0, 1);
   if (style.plusSign && s.front() != '-')
     s.insert(s.begin(), '+');
   return s;

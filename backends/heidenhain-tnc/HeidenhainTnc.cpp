@@ -8,6 +8,7 @@
 // in backends/heidenhain-tnc/README.md. The structural checker
 // tests/backends/check-heidenhain-tnc.py reads these programs back.
 #include "backends/Backend.h"
+#include "backends/common/EmitterBackend.h"
 #include "backends/common/IsoEmitter.h"
 #include "backends/common/Program.h"
 #include "backends/common/Words.h"
@@ -592,21 +593,10 @@ private:
   bool ok_ = true;
 };
 
-class HeidenhainTncBackend final : public Backend {
-public:
-  HeidenhainTncBackend() : Backend(tncDescriptor()) {}
-
-  std::optional<std::string> emit(const ir::Module &module, const EmitOptions &options,
-                                   DiagnosticEngine &diags) override {
-    auto program = buildProgram(module, options.toolTable, diags);
-    if (!program)
-      return std::nullopt;
-    return KlartextEmitter(descriptor(), options, diags).run(*program);
-  }
-};
-
 } // namespace
 
-std::unique_ptr<Backend> createHeidenhainTncBackend() { return std::make_unique<HeidenhainTncBackend>(); }
+std::unique_ptr<Backend> createHeidenhainTncBackend() {
+  return std::make_unique<EmitterBackend<KlartextEmitter>>(tncDescriptor());
+}
 
 } // namespace stepnc::backends

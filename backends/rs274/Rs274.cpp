@@ -2,6 +2,7 @@
 // checked in the test suite by LinuxCNC's own `rs274`: it must run without
 // error and make the planned moves (backends/rs274/README.md).
 #include "backends/Backend.h"
+#include "backends/common/EmitterBackend.h"
 #include "backends/common/IsoEmitter.h"
 
 #include <cmath>
@@ -135,21 +136,10 @@ private:
   }
 };
 
-class Rs274Backend final : public Backend {
-public:
-  Rs274Backend() : Backend(rs274Descriptor()) {}
-
-  std::optional<std::string> emit(const ir::Module &module, const EmitOptions &options,
-                                   DiagnosticEngine &diags) override {
-    auto program = buildProgram(module, options.toolTable, diags);
-    if (!program)
-      return std::nullopt;
-    return Rs274Emitter(descriptor(), options, diags).run(*program);
-  }
-};
-
 } // namespace
 
-std::unique_ptr<Backend> createRs274Backend() { return std::make_unique<Rs274Backend>(); }
+std::unique_ptr<Backend> createRs274Backend() {
+  return std::make_unique<EmitterBackend<Rs274Emitter>>(rs274Descriptor());
+}
 
 } // namespace stepnc::backends

@@ -7,6 +7,7 @@
 // taken where a fact is unverified, are in backends/siemens-840d/README.md. The structure of what is written is
 // checked by tests/backends/check-siemens-840d.py.
 #include "backends/Backend.h"
+#include "backends/common/EmitterBackend.h"
 #include "backends/common/IsoEmitter.h"
 
 #include <algorithm>
@@ -174,7 +175,40 @@ class SiemensEmitter final : public IsoEmitter {
 public:
   using IsoEmitter::IsoEmitter;
 
+  /// The program, once every tap is known to be a CYCLE84 (all reported
+  /// together, before anything is written).
+  std::optional<std::string> run(const Program &p) {
+    if (!tapsAsCycles(p))
+      return std::nullopt;
+    return IsoEmitter::run(p);
+  }
+
 private:
+  /// A tap written as moves would feed out without reversing the spindle and
+  /// break: every tapping step must be a CYCLE84, else nothing is written.
+  bool tapsAsCycles(const Program &p) {
+    bool ok = true;
+    for (const Step &s : p.steps) {
+      if (s.kind != Step::Kind::Moves || !isTapping(s.operation))
+        continue;
+      std::string why;
+      if (!d_.cycles.count(CycleKind::Tap))
+        why = "cycles are off (--no-cycles or cycles=off)";
+      else if (!s.cycle)
+        why = "its moves are not one tapping cycle (to the hole, feed down, feed out)";
+      else
+        why = cycleCall(p, s, *s.cycle, d_).whyNot;
+      if (why.empty())
+        continue;
+      diags_.error(s.exec->origin.loc, "workingstep " + s.exec->symbol + " (" + s.operation +
+                                           ") cannot be written as CYCLE84: " + why +
+                                           "; as plain moves the spindle would not reverse at the bottom")
+          .entity(s.exec->origin.entityId);
+      ok = false;
+    }
+    return ok;
+  }
+
   std::string comment(const std::string &text) const override {
     // Room for a block number and "; " within the line limit.
     const size_t room = d_.maxLineLength > 32 ? d_.maxLineLength - 16 : std::string::npos;
@@ -238,49 +272,10 @@ private:
   }
 };
 
-class SiemensBackend final : public Backend {
-public:
-  SiemensBackend() : Backend(siemensDescriptor()) {}
-
-  std::optional<std::string> emit(const ir::Module &module, const EmitOptions &options,
-                                   DiagnosticEngine &diags) override {
-    auto program = buildProgram(module, options.toolTable, diags);
-    if (!program)
-      return std::nullopt;
-    if (!tapsAsCycles(*program, diags))
-      return std::nullopt;
-    return SiemensEmitter(descriptor(), options, diags).run(*program);
-  }
-
-private:
-  /// A tap written as moves would feed out without reversing the spindle and
-  /// break: every tapping step must be a CYCLE84, else nothing is written.
-  bool tapsAsCycles(const Program &p, DiagnosticEngine &diags) const {
-    bool ok = true;
-    for (const Step &s : p.steps) {
-      if (s.kind != Step::Kind::Moves || !isTapping(s.operation))
-        continue;
-      std::string why;
-      if (!descriptor().cycles.count(CycleKind::Tap))
-        why = "cycles are off (--no-cycles or cycles=off)";
-      else if (!s.cycle)
-        why = "its moves are not one tapping cycle (to the hole, feed down, feed out)";
-      else
-        why = cycleCall(p, s, *s.cycle, descriptor()).whyNot;
-      if (why.empty())
-        continue;
-      diags.error(s.exec->origin.loc, "workingstep " + s.exec->symbol + " (" + s.operation +
-                                          ") cannot be written as CYCLE84: " + why +
-                                          "; as plain moves the spindle would not reverse at the bottom")
-          .entity(s.exec->origin.entityId);
-      ok = false;
-    }
-    return ok;
-  }
-};
-
 } // namespace
 
-std::unique_ptr<Backend> createSiemens840dBackend() { return std::make_unique<SiemensBackend>(); }
+std::unique_ptr<Backend> createSiemens840dBackend() {
+  return std::make_unique<EmitterBackend<SiemensEmitter>>(siemensDescriptor());
+}
 
 } // namespace stepnc::backends

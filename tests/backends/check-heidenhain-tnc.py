@@ -33,6 +33,8 @@ import math
 import re
 import sys
 
+import toolpath_ir
+
 NUM_SIGNED = r"[+-]\d+(?:\.\d+)?"
 NUM_UNSIGNED = r"\d+(?:\.\d+)?"
 M_ALLOWED = {0, 1, 2, 3, 4, 5, 7, 8, 9, 30, 99}
@@ -478,42 +480,10 @@ def check_cycle_200(body, cont, where, mach, problems):
 
 # --- Comparison with the toolpath IR ---------------------------------------------------
 
-IR_MOVE = re.compile(r"^\s*(rapid|linear|arc)\s+(.*)$")
-IR_ATTR = re.compile(r"(\w+)=(\([^)]*\)|\S+)")
-
-
-def ir_vec(text):
-    return tuple(float(v) for v in text.split(")")[0].strip("(").split(","))
-
-
 def ir_moves(path):
-    out = []
-    pos = (0.0, 0.0, 0.0)  # the program model's start (backends/common/Program.cpp)
-    with open(path) as f:
-        for lineno, line in enumerate(f, 1):
-            m = IR_MOVE.match(line.split(";")[0])
-            if not m:
-                continue
-            attrs = dict(IR_ATTR.findall(m.group(2)))
-            to = ir_vec(attrs["to"])
-            move = {"kind": m.group(1), "to": to, "where": "IR line %d" % lineno}
-            if "feed" in attrs:
-                move["feed"] = float(attrs["feed"].replace("mm/min", ""))
-            if m.group(1) == "arc":
-                c = ir_vec(attrs["center"])
-                ccw = attrs.get("dir") == "ccw"
-                turns = int(attrs.get("turns", "0"))
-                a = (pos[0] - c[0], pos[1] - c[1])
-                b = (to[0] - c[0], to[1] - c[1])
-                sweep = turn_angle(a, b, ccw)
-                if math.hypot(to[0] - pos[0], to[1] - pos[1]) <= 1e-9:
-                    sweep = 2 * math.pi
-                move.update(centre=(c[0], c[1]), ccw=ccw, sweep=sweep + 2 * math.pi * turns, turns=turns,
-                            start=pos)
-            else:
-                move["start"] = pos
-            out.append(move)
-            pos = to
+    out = toolpath_ir.read_moves(path)
+    for mv in out:
+        mv["where"] = "IR line %d" % mv["line"]
     return out
 
 

@@ -28,36 +28,11 @@ import subprocess
 import sys
 import tempfile
 
+import toolpath_ir
+
 TOL = 1e-3
 
-MOVE_RE = re.compile(r"^\s*(rapid|linear|arc)\s+(.*)$")
-ATTR_RE = re.compile(r"(\w+)=(\([^)]*\)|\S+)")
 CANON_RE = re.compile(r"(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED|SET_FEED_RATE)\(([^)]*)\)")
-
-
-def vec(text):
-    return tuple(float(v) for v in text.split(")")[0].strip("(").split(","))
-
-
-def ir_moves(path):
-    """The moves of every `moves` block, in order: (kind, end, extra)."""
-    out = []
-    with open(path) as f:
-        for line in f:
-            code = line.split(";")[0]
-            m = MOVE_RE.match(code)
-            if not m:
-                continue
-            attrs = dict(ATTR_RE.findall(m.group(2)))
-            move = {"kind": m.group(1), "to": vec(attrs["to"]), "text": code.strip()}
-            if "feed" in attrs:
-                move["feed"] = float(attrs["feed"].replace("mm/min", ""))
-            if m.group(1) == "arc":
-                move["center"] = vec(attrs["center"])
-                move["ccw"] = attrs["dir"] == "ccw"
-                move["turns"] = int(attrs.get("turns", "0"))
-            out.append(move)
-    return out
 
 
 def canon_moves(path):
@@ -74,7 +49,7 @@ def canon_moves(path):
                 continue
             if m.group(1) == "ARC_FEED":
                 e1, e2, c1, c2, turn, e3 = (float(a) for a in args[:6])
-                out.append({"kind": "arc", "to": (e1, e2, e3), "center": (c1, c2), "ccw": turn > 0,
+                out.append({"kind": "arc", "to": (e1, e2, e3), "centre": (c1, c2), "ccw": turn > 0,
                             "turns": abs(int(turn)) - 1, "feed": feed, "text": "canon line %d: %s" % (n, line.strip())})
             else:
                 kind = "rapid" if m.group(1) == "STRAIGHT_TRAVERSE" else "linear"
@@ -119,7 +94,7 @@ def compare(ir, canon, feeds_only, feed_tol):
             why = "end point differs"
         elif x["kind"] != "rapid" and abs(x["feed"] - y["feed"]) > feed_tol:
             why = "feed %.3f != %.3f" % (x["feed"], y["feed"])
-        elif x["kind"] == "arc" and (not close(x["center"][:2], y["center"]) or x["ccw"] != y["ccw"]
+        elif x["kind"] == "arc" and (not close(x["centre"], y["centre"]) or x["ccw"] != y["ccw"]
                                      or x["turns"] != y["turns"]):
             why = "arc centre, direction or turns differ"
         if why:
@@ -175,7 +150,7 @@ def check(stepnc, path, cycles, extra, workdir, program=None):
                  canon_path], cwd=workdir, stdin=subprocess.DEVNULL)
     if r.returncode != 0:
         return ["rs274 rejected the program (exit %d):\n%s%s" % (r.returncode, r.stdout, r.stderr)]
-    problems, n = compare(ir_moves(ir_path), canon_moves(canon_path), cycles, 0.05 + 1e-9)
+    problems, n = compare(toolpath_ir.read_moves(ir_path), canon_moves(canon_path), cycles, 0.05 + 1e-9)
     if not problems:
         print("ok: %s%s: %d moves match" % (os.path.basename(path), "" if cycles else " (--no-cycles)", n))
     return problems

@@ -49,6 +49,9 @@ import subprocess
 import sys
 import tempfile
 
+import toolpath_ir
+from toolpath_ir import arc_sweep
+
 RADIUS_TOL = 1e-3
 MAX_NAME = 24
 
@@ -112,50 +115,9 @@ def arg_number(text):
 ARC_LENGTH_TOL = 0.01
 
 
-def arc_sweep(start, end, centre, ccw):
-    """The angle from start to end about centre (radians, in (0, 2 pi]); end over start is a whole turn."""
-    if math.dist(start, end) < 1e-9:
-        return 2 * math.pi
-    a = math.atan2(start[1] - centre[1], start[0] - centre[0])
-    b = math.atan2(end[1] - centre[1], end[0] - centre[0])
-    angle = (b - a) if ccw else (a - b)
-    while angle <= 0:
-        angle += 2 * math.pi
-    while angle > 2 * math.pi:
-        angle -= 2 * math.pi
-    return angle
-
-
-IR_MOVE_RE = re.compile(r"^\s*(rapid|linear|arc)\s+(.*)$")
-IR_ATTR_RE = re.compile(r"(\w+)=(\([^)]*\)|\S+)")
-
-
-def ir_point(text):
-    return tuple(float(v) for v in text.split(")")[0].strip("(").split(","))
-
-
 def planned_moves(path):
     """The moves of every `moves` block of a toolpath IR file, in order."""
-    out = []
-    where = None
-    with open(path) as f:
-        for n, line in enumerate(f, 1):
-            m = IR_MOVE_RE.match(line.split(";")[0])
-            if not m:
-                continue
-            attrs = dict(IR_ATTR_RE.findall(m.group(2)))
-            move = dict(kind=m.group(1), to=ir_point(attrs["to"]), line=n,
-                        feed=float(attrs.get("feed", "0").replace("mm/min", "")))
-            if move["kind"] == "arc":
-                centre = ir_point(attrs["center"])[:2]
-                ccw = attrs["dir"] == "ccw"
-                start = where[:2] if where else move["to"][:2]
-                move.update(centre=centre, ccw=ccw, radius=math.dist(start, centre),
-                            sweep=arc_sweep(start, move["to"][:2], centre, ccw)
-                            + 2 * math.pi * int(attrs.get("turns", "0")))
-            where = move["to"]
-            out.append(move)
-    return out
+    return toolpath_ir.read_moves(path)
 
 
 def on_circle(piece, centre, radius, tol):
