@@ -90,12 +90,12 @@ std::vector<KindSpec> makeTable() {
   // Executables.
   add({"workplan", "executable", Sigil::Executable, true, {{"setup", T::Ref}}, "executable"});
   add({"workingstep", "executable", Sigil::Executable, true,
-       {{"feature", T::Ref, true}, {"secplane", T::Length, true}}, "operation moves"});
+       {{"feature", T::Ref, true}, {"secplane", T::Length, true}}, "operation moves motion"});
   add({"program_stop", "executable", Sigil::None, true, {}, {}});
   add({"optional_stop", "executable", Sigil::None, true, {}, {}});
   add({"display_message", "executable", Sigil::None, true, {{"message", T::Text, true}}, {}});
   // A rapid movement is a workingstep of its own (ISO 14649-10), with explicit toolpaths.
-  add({"rapid_movement", "executable", Sigil::Executable, true, {{"secplane", T::Length, true}}, "toolpath moves"});
+  add({"rapid_movement", "executable", Sigil::Executable, true, {{"secplane", T::Length, true}}, "toolpath moves motion"});
 
   // Features (children of their workpiece).
   add({"planar_face", "feature", Sigil::Resource, true,
@@ -300,6 +300,35 @@ std::vector<KindSpec> makeTable() {
         {"turns", T::Count},
         {"feed", T::Feed, true},
         {"role", T::Word, false, roles}},
+       {}});
+
+  // Motion IR: what plan-motion makes of the moves (docs/motion.md). `motion`
+  // holds the segments that follow the moves of its executable; `from` is
+  // where the first starts. Segments are exact plain numbers (shortest round
+  // trip) in mm, s, radians, mm/s, mm/s^2, mm/s^3, except `feed` (mm/min).
+  // `move` and `next` count the program's moves from 0 in program order.
+  add({"motion", "motion", Sigil::None, false,
+       {{"machine", T::Text, true},
+        {"tolerance", T::Length, true},
+        {"time", T::Time, true},
+        {"from", T::Reals, true}},
+       "motion_segment"});
+  add({"motion_segment", "motion_segment", Sigil::None, false,
+       {{"shape", T::Word, true, "line arc blend"},
+        {"to", T::Reals, true},
+        {"center", T::Reals},
+        {"dir", T::Word, false, "cw ccw"},
+        {"sweep", T::Real},
+        {"points", T::Reals},
+        {"length", T::Real, true},
+        {"feed", T::Real},
+        {"move", T::Count, true},
+        {"next", T::Count},
+        {"stop", T::Word, false, "start reversal tiny program"},
+        {"limited_by", T::Word, true, "feed machine_feed axis_velocity acceleration jerk"},
+        {"limits", T::Reals, true},
+        {"v0", T::Real, true},
+        {"phases", T::Reals, true}},
        {}});
   return t;
 }

@@ -22,6 +22,8 @@ const char *valueTypeName(ValueType t) {
   case ValueType::Ref: return "reference";
   case ValueType::Point: return "point";
   case ValueType::Direction: return "direction";
+  case ValueType::Real: return "number";
+  case ValueType::Reals: return "number list";
   }
   return "value";
 }
@@ -62,6 +64,13 @@ Value Value::ref(std::string symbol) {
   out.text = std::move(symbol);
   return out;
 }
+Value Value::reals(std::vector<double> v) {
+  Value out;
+  out.type = ValueType::Reals;
+  out.numbers = std::move(v);
+  return out;
+}
+
 Value Value::point(const Vec3 &p) {
   Value out;
   out.type = ValueType::Point;
@@ -121,7 +130,8 @@ std::optional<double> Node::number(std::string_view name) const {
   case ValueType::Feed:
   case ValueType::Spindle:
   case ValueType::Time:
-  case ValueType::Ratio: return v->number;
+  case ValueType::Ratio:
+  case ValueType::Real: return v->number;
   case ValueType::Count: return static_cast<double>(v->count);
   default: return std::nullopt;
   }

@@ -41,6 +41,8 @@ enum class ValueType : uint8_t {
   Ref,        ///< a symbol: %resource or @executable
   Point,      ///< (x,y,z) mm
   Direction,  ///< (x,y,z) unit vector
+  Real,       ///< a plain number written exactly (shortest round trip); planned motion
+  Reals,      ///< (a,b,...) plain numbers written exactly
 };
 
 const char *valueTypeName(ValueType t);
@@ -52,6 +54,7 @@ struct Value {
   bool flag = false;   ///< Flag
   std::string text;    ///< Word, Text, Ref (with its sigil)
   Vec3 vec = Vec3::Zero();  ///< Point, Direction
+  std::vector<double> numbers;  ///< Reals
 
   static Value length(double mm) { return makeNumber(ValueType::Length, mm); }
   static Value angle(double deg) { return makeNumber(ValueType::Angle, deg); }
@@ -66,6 +69,8 @@ struct Value {
   static Value ref(std::string symbol);
   static Value point(const Vec3 &p);
   static Value direction(const Vec3 &d);
+  static Value real(double v) { return makeNumber(ValueType::Real, v); }
+  static Value reals(std::vector<double> v);
 
   bool operator==(const Value &o) const;
 

@@ -107,6 +107,28 @@ bool parseToken(std::string_view tok, const AttrSpec &a, Value &out) {
   case ValueType::Text: return false;
   case ValueType::Point:
   case ValueType::Direction: return parseVector(tok, a.type, out);
+  case ValueType::Real:
+    out = Value::real(0);
+    return parseDouble(tok, out.number);
+  case ValueType::Reals: {
+    out = Value::reals({});
+    if (tok.size() < 2 || tok.front() != '(' || tok.back() != ')')
+      return false;
+    std::string_view rest = tok.substr(1, tok.size() - 2);
+    while (!rest.empty()) {
+      const size_t comma = rest.find(',');
+      double x = 0;
+      if (!parseDouble(rest.substr(0, comma), x))
+        return false;
+      out.numbers.push_back(x);
+      if (comma == std::string_view::npos)
+        break;
+      rest.remove_prefix(comma + 1);
+      if (rest.empty())
+        return false;
+    }
+    return true;
+  }
   }
   return false;
 }

@@ -126,6 +126,16 @@ void printValue(const Value &v, std::string &out) {
   case ValueType::Text: appendQuoted(v.text, out); break;
   case ValueType::Point:
   case ValueType::Direction: appendVector(v.vec, v.type, out); break;
+  case ValueType::Real: out += formatExact(v.number); break;
+  case ValueType::Reals:
+    out += '(';
+    for (size_t i = 0; i < v.numbers.size(); ++i) {
+      if (i > 0)
+        out += ',';
+      out += formatExact(v.numbers[i]);
+    }
+    out += ')';
+    break;
   }
 }
 
@@ -144,6 +154,8 @@ std::string describeValue(const AttrSpec &a) {
   case ValueType::Ref: return "a reference (%name or @name)";
   case ValueType::Point: return "a point (x,y,z)mm";
   case ValueType::Direction: return "a direction (x,y,z)";
+  case ValueType::Real: return "a number";
+  case ValueType::Reals: return "a list of numbers (a,b,...)";
   }
   return "a value";
 }

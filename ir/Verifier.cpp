@@ -56,7 +56,7 @@ bool isDimension(std::string_view name) {
 
 bool isNumber(ValueType t) {
   return t == ValueType::Length || t == ValueType::Angle || t == ValueType::Feed || t == ValueType::Spindle ||
-         t == ValueType::Time || t == ValueType::Ratio;
+         t == ValueType::Time || t == ValueType::Ratio || t == ValueType::Real;
 }
 
 std::string quoted(std::string_view s) {
@@ -246,6 +246,9 @@ void Verifier::checkValue(const Node &n, const Attr &a) {
     report(n, attr() + " must be a finite number, found " + formatShortest(v.number));
   else if (v.type == ValueType::Length && isDimension(a.name) && (isRadius(a.name) ? v.number < 0 : v.number <= 0))
     report(n, attr() + (isRadius(a.name) ? " must not be negative" : " must be positive") + ", found " + printed(v));
+  else if (v.type == ValueType::Reals &&
+           !std::all_of(v.numbers.begin(), v.numbers.end(), [](double x) { return std::isfinite(x); }))
+    report(n, attr() + " must hold finite numbers");
   else if (v.type == ValueType::Point && !v.vec.allFinite())
     report(n, attr() + " must have finite coordinates");
   else if (v.type == ValueType::Direction && !(std::abs(v.vec.norm() - 1) <= kUnitTolerance))

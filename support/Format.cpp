@@ -13,6 +13,14 @@ std::string formatShortest(double value) {
   return std::string(buf, r.ptr);
 }
 
+std::string formatExact(double value) {
+  if (value == 0.0)
+    value = 0.0;  // folds -0
+  char buf[400];
+  auto r = std::to_chars(buf, buf + sizeof buf, value, std::chars_format::fixed);
+  return std::string(buf, r.ptr);
+}
+
 std::string formatFixed(double value, int decimals) {
   char buf[400];
   auto r = std::to_chars(buf, buf + sizeof buf, value, std::chars_format::fixed, decimals);

@@ -12,6 +12,11 @@ namespace stepnc {
 /// may use exponent notation ("1e-05"). `-0` prints as "0".
 std::string formatShortest(double value);
 
+/// Shortest fixed-point text that reads back as the same double: no exponent,
+/// `-0` prints as "0". For values that must survive a text round trip
+/// exactly (planned motion).
+std::string formatExact(double value);
+
 /// Fixed-point with exactly `decimals` digits after the point; `-0.000` prints
 /// as "0.000". Non-finite values print as "nan"/"inf" (callers reject them first).
 std::string formatFixed(double value, int decimals);
