@@ -195,3 +195,36 @@ std::optional<Machine> readMachine(const SourceFile &file, DiagnosticEngine &dia
 }
 
 } // namespace stepnc::runtime
+
+namespace stepnc::runtime {
+
+// Generated from machines/*.toml at build time (runtime/CMakeLists.txt).
+extern const std::vector<std::pair<std::string, std::string>> kShippedMachines;
+
+std::vector<std::string> shippedMachineNames() {
+  std::vector<std::string> names;
+  for (const auto &[name, text] : kShippedMachines)
+    names.push_back(name);
+  return names;
+}
+
+std::optional<Machine> loadMachine(const std::string &spec, std::unique_ptr<SourceFile> &file,
+                                   DiagnosticEngine &diags) {
+  for (const auto &[name, text] : kShippedMachines)
+    if (name == spec) {
+      file = SourceFile::fromString("machines/" + name + ".toml", text);
+      return readMachine(*file, diags);
+    }
+  std::string error;
+  file = SourceFile::open(spec, error);
+  if (!file) {
+    std::string names;
+    for (const auto &[name, text] : kShippedMachines)
+      names += (names.empty() ? "" : ", ") + name;
+    diags.error({}, "cannot read the machine '" + spec + "': " + error + " (shipped machines: " + names + ")");
+    return std::nullopt;
+  }
+  return readMachine(*file, diags);
+}
+
+} // namespace stepnc::runtime

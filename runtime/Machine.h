@@ -12,6 +12,7 @@
 #include "support/Diagnostics.h"
 #include "support/SourceFile.h"
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -47,5 +48,14 @@ struct Machine {
 /// (unknown keys, missing or out-of-range values, TOML syntax) at its place
 /// in the file; returns nullopt when there was one.
 std::optional<Machine> readMachine(const SourceFile &file, DiagnosticEngine &diags);
+
+/// The machines shipped in machines/ (built into stepnc), by file stem:
+/// "hsc-3axis", "conventional-3axis".
+std::vector<std::string> shippedMachineNames();
+
+/// A machine named on a command line: a file, else a shipped machine's
+/// name. `file` keeps the text diagnostics point into.
+std::optional<Machine> loadMachine(const std::string &spec, std::unique_ptr<SourceFile> &file,
+                                   DiagnosticEngine &diags);
 
 } // namespace stepnc::runtime

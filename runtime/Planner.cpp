@@ -1,0 +1,307 @@
+#include "runtime/Planner.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace stepnc::runtime {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// How an axis's budget is shared on a curved segment (REFERENCES: v <=
+// sqrt(a rho), (j rho^2)^(1/3)). At the speed cap the curvature may take
+// kCurveAccel of an axis's acceleration and kCurveJerk of its jerk; the
+// coupling term 3 v a r2 at most kCouplingJerk. What is left is the path's
+// own acceleration and jerk, so that speed can still change on the segment.
+constexpr double kCurveAccel = 0.8;
+constexpr double kCurveJerk = 0.6;
+constexpr double kCouplingJerk = 0.2;
+
+/// Turning more than this (radians) is a reversal: the tool stops.
+constexpr double kReversal = 179.0 * 3.14159265358979323846 / 180.0;
+/// Blends shorter than this (mm on each side) are not made; the tool stops.
+constexpr double kTinyBlend = 1e-6;
+/// Share of the tolerance blends use; sampled deviations may miss a little.
+constexpr double kToleranceShare = 0.9;
+
+struct Piece {
+  Segment seg;
+  double feed = 0;  ///< mm/s; 0 for rapids
+  uint32_t move = 0;
+  bool stopBefore = false;
+  double cutStart = 0, cutEnd = 0;  ///< mm taken by blends at either end
+};
+
+/// Distance from p to the part [s0, s1] of a line or arc; for helices an
+/// upper bound (a point of the helix at p's angle).
+double distanceTo(const Segment &seg, double s0, double s1, const Vec3 &p) {
+  if (seg.kind == SegmentKind::Line) {
+    const PathPoint a = seg.at(s0);
+    const double s = std::clamp((p - a.p).dot(a.r1), 0.0, s1 - s0);
+    return (a.p + a.r1 * s - p).norm();
+  }
+  // Arc: the angle of p about the axis, taken into the swept range.
+  const double rise = seg.sweep > 0 ? (seg.end.z() - seg.start.z()) / seg.sweep : 0;
+  const double k = std::sqrt(seg.radius * seg.radius + rise * rise);
+  const double sigma = seg.ccw ? 1 : -1;
+  double theta = sigma * (std::atan2(p.y() - seg.center.y(), p.x() - seg.center.x()) - seg.startAngle);
+  const double turn = 2 * 3.14159265358979323846;
+  const double t0 = s0 / k, t1 = s1 / k;
+  theta = t0 + std::fmod(std::fmod(theta - t0, turn) + turn, turn);  // the first at or after t0
+  double best = std::min((seg.at(s0).p - p).norm(), (seg.at(s1).p - p).norm());
+  for (double t = theta; t <= t1; t += turn)
+    best = std::min(best, (seg.at(t * k).p - p).norm());
+  return best;
+}
+
+/// A quintic joining a's point at s = a.length - la to b's at lb, matching
+/// tangent and curvature at both ends (quintic Hermite, end derivatives
+/// scaled by the chord).
+std::array<Vec3, 6> blendPoints(const Segment &a, double la, const Segment &b, double lb) {
+  const PathPoint p0 = a.at(a.length - la), p1 = b.at(lb);
+  const double m = (p1.p - p0.p).norm();
+  std::array<Vec3, 6> c;
+  c[0] = p0.p;
+  c[5] = p1.p;
+  c[1] = c[0] + p0.r1 * (m / 5);
+  c[2] = 2 * c[1] - c[0] + p0.r2 * (m * m / 20);
+  c[4] = c[5] - p1.r1 * (m / 5);
+  c[3] = 2 * c[4] - c[5] + p1.r2 * (m * m / 20);
+  return c;
+}
+
+/// How far a blend strays from the two pieces it replaces (sampled along
+/// its parameter: no arc-length inversion needed to find the worst point).
+double blendDeviation(const std::array<Vec3, 6> &ctrl, const Segment &a, double la, const Segment &b, double lb) {
+  constexpr int kSamples = 24;
+  const QuinticCurve curve(ctrl);
+  double worst = 0;
+  for (int i = 1; i < kSamples; ++i) {
+    const Vec3 p = curve.point(double(i) / kSamples);
+    worst = std::max(worst, std::min(distanceTo(a, a.length - la, a.length, p), distanceTo(b, 0, lb, p)));
+  }
+  return worst;
+}
+
+struct Junction {
+  bool stop = false;
+  StopReason reason = StopReason::None;
+  bool blended = false;
+  Segment blend;
+};
+
+/// Decides how pieces a and b meet: smoothly, through a blend, or at rest.
+Junction join(Piece &a, Piece &b, double tolerance) {
+  Junction j;
+  if (b.stopBefore) {
+    j.stop = true;
+    j.reason = StopReason::Program;
+    return j;
+  }
+  const PathPoint ea = a.seg.at(a.seg.length), sb = b.seg.at(0);
+  const double cosTurn = std::clamp(ea.r1.dot(sb.r1), -1.0, 1.0);
+  const double turn = std::acos(cosTurn);
+  const double scale = 1 / std::max(1e-3, std::max(ea.r2.norm(), sb.r2.norm()));  // a length of the curves
+  if (turn < 1e-9 && (ea.r2 - sb.r2).norm() * scale < 1e-9)
+    return j;  // tangent and curvature already agree
+  if (turn > kReversal) {
+    j.stop = true;
+    j.reason = StopReason::Reversal;
+    return j;
+  }
+  // Cut back as far as the tolerance allows, at most half of each piece
+  // (the other half belongs to the blend at its other end).
+  const double target = tolerance * kToleranceShare;
+  double l = std::min(a.seg.length / 2, b.seg.length / 2);
+  const bool linear = a.seg.kind == SegmentKind::Line && b.seg.kind == SegmentKind::Line;
+  if (linear) {
+    // Between two lines the blend is symmetric about the corner's bisector
+    // and the same shape at every size: its deviation is its middle's
+    // distance from the lines, proportional to l.
+    const QuinticCurve curve(blendPoints(a.seg, l, b.seg, l));
+    const Vec3 mid = curve.point(0.5), dir = a.seg.at(0).r1;
+    const Vec3 off = mid - a.seg.end;
+    const double dev = (off - dir * off.dot(dir)).norm();
+    if (dev > target)
+      l *= target / dev;
+    if (l >= kTinyBlend) {
+      j.blended = true;
+      j.blend = Segment::blend(blendPoints(a.seg, l, b.seg, l));
+      a.cutEnd = l;
+      b.cutStart = l;
+      return j;
+    }
+  }
+  double lastL = 0, lastDev = 0;
+  for (int it = 0; it < 40 && l >= kTinyBlend; ++it) {
+    const std::array<Vec3, 6> ctrl = blendPoints(a.seg, l, b.seg, l);
+    const double dev = blendDeviation(ctrl, a.seg, l, b.seg, l);
+    if (dev <= target) {
+      j.blended = true;
+      j.blend = Segment::blend(ctrl);
+      a.cutEnd = l;
+      b.cutStart = l;
+      return j;
+    }
+    // The deviation grows like l^p near the junction, p between 1 (a
+    // corner) and 3 (a curvature step): estimated from the last two tries,
+    // 2 until there are two.
+    double p = 2;
+    if (lastL > 0 && lastDev > 0 && dev > 0 && lastL != l)
+      p = std::clamp(std::log(dev / lastDev) / std::log(l / lastL), 1.0, 4.0);
+    lastL = l;
+    lastDev = dev;
+    l *= std::clamp(std::pow(0.97 * target / dev, 1 / p), 0.02, 0.95);
+  }
+  j.stop = true;
+  j.reason = StopReason::Tiny;
+  return j;
+}
+
+/// The speed cap and the path acceleration and jerk for one segment.
+void limitsFor(const Segment &seg, double feed, const Machine &machine, SegmentInfo &info) {
+  const AxisDemand d = seg.demand();
+  double v = kInf;
+  SpeedLimit by = SpeedLimit::Feed;
+  auto cap = [&](double value, SpeedLimit why) {
+    if (value < v) {
+      v = value;
+      by = why;
+    }
+  };
+  if (feed > 0) {
+    cap(feed, SpeedLimit::Feed);
+    if (machine.maxFeed)
+      cap(*machine.maxFeed / 60, SpeedLimit::MachineFeed);
+  }
+  const size_t n = std::min<size_t>(3, machine.axes.size());
+  for (size_t k = 0; k < n; ++k) {
+    const Axis &ax = machine.axes[k];
+    if (d.r1[k] > 0)
+      cap(ax.velocity / 60 / d.r1[k], SpeedLimit::AxisVelocity);
+    if (d.r2[k] > 0)
+      cap(std::sqrt(kCurveAccel * ax.acceleration / d.r2[k]), SpeedLimit::Acceleration);
+    if (d.r3[k] > 0)
+      cap(std::cbrt(kCurveJerk * ax.jerk / d.r3[k]), SpeedLimit::Jerk);
+  }
+  double a = kInf, jerk = kInf;
+  for (size_t k = 0; k < n; ++k) {
+    const Axis &ax = machine.axes[k];
+    if (d.r1[k] <= 0)
+      continue;
+    double ak = (ax.acceleration - v * v * d.r2[k]) / d.r1[k];
+    if (d.r2[k] > 0 && v > 0)
+      ak = std::min(ak, kCouplingJerk * ax.jerk / (3 * v * d.r2[k]));
+    a = std::min(a, ak);
+  }
+  for (size_t k = 0; k < n; ++k) {
+    const Axis &ax = machine.axes[k];
+    if (d.r1[k] > 0)
+      jerk = std::min(jerk, (ax.jerk - v * v * v * d.r3[k] - 3 * v * a * d.r2[k]) / d.r1[k]);
+  }
+  info.limits = {v, a, jerk};
+  info.limitedBy = by;
+}
+
+} // namespace
+
+Trajectory plan(const PathInput &input, const Machine &machine, const PlanOptions &options) {
+  const double tolerance = options.tolerance > 0 ? options.tolerance : machine.pathTolerance;
+  Trajectory out;
+  out.machine = machine.name;
+  out.tolerance = tolerance;
+  out.cycleTime = machine.cycleTime;
+  out.start = input.start;
+
+  // 1. One piece per move with any length.
+  std::vector<Piece> pieces;
+  pieces.reserve(input.moves.size());
+  Vec3 at = input.start;
+  bool pendingStop = false;
+  for (size_t i = 0; i < input.moves.size(); ++i) {
+    const PathMove &m = input.moves[i];
+    pendingStop = pendingStop || m.stopBefore;
+    Piece p;
+    p.seg = m.kind == PathMove::Kind::Line ? Segment::line(at, m.to)
+                                           : Segment::arcTurns(at, m.to, m.center, m.ccw, m.turns);
+    if (!(p.seg.length > 1e-9)) {
+      at = m.to;
+      continue;
+    }
+    p.feed = m.feed > 0 ? m.feed / 60 : 0;
+    p.move = uint32_t(i);
+    p.stopBefore = pendingStop;
+    pendingStop = false;
+    pieces.push_back(std::move(p));
+    at = m.to;
+  }
+
+  // 2. Junctions: blends or stops.
+  std::vector<Junction> joins(pieces.size());
+  for (size_t i = 1; i < pieces.size(); ++i)
+    joins[i] = join(pieces[i - 1], pieces[i], tolerance);
+
+  // 3. Segments with their caps; `atRest[k]`: segment k starts at rest.
+  std::vector<char> atRest;
+  auto push = [&](Segment seg, double feed, uint32_t move, uint32_t next, StopReason stop) {
+    SegmentInfo info;
+    info.feed = feed;
+    info.move = move;
+    info.nextMove = next;
+    info.stop = stop;
+    limitsFor(seg, feed, machine, info);
+    out.segments.push_back(std::move(seg));
+    out.info.push_back(info);
+    atRest.push_back(stop != StopReason::None);
+  };
+  out.segments.reserve(pieces.size() * 2);
+  out.info.reserve(pieces.size() * 2);
+  StopReason stop = StopReason::Start;
+  for (size_t i = 0; i < pieces.size(); ++i) {
+    const Piece &p = pieces[i];
+    if (i > 0) {
+      const Junction &jn = joins[i];
+      if (jn.stop)
+        stop = jn.reason;
+      if (jn.blended) {
+        const Piece &prev = pieces[i - 1];
+        double feed = 0;  // the slower of the two; a rapid takes the feed of the other
+        if (prev.feed > 0 && p.feed > 0)
+          feed = std::min(prev.feed, p.feed);
+        else
+          feed = std::max(prev.feed, p.feed);
+        push(jn.blend, feed, prev.move, p.move, stop);
+        stop = StopReason::None;
+      }
+    }
+    const double s0 = p.cutStart, s1 = p.seg.length - p.cutEnd;
+    if (s1 - s0 > 1e-9) {
+      push(p.seg.part(s0, s1), p.feed, p.move, p.move, stop);
+      stop = StopReason::None;
+    }
+  }
+
+  // 4. Junction speeds: caps, then backward and forward look-ahead.
+  const size_t n = out.segments.size();
+  std::vector<double> vj(n + 1, 0.0);
+  for (size_t k = 1; k < n; ++k)
+    vj[k] = atRest[k] ? 0 : std::min(out.info[k - 1].limits.v, out.info[k].limits.v);
+  for (size_t k = n; k-- > 0;) {
+    const PathLimits &lim = out.info[k].limits;
+    vj[k] = std::min(vj[k], reachableSpeed(vj[k + 1], out.segments[k].length, lim.a, lim.j));
+  }
+  for (size_t k = 0; k < n; ++k) {
+    const PathLimits &lim = out.info[k].limits;
+    vj[k + 1] = std::min(vj[k + 1], reachableSpeed(vj[k], out.segments[k].length, lim.a, lim.j));
+  }
+
+  // 5. Profiles.
+  out.profiles.reserve(n);
+  for (size_t k = 0; k < n; ++k)
+    out.profiles.push_back(planProfile(vj[k], vj[k + 1], out.segments[k].length, out.info[k].limits));
+  return out;
+}
+
+} // namespace stepnc::runtime

@@ -1,0 +1,53 @@
+// The motion planner: programmed moves (lines, arcs, helices; rapids and
+// feeds) become a trajectory the machine can follow within every axis limit.
+//
+//  1. Geometry. Each move becomes a segment. Where two segments meet with a
+//     change of direction or of curvature, both are cut back and joined by a
+//     quintic blend that matches position, tangent and curvature at each end
+//     and stays within the path tolerance; where the path turns back on
+//     itself the tool stops instead.
+//  2. Speed caps. Each segment gets the highest speed, and the path
+//     acceleration and jerk, that keep every axis within its limits given
+//     the segment's direction, curvature and change of curvature, and never
+//     above the programmed feed.
+//  3. Look-ahead. A backward then a forward pass over the whole path bound
+//     the speed at each junction by what the neighbouring segments can reach
+//     with jerk-limited speed changes (closed forms, Profile.h).
+//  4. Profiles. Each segment gets its fastest seven-phase profile between its
+//     junction speeds, with zero acceleration at both ends.
+#pragma once
+
+#include "runtime/Machine.h"
+#include "runtime/Trajectory.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace stepnc::runtime {
+
+struct PathMove {
+  enum class Kind : uint8_t { Line, Arc } kind = Kind::Line;
+  Vec3 to = Vec3::Zero();
+  Vec3 center = Vec3::Zero();  ///< arcs: the axis parallel to z through it
+  bool ccw = true;
+  int64_t turns = 0;           ///< arcs: whole turns before the last arc to `to`
+  double feed = 0;             ///< mm/min; 0 = rapid (the axes' speed)
+  bool stopBefore = false;     ///< the tool is at rest before this move
+};
+
+struct PathInput {
+  Vec3 start = Vec3::Zero();  ///< where the tool is, at rest
+  std::vector<PathMove> moves;
+};
+
+struct PlanOptions {
+  /// mm; blends stay this close to the programmed path (default: the
+  /// machine's path tolerance).
+  double tolerance = 0;
+};
+
+/// Plans the moves on the machine. Moves of zero length are skipped; the
+/// trajectory ends at rest at the last move's end.
+Trajectory plan(const PathInput &input, const Machine &machine, const PlanOptions &options = {});
+
+} // namespace stepnc::runtime

@@ -1,0 +1,572 @@
+// The reference player (Player.h): samples a trajectory at the controller
+// cycle, evaluates every axis analytically, and checks it against the
+// machine, the programmed feed and, when given, the programmed path.
+//
+// Choices the figures depend on:
+//  - Samples fall at t = kT while kT < D - 1e-9 T, then one more exactly at
+//    the end D: floor(D/T) + 2 samples, or floor(D/T) + 1 when D is a whole
+//    number of periods (the last regular sample would be the end itself).
+//    Sample times are k T, not a running sum, so they do not drift; segment
+//    start times are a running sum of profile durations in segment order,
+//    the same sum as D, so the last segment ends exactly at D.
+//  - The lowest feed ratio and the slowest places are taken "between stops":
+//    a sample does not count while its segment speeds up from rest (the
+//    rising phases of a segment that starts with a stop: the first segment
+//    or one whose SegmentInfo::stop is set) or slows down to rest (the
+//    falling phases of the last segment or of one followed by a stop). A
+//    speed-up or slow-down that a short stop-adjacent segment hands on to
+//    its neighbour still counts on the neighbour. Slow time counts every
+//    sample, stops included.
+//  - Slow time weighs each sample by the interval to the next sample.
+//  - Slowest places are feed segments whose lowest counted speed is below
+//    slowFraction of their feed; segments at full feed are not listed.
+//  - Deviation is measured from the programmed moves themselves (arcs about
+//    the centre as programmed), not from the planner's segments, so that a
+//    planner that misreads a move is caught.
+#include "runtime/Player.h"
+
+#include "support/Format.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+namespace stepnc::runtime {
+
+namespace {
+
+constexpr double kTwoPi = 2 * std::numbers::pi;
+/// Relative slack on every limit: the planner may use a limit exactly, and
+/// the derivatives carry rounding.
+constexpr double kSlack = 1e-6;
+constexpr double kEndPositionTol = 1e-9;       // mm, against the last segment's end
+constexpr double kProgrammedEndTol = 1e-6;     // mm, against the last programmed point
+constexpr double kEndSpeedTol = 1e-9;          // mm/s
+constexpr double kEndAccelerationTol = 1e-6;   // mm/s^2
+/// In the plane, an arc's end this close to its start closes a full turn.
+constexpr double kSamePointInPlane = 1e-9;     // mm
+
+/// A programmed move, prepared for distance queries.
+struct Programmed {
+  bool arc = false;
+  Vec3 from = Vec3::Zero();
+  Vec3 to = Vec3::Zero();
+  // Arcs and helices: the axis through (cx, cy), the start angle, the swept
+  // angle (> 0) and its sense (+1 counter-clockwise), the radius at the
+  // start and its change over the sweep.
+  double cx = 0, cy = 0;
+  double radius = 0, radiusChange = 0;
+  double startAngle = 0;
+  double sweep = 0;
+  double dir = 1;
+};
+
+/// The angle brought into [0, 2 pi).
+double wrap(double angle) {
+  angle = std::fmod(angle, kTwoPi);
+  if (angle < 0)
+    angle += kTwoPi;
+  if (angle >= kTwoPi)  // -tiny + 2 pi rounds to 2 pi
+    angle = 0;
+  return angle;
+}
+
+Programmed prepare(const Vec3 &from, const PathMove &move) {
+  Programmed m;
+  m.from = from;
+  m.to = move.to;
+  if (move.kind != PathMove::Kind::Arc)
+    return m;
+  m.arc = true;
+  m.dir = move.ccw ? 1 : -1;
+  // About the programmed centre as given, not the planner's centre moved
+  // onto the bisector: the check is meant to be independent of the planner.
+  // Where rounding makes the start and end radius differ, the radius changes
+  // in proportion to the angle (a spiral, as controllers run such arcs); the
+  // difference is the rounding, far below any path tolerance.
+  m.cx = move.center.x();
+  m.cy = move.center.y();
+  const double fx = from.x() - m.cx, fy = from.y() - m.cy;
+  const double tx = move.to.x() - m.cx, ty = move.to.y() - m.cy;
+  m.radius = std::hypot(fx, fy);
+  m.radiusChange = std::hypot(tx, ty) - m.radius;
+  m.startAngle = std::atan2(fy, fx);
+  double last = kTwoPi;  // over the start in the plane: the last arc is a whole turn
+  if (std::hypot(tx - fx, ty - fy) > kSamePointInPlane) {
+    last = wrap(m.dir * (std::atan2(ty, tx) - m.startAngle));
+    if (last == 0)
+      last = kTwoPi;
+  }
+  m.sweep = last + kTwoPi * static_cast<double>(std::max<int64_t>(move.turns, 0));
+  return m;
+}
+
+double distanceToLine(const Vec3 &from, const Vec3 &to, const Vec3 &q) {
+  const Vec3 d = to - from;
+  const double ll = d.squaredNorm();
+  if (ll == 0)
+    return (q - from).norm();
+  const double u = std::clamp((q - from).dot(d) / ll, 0.0, 1.0);
+  return (q - (from + u * d)).norm();
+}
+
+/// Distance from q to the move: exact for lines and plane arcs; for helices
+/// (and spirals) the distance to the curve's point at q's own angle on the
+/// nearest turns, an upper bound that is close while q is near the curve.
+double distanceTo(const Programmed &m, const Vec3 &q) {
+  if (!m.arc)
+    return distanceToLine(m.from, m.to, q);
+  double best = std::min((q - m.from).norm(), (q - m.to).norm());
+  const double qx = q.x() - m.cx, qy = q.y() - m.cy;
+  const double rho = std::hypot(qx, qy);
+  // At q's angle the curve lies straight out from q's foot on the axis, so
+  // the distance is hypot(rho - r, dz): no sin or cos.
+  const double delta = wrap(m.dir * (std::atan2(qy, qx) - m.startAngle));
+  if (delta > m.sweep)
+    return best;
+  const double z0 = m.from.z(), dz = m.to.z() - m.from.z();
+  auto consider = [&](double theta) {
+    const double f = theta / m.sweep;
+    best = std::min(best, std::hypot(rho - (m.radius + m.radiusChange * f), q.z() - (z0 + dz * f)));
+  };
+  // Candidate angles delta + 2 pi k, k = 0 .. maxTurn: the turn nearest q in
+  // z (helices) or in radius (plane spirals), and its neighbours; on a plane
+  // arc every turn passes the same point.
+  const double maxTurn = std::floor((m.sweep - delta) / kTwoPi);
+  double k = 0;
+  if (dz != 0)
+    k = std::round(((q.z() - z0) / dz * m.sweep - delta) / kTwoPi);
+  else if (m.radiusChange != 0)
+    k = std::round(((rho - m.radius) / m.radiusChange * m.sweep - delta) / kTwoPi);
+  k = std::clamp(k, 0.0, maxTurn);
+  for (double kk : {k - 1, k, k + 1})
+    if (kk >= 0 && kk <= maxTurn)
+      consider(delta + kk * kTwoPi);
+  return best;
+}
+
+struct SlowCandidate {
+  SlowSpot spot;
+  double ratio = 0;
+};
+
+} // namespace
+
+std::string_view violationKindName(ViolationKind kind) {
+  switch (kind) {
+  case ViolationKind::Velocity:
+    return "velocity";
+  case ViolationKind::Acceleration:
+    return "acceleration";
+  case ViolationKind::Jerk:
+    return "jerk";
+  case ViolationKind::Feed:
+    return "feed";
+  case ViolationKind::Deviation:
+    return "deviation";
+  case ViolationKind::EndState:
+    return "end state";
+  }
+  return "?";
+}
+
+SimReport simulate(const Trajectory &trajectory, const Machine &machine, const SimOptions &options,
+                   const std::function<void(const Sample &)> &onSample) {
+  SimReport r;
+  const size_t n =
+      std::min({trajectory.segments.size(), trajectory.profiles.size(), trajectory.info.size()});
+  double period = options.period > 0 ? options.period : machine.cycleTime;
+  if (!(period > 0))
+    period = trajectory.cycleTime;
+  r.period = period;
+  r.slowFraction = options.slowFraction;
+
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  Vec3 vMax(kInf, kInf, kInf), aMax(kInf, kInf, kInf), jMax(kInf, kInf, kInf);
+  for (size_t k = 0; k < 3 && k < machine.axes.size(); ++k) {
+    vMax[k] = machine.axes[k].velocity / 60;
+    aMax[k] = machine.axes[k].acceleration;
+    jMax[k] = machine.axes[k].jerk;
+  }
+  const Vec3 vAllowed = vMax * (1 + kSlack), aAllowed = aMax * (1 + kSlack), jAllowed = jMax * (1 + kSlack);
+
+  // Times and distances come from the profiles, not from the samples.
+  std::vector<double> durations(n);
+  double duration = 0, programmedFeedTime = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const double d = trajectory.profiles[i].duration();
+    durations[i] = d;
+    duration += d;
+    const double feed = trajectory.info[i].feed;
+    if (feed > 0) {
+      r.feedTime += d;
+      r.feedDistance += trajectory.segments[i].length;
+      programmedFeedTime += feed * d;
+    } else {
+      r.rapidTime += d;
+      r.rapidDistance += trajectory.segments[i].length;
+    }
+  }
+  r.duration = duration;
+  if (r.feedTime > 0) {
+    r.meanFeed = r.feedDistance / r.feedTime;
+    r.meanProgrammedFeed = programmedFeedTime / r.feedTime;
+  }
+
+  std::vector<Programmed> programmed;
+  if (options.programmed) {
+    programmed.reserve(options.programmed->moves.size());
+    Vec3 at = options.programmed->start;
+    for (const PathMove &move : options.programmed->moves) {
+      programmed.push_back(prepare(at, move));
+      at = move.to;
+    }
+    r.deviationChecked = true;
+    r.tolerance = options.tolerance > 0 ? options.tolerance : trajectory.tolerance;
+  }
+  const double deviationAllowed = r.tolerance * (1 + kSlack) + 1e-9;
+
+  auto violate = [&](ViolationKind kind, int axis, double t, uint32_t segment, double value, double limit) {
+    ++r.violationCount;
+    if (r.violations.size() < options.maxViolations)
+      r.violations.push_back({kind, axis, t, segment, value, limit});
+  };
+
+  // The segment under the samples, and what is known of it.
+  size_t seg = 0;
+  double segStart = 0;
+  struct Current {
+    double feed = 0, slowSpeed = 0, riseEnd = 0, fallStart = 0;
+    bool capped = false, isShort = false;
+    bool seen = false;  ///< some sample counted towards the lowest ratio
+    double minRatio = 0;
+    double minSpeed = 0;
+    SlowReason minReason = SlowReason::Ramp;
+  } cur;
+  std::vector<SlowCandidate> candidates;
+  auto enter = [&](size_t i) {
+    const SegmentInfo &info = trajectory.info[i];
+    const Profile &profile = trajectory.profiles[i];
+    cur = Current{};
+    cur.feed = info.feed;
+    if (cur.feed <= 0)
+      return;
+    cur.slowSpeed = options.slowFraction * cur.feed;
+    cur.capped = info.limits.v < cur.slowSpeed;
+    cur.isShort = profile.peak() < info.limits.v * (1 - 1e-9);
+    // Phases 0-2 rise, 3 cruises, 4-6 fall (Profile.h).
+    const bool fromRest = i == 0 || info.stop != StopReason::None;
+    const bool toRest = i + 1 == n || trajectory.info[i + 1].stop != StopReason::None;
+    if (fromRest)
+      cur.riseEnd = profile.phases[0].duration + profile.phases[1].duration + profile.phases[2].duration;
+    cur.fallStart = kInf;
+    if (toRest)
+      cur.fallStart =
+          durations[i] - (profile.phases[4].duration + profile.phases[5].duration + profile.phases[6].duration);
+  };
+  auto leave = [&](size_t i) {
+    if (cur.feed > 0 && cur.seen && cur.minRatio < options.slowFraction) {
+      SlowCandidate c;
+      c.ratio = cur.minRatio;
+      c.spot.move = trajectory.info[i].move;
+      c.spot.segment = static_cast<uint32_t>(i);
+      c.spot.speed = cur.minSpeed;
+      c.spot.feed = cur.feed;
+      c.spot.reason = cur.minReason;
+      c.spot.limitedBy = trajectory.info[i].limitedBy;
+      candidates.push_back(c);
+    }
+  };
+  if (n > 0)
+    enter(0);
+
+  const double lastRegular = duration - 1e-9 * period;
+  Sample s, prev;
+  bool havePrev = false;
+  for (size_t k = 0;; ++k) {
+    double t = static_cast<double>(k) * period;
+    const bool final = !(t < lastRegular);
+    if (final)
+      t = duration;
+    double next = static_cast<double>(k + 1) * period;
+    if (!(next < lastRegular))
+      next = duration;
+    const double weight = final ? 0 : next - t;
+
+    s.t = t;
+    if (n == 0) {
+      s.p = trajectory.start;
+      s.v = s.a = s.j = Vec3::Zero();
+      s.speed = 0;
+    } else {
+      while (seg + 1 < n && (final || t >= segStart + durations[seg])) {
+        leave(seg);
+        segStart += durations[seg];
+        ++seg;
+        enter(seg);
+      }
+      // The end is the last profile's own end, not a difference of sums.
+      const double local = final ? durations[seg] : t - segStart;
+      const PathState ps = trajectory.profiles[seg].at(local);
+      const PathPoint pp = trajectory.segments[seg].at(ps.s);
+      s.segment = static_cast<uint32_t>(seg);
+      s.p = pp.p;
+      s.v = ps.v * pp.r1;
+      s.a = ps.a * pp.r1 + ps.v * ps.v * pp.r2;
+      s.j = ps.j * pp.r1 + 3 * ps.v * ps.a * pp.r2 + ps.v * ps.v * ps.v * pp.r3;
+      s.speed = ps.v;
+
+      const uint32_t sg = s.segment;
+      for (int a = 0; a < 3; ++a) {
+        const double v = std::abs(s.v[a]), acc = std::abs(s.a[a]), j = std::abs(s.j[a]);
+        r.maxVelocity[a] = std::max(r.maxVelocity[a], v);
+        r.maxAcceleration[a] = std::max(r.maxAcceleration[a], acc);
+        r.maxJerk[a] = std::max(r.maxJerk[a], j);
+        if (v > vAllowed[a])
+          violate(ViolationKind::Velocity, a, t, sg, v, vMax[a]);
+        if (acc > aAllowed[a])
+          violate(ViolationKind::Acceleration, a, t, sg, acc, aMax[a]);
+        if (j > jAllowed[a])
+          violate(ViolationKind::Jerk, a, t, sg, j, jMax[a]);
+        if (havePrev) {
+          // A jump between samples: what no bounded jerk (acceleration)
+          // could have done in the interval.
+          const double dt = t - prev.t;
+          const double da = std::abs(s.a[a] - prev.a[a]), dv = std::abs(s.v[a] - prev.v[a]);
+          if (da > jAllowed[a] * dt + 1e-6)
+            violate(ViolationKind::Jerk, a, t, sg, da / dt, jMax[a]);
+          if (dv > aAllowed[a] * dt + 1e-6)
+            violate(ViolationKind::Acceleration, a, t, sg, dv / dt, aMax[a]);
+        }
+      }
+
+      if (cur.feed > 0) {
+        if (s.speed > cur.feed * (1 + 1e-9) + 1e-9)
+          violate(ViolationKind::Feed, -1, t, sg, s.speed, cur.feed);
+        SlowReason reason = SlowReason::Ramp;
+        const bool slow = s.speed < cur.slowSpeed;
+        if (slow) {
+          const SegmentInfo &info = trajectory.info[seg];
+          if (cur.capped) {
+            reason = SlowReason::Cap;
+            r.slowCapTime[static_cast<size_t>(info.limitedBy)] += weight;
+          } else if (cur.isShort) {
+            reason = SlowReason::Short;
+          }
+          r.slowTime[static_cast<size_t>(reason)] += weight;
+        }
+        if (local >= cur.riseEnd && local <= cur.fallStart) {
+          const double ratio = s.speed / cur.feed;
+          r.minFeedRatio = std::min(r.minFeedRatio, ratio);
+          if (!cur.seen || ratio < cur.minRatio) {
+            cur.seen = true;
+            cur.minRatio = ratio;
+            cur.minSpeed = s.speed;
+            cur.minReason = reason;
+          }
+        }
+      }
+
+      if (!programmed.empty()) {
+        const SegmentInfo &info = trajectory.info[seg];
+        double d = kInf;
+        if (info.move < programmed.size())
+          d = distanceTo(programmed[info.move], s.p);
+        if (info.nextMove != info.move && info.nextMove < programmed.size())
+          d = std::min(d, distanceTo(programmed[info.nextMove], s.p));
+        if (d != kInf) {
+          r.maxDeviation = std::max(r.maxDeviation, d);
+          if (d > deviationAllowed)
+            violate(ViolationKind::Deviation, -1, t, sg, d, r.tolerance);
+        }
+      }
+    }
+
+    if (onSample)
+      onSample(s);
+    prev = s;
+    havePrev = true;
+    ++r.samples;
+    if (final)
+      break;
+  }
+  if (n > 0)
+    leave(seg);
+
+  // The end state: the last sample is the end.
+  r.endPosition = s.p;
+  const uint32_t lastSegment = n > 0 ? static_cast<uint32_t>(n - 1) : 0;
+  const Vec3 end = n > 0 ? trajectory.segments[n - 1].end : trajectory.start;
+  const double off = (s.p - end).norm();
+  if (!(off <= kEndPositionTol))
+    violate(ViolationKind::EndState, -1, s.t, lastSegment, off, kEndPositionTol);
+  if (!(std::abs(s.speed) <= kEndSpeedTol) || !(s.a.norm() < kEndAccelerationTol)) {
+    bool named = false;
+    for (int a = 0; a < 3; ++a)
+      if (std::abs(s.v[a]) > kEndSpeedTol || std::abs(s.a[a]) >= kEndAccelerationTol) {
+        violate(ViolationKind::EndState, a, s.t, lastSegment, std::abs(s.v[a]), kEndSpeedTol);
+        named = true;
+      }
+    if (!named) {  // spread over the axes, each within its share: name the fastest
+      int a = 0;
+      s.v.cwiseAbs().maxCoeff(&a);
+      violate(ViolationKind::EndState, a, s.t, lastSegment, std::abs(s.v[a]), kEndSpeedTol);
+    }
+  }
+  if (options.programmed) {
+    const PathInput &in = *options.programmed;
+    const Vec3 target = in.moves.empty() ? in.start : in.moves.back().to;
+    const double miss = (s.p - target).norm();
+    if (!(miss <= kProgrammedEndTol))
+      violate(ViolationKind::EndState, -1, s.t, lastSegment, miss, kProgrammedEndTol);
+  }
+
+  // Slowest first; equal ratios in path order, so the list is deterministic.
+  auto slower = [](const SlowCandidate &x, const SlowCandidate &y) {
+    return x.ratio != y.ratio ? x.ratio < y.ratio : x.spot.segment < y.spot.segment;
+  };
+  const size_t keep = std::min(options.maxSlowSpots, candidates.size());
+  std::partial_sort(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(keep), candidates.end(),
+                    slower);
+  for (size_t i = 0; i < keep; ++i)
+    r.slowest.push_back(candidates[i].spot);
+  return r;
+}
+
+namespace {
+
+std::string seconds(double t) { return formatFixed(t, 3) + " s"; }
+std::string perMinute(double mmPerS) { return formatFixed(mmPerS * 60, 1) + " mm/min"; }
+std::string percent(double fraction) { return formatFixed(fraction * 100, 1) + " %"; }
+
+/// "95", "97.5": a setting as people write it.
+std::string plain(double v) {
+  std::string s = formatFixed(v, 3);
+  while (s.back() == '0')
+    s.pop_back();
+  if (s.back() == '.')
+    s.pop_back();
+  return s;
+}
+
+std::string axisName(const Machine &machine, int axis) {
+  if (axis >= 0 && static_cast<size_t>(axis) < machine.axes.size())
+    return machine.axes[static_cast<size_t>(axis)].name;
+  return std::string(1, "xyz"[std::clamp(axis, 0, 2)]);
+}
+
+std::string reasonText(SlowReason reason, SpeedLimit limitedBy) {
+  switch (reason) {
+  case SlowReason::Ramp:
+    return "speeding up or slowing down";
+  case SlowReason::Short:
+    return "too short to reach its speed";
+  case SlowReason::Cap:
+    break;
+  }
+  return "capped by " + std::string(speedLimitDescription(limitedBy));
+}
+
+} // namespace
+
+std::string formatReport(const SimReport &report, const Trajectory &trajectory, const Machine &machine,
+                         const std::function<std::string(uint32_t move)> &nameMove) {
+  auto name = [&](uint32_t move) { return nameMove ? nameMove(move) : "move " + std::to_string(move); };
+  std::string out;
+
+  out += "machine: " + machine.name;
+  if (!trajectory.machine.empty() && trajectory.machine != machine.name)
+    out += " (trajectory planned for " + trajectory.machine + ")";
+  out += " (cycle " + formatFixed(report.period * 1000, 3) + " ms, " + std::to_string(report.samples) +
+         " samples, path tolerance " + formatFixed(trajectory.tolerance, 3) + " mm)\n";
+
+  out += "cycle time: " + seconds(report.duration) + " (feed moves " + seconds(report.feedTime) + " over " +
+         formatFixed(report.feedDistance, 1) + " mm, rapids " + seconds(report.rapidTime) + " over " +
+         formatFixed(report.rapidDistance, 1) + " mm)\n";
+
+  if (report.feedTime > 0) {
+    out += "feed on feed moves: mean " + perMinute(report.meanFeed) + " of " + perMinute(report.meanProgrammedFeed) +
+           " programmed (" + percent(report.meanProgrammedFeed > 0 ? report.meanFeed / report.meanProgrammedFeed : 0) +
+           "), lowest " + percent(report.minFeedRatio) + " between stops\n";
+    const double slow = report.slowTime[0] + report.slowTime[1] + report.slowTime[2];
+    out += "below " + plain(report.slowFraction * 100) + " % of the programmed feed: " + seconds(slow) + "\n";
+    if (report.slowTime[static_cast<size_t>(SlowReason::Ramp)] > 0)
+      out += "  speeding up or slowing down: " + seconds(report.slowTime[static_cast<size_t>(SlowReason::Ramp)]) +
+             "\n";
+    if (report.slowTime[static_cast<size_t>(SlowReason::Short)] > 0)
+      out += "  segments too short to reach their speed: " +
+             seconds(report.slowTime[static_cast<size_t>(SlowReason::Short)]) + "\n";
+    for (size_t l = 0; l < 5; ++l)
+      if (report.slowCapTime[l] > 0)
+        out += "  capped by " + std::string(speedLimitDescription(static_cast<SpeedLimit>(l))) + ": " +
+               seconds(report.slowCapTime[l]) + "\n";
+    if (!report.slowest.empty()) {
+      out += "slowest places:\n";
+      for (const SlowSpot &spot : report.slowest)
+        out += "  " + name(spot.move) + " (segment " + std::to_string(spot.segment) + "): " + perMinute(spot.speed) +
+               " of " + perMinute(spot.feed) + " (" + percent(spot.feed > 0 ? spot.speed / spot.feed : 0) + "), " +
+               reasonText(spot.reason, spot.limitedBy) + "\n";
+    }
+  } else {
+    out += "feed on feed moves: no feed moves\n";
+  }
+
+  out += "axis peaks (of the limit):\n";
+  for (size_t k = 0; k < 3 && k < machine.axes.size(); ++k) {
+    const Axis &axis = machine.axes[k];
+    auto of = [](double value, double limit) { return limit > 0 ? " (" + percent(value / limit) + ")" : ""; };
+    out += "  " + axis.name + ": |v| " + perMinute(report.maxVelocity[k]) +
+           of(report.maxVelocity[k] * 60, axis.velocity) + ", |a| " + formatFixed(report.maxAcceleration[k], 1) +
+           " mm/s^2" + of(report.maxAcceleration[k], axis.acceleration) + ", |j| " +
+           formatFixed(report.maxJerk[k], 1) + " mm/s^3" + of(report.maxJerk[k], axis.jerk) + "\n";
+  }
+
+  if (report.deviationChecked)
+    out += "contour deviation: max " + formatFixed(report.maxDeviation, 4) + " mm (tolerance " +
+           formatFixed(report.tolerance, 4) + " mm)\n";
+
+  if (report.violationCount == 0) {
+    out += "violations: none\n";
+    return out;
+  }
+  out += "violations: " + std::to_string(report.violationCount) + " (showing " +
+         std::to_string(report.violations.size()) + ")\n";
+  for (const Violation &v : report.violations) {
+    out += "  t=" + seconds(v.t) + ", ";
+    if (v.segment < trajectory.info.size())
+      out += name(trajectory.info[v.segment].move) + ", ";
+    out += "segment " + std::to_string(v.segment);
+    switch (v.kind) {
+    case ViolationKind::Velocity:
+      out += ", axis " + axisName(machine, v.axis) + ": velocity " + perMinute(v.value) + " > " + perMinute(v.limit);
+      break;
+    case ViolationKind::Acceleration:
+      out += ", axis " + axisName(machine, v.axis) + ": acceleration " + formatFixed(v.value, 1) + " mm/s^2 > " +
+             formatFixed(v.limit, 1) + " mm/s^2";
+      break;
+    case ViolationKind::Jerk:
+      out += ", axis " + axisName(machine, v.axis) + ": jerk " + formatFixed(v.value, 1) + " mm/s^3 > " +
+             formatFixed(v.limit, 1) + " mm/s^3";
+      break;
+    case ViolationKind::Feed:
+      out += ": speed " + perMinute(v.value) + " above the programmed feed " + perMinute(v.limit);
+      break;
+    case ViolationKind::Deviation:
+      out += ": " + formatFixed(v.value, 6) + " mm from the programmed path (tolerance " + formatFixed(v.limit, 4) +
+             " mm)";
+      break;
+    case ViolationKind::EndState:
+      if (v.axis < 0)
+        out += ": ends " + formatFixed(v.value, 9) + " mm from its end point (allowed " + formatFixed(v.limit, 9) +
+               " mm)";
+      else
+        out += ", axis " + axisName(machine, v.axis) + ": not at rest at the end (" + perMinute(v.value) + ")";
+      break;
+    }
+    out += "\n";
+  }
+  return out;
+}
+
+} // namespace stepnc::runtime

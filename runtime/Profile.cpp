@@ -1,0 +1,157 @@
+#include "runtime/Profile.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace stepnc::runtime {
+
+double Profile::duration() const {
+  double t = 0;
+  for (const Phase &ph : phases)
+    t += ph.duration;
+  return t;
+}
+
+PathState Profile::at(double t) const {
+  PathState st{0, v0, 0, 0};
+  if (t <= 0) {
+    st.j = phases[0].jerk;
+    return st;
+  }
+  for (const Phase &ph : phases) {
+    if (ph.duration <= 0)
+      continue;
+    const double d = std::min(t, ph.duration);
+    st.s += st.v * d + st.a * d * d / 2 + ph.jerk * d * d * d / 6;
+    st.v += st.a * d + ph.jerk * d * d / 2;
+    st.a += ph.jerk * d;
+    st.j = ph.jerk;
+    t -= d;
+    if (t <= 0)
+      return st;
+  }
+  st.j = 0;
+  return st;
+}
+
+double Profile::v1() const {
+  double v = v0, a = 0;
+  for (const Phase &ph : phases) {
+    v += a * ph.duration + ph.jerk * ph.duration * ph.duration / 2;
+    a += ph.jerk * ph.duration;
+  }
+  return v;
+}
+
+double Profile::peak() const {
+  // Speed is extreme only where acceleration is zero, which in these
+  // profiles is at phase boundaries.
+  double v = v0, a = 0, best = v0;
+  for (const Phase &ph : phases) {
+    v += a * ph.duration + ph.jerk * ph.duration * ph.duration / 2;
+    a += ph.jerk * ph.duration;
+    best = std::max(best, v);
+  }
+  return best;
+}
+
+double rampTime(double dv, double a, double j) {
+  if (dv <= 0)
+    return 0;
+  return dv >= a * a / j ? dv / a + a / j : 2 * std::sqrt(dv / j);
+}
+
+double rampDistance(double v0, double v1, double a, double j) {
+  return (v0 + v1) / 2 * rampTime(std::abs(v1 - v0), a, j);
+}
+
+double reachableSpeed(double v0, double length, double a, double j) {
+  if (length <= 0)
+    return v0;
+  const double dvFull = a * a / j;  // the change at which acceleration first reaches a
+  if (rampDistance(v0, v0 + dvFull, a, j) >= length) {
+    // (2 v0 + dv) sqrt(dv / j) = L: with x = sqrt(dv), x^3 + p x - q = 0,
+    // p = 2 v0 >= 0, q = L sqrt(j): one real root, in the hyperbolic form
+    // that stays accurate when p is large.
+    const double p = 2 * v0, q = length * std::sqrt(j);
+    double x = p <= 0 ? std::cbrt(q)
+                      : 2 * std::sqrt(p / 3) * std::sinh(std::asinh(1.5 * q / p * std::sqrt(3 / p)) / 3);
+    x -= (x * x * x + p * x - q) / (3 * x * x + p);  // one Newton step polishes rounding
+    return v0 + std::max(0.0, x * x);
+  }
+  // (2 v0 + dv)(dv / a + a / j) = 2 L: dv^2 / a + b dv + c = 0.
+  const double b = 2 * v0 / a + a / j, c = 2 * v0 * a / j - 2 * length;
+  const double dv = -2 * c / (b + std::sqrt(b * b - 4 * c / a));
+  return v0 + std::max(0.0, dv);
+}
+
+namespace {
+
+/// Phases of a speed change from v0 to v1 with zero end accelerations,
+/// written to phases[first..first+2].
+void rampPhases(std::array<Phase, 7> &phases, int first, double v0, double v1, double a, double j) {
+  const double dv = std::abs(v1 - v0);
+  const double sign = v1 >= v0 ? 1 : -1;
+  if (dv <= 0)
+    return;
+  double t1, t2;
+  if (dv >= a * a / j) {
+    t1 = a / j;
+    t2 = dv / a - a / j;
+  } else {
+    t1 = std::sqrt(dv / j);
+    t2 = 0;
+  }
+  phases[first] = {t1, sign * j};
+  phases[first + 1] = {t2, 0};
+  phases[first + 2] = {t1, -sign * j};
+}
+
+} // namespace
+
+Profile planProfile(double v0, double v1, double length, const PathLimits &limits) {
+  const double a = limits.a, j = limits.j;
+  Profile prof;
+  prof.v0 = v0;
+  if (length <= 0)
+    return prof;
+  const double low = std::max(v0, v1);
+  auto distance = [&](double vp) { return rampDistance(v0, vp, a, j) + rampDistance(vp, v1, a, j); };
+  double vp = std::max(low, limits.v);
+  if (distance(vp) > length) {
+    // Highest peak whose rise and fall fit: distance(vp) grows with vp.
+    // Newton from below inside a shrinking bracket; `lo` always fits, so
+    // the cruise below makes up any remainder and the length is exact.
+    // d/dvp of one ramp's distance (v + vp)/2 T(vp - v).
+    auto slope = [&](double v, double x) {
+      const double dv = x - v;
+      if (dv <= 0)
+        return rampTime(0, a, j) / 2;
+      const double dT = dv >= a * a / j ? 1 / a : 1 / std::sqrt(j * dv);
+      return rampTime(dv, a, j) / 2 + (v + x) / 2 * dT;
+    };
+    double lo = low, hi = std::min(vp, reachableSpeed(std::min(v0, v1), length, a, j));
+    double x = hi;
+    for (int it = 0; it < 60 && hi - lo > 1e-12 * hi; ++it) {
+      const double f = distance(x) - length;
+      if (f <= 0)
+        lo = x;
+      else
+        hi = x;
+      const double df = slope(v0, x) + slope(v1, x);
+      double next = df > 0 ? x - f / df : (lo + hi) / 2;
+      if (!(next > lo && next < hi))
+        next = (lo + hi) / 2;
+      x = next;
+    }
+    vp = lo;
+  }
+  rampPhases(prof.phases, 0, v0, vp, a, j);
+  rampPhases(prof.phases, 4, vp, v1, a, j);
+  const double cruise = length - distance(vp);
+  if (vp > 0 && cruise > 1e-12 * vp)  // below that, rounding of the ramps' distances
+    prof.phases[3] = {cruise / vp, 0};
+  return prof;
+}
+
+} // namespace stepnc::runtime

@@ -1,0 +1,224 @@
+#include "runtime/Segment.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace stepnc::runtime {
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+/// Five-point Gauss–Legendre nodes and weights on [-1, 1].
+constexpr std::array<double, 5> kGaussX{0.0, -0.5384693101056831, 0.5384693101056831, -0.9061798459386640,
+                                        0.9061798459386640};
+constexpr std::array<double, 5> kGaussW{0.5688888888888889, 0.4786286704993665, 0.4786286704993665,
+                                        0.2369268850561891, 0.2369268850561891};
+
+} // namespace
+
+double QuinticCurve::length(double u0, double u1) const {
+  const double h = (u1 - u0) / 2, m = (u0 + u1) / 2;
+  double sum = 0;
+  for (size_t i = 0; i < kGaussX.size(); ++i)
+    sum += kGaussW[i] * speed(m + h * kGaussX[i]);
+  return sum * h;
+}
+
+namespace {
+
+/// Derivatives with respect to arc length from those with respect to u.
+PathPoint fromParameter(const Vec3 &p, const Vec3 &d1, const Vec3 &d2, const Vec3 &d3) {
+  PathPoint out;
+  out.p = p;
+  const double q = d1.norm();
+  if (q <= 0)
+    return out;
+  const double q2 = q * q, q4 = q2 * q2;
+  const double d12 = d1.dot(d2);
+  const double qu = d12 / q;
+  out.r1 = d1 / q;
+  out.r2 = d2 / q2 - d1 * (d12 / q4);
+  const Vec3 first = d3 / q2 - d2 * (2 * qu / (q2 * q));
+  const Vec3 second = d2 * (d12 / q4) + d1 * ((d2.squaredNorm() + d1.dot(d3)) / q4) - d1 * (4 * d12 * qu / (q4 * q));
+  out.r3 = (first - second) / q;
+  return out;
+}
+
+} // namespace
+
+Segment Segment::line(const Vec3 &from, const Vec3 &to) {
+  Segment s;
+  s.kind = SegmentKind::Line;
+  s.start = from;
+  s.end = to;
+  s.length = (to - from).norm();
+  return s;
+}
+
+Segment Segment::arc(const Vec3 &from, const Vec3 &to, const Vec3 &center, bool ccw, double sweep) {
+  Segment s;
+  s.kind = SegmentKind::Arc;
+  s.start = from;
+  s.end = to;
+  s.ccw = ccw;
+  s.sweep = sweep;
+  Eigen::Vector2d f = from.head<2>(), t = to.head<2>(), c = center.head<2>();
+  const Eigen::Vector2d chord = t - f;
+  if (chord.norm() > 1e-9) {
+    // The nearest point to the given centre that is equally far from both
+    // ends: printed centres are rounded, the arc must still end at `to`.
+    // Only a rounding's worth: a nearly closed arc whose ends differ in
+    // radius would otherwise collapse onto its short chord.
+    const Eigen::Vector2d mid = (f + t) / 2;
+    const Eigen::Vector2d n = Eigen::Vector2d(-chord.y(), chord.x()).normalized();
+    const Eigen::Vector2d moved = mid + n * n.dot(c - mid);
+    if ((moved - c).norm() <= 1e-3)
+      c = moved;
+  }
+  s.center = Vec3(c.x(), c.y(), 0);
+  s.radius = (f - c).norm();
+  s.startAngle = std::atan2(f.y() - c.y(), f.x() - c.x());
+  const double rise = sweep > 0 ? (to.z() - from.z()) / sweep : 0;
+  s.length = sweep * std::sqrt(s.radius * s.radius + rise * rise);
+  return s;
+}
+
+Segment Segment::arcTurns(const Vec3 &from, const Vec3 &to, const Vec3 &center, bool ccw, int64_t turns) {
+  Segment s = arc(from, to, center, ccw, 0);
+  const double endAngle = std::atan2(to.y() - s.center.y(), to.x() - s.center.x());
+  double d = ccw ? endAngle - s.startAngle : s.startAngle - endAngle;
+  d = std::fmod(d, 2 * kPi);
+  if (d < 0)
+    d += 2 * kPi;
+  if ((to.head<2>() - from.head<2>()).norm() <= 1e-9)
+    d = 2 * kPi;  // over the start: the last arc is a whole turn
+  return arc(from, to, center, ccw, d + 2 * kPi * double(std::max<int64_t>(turns, 0)));
+}
+
+Segment Segment::part(double s0, double s1) const {
+  s0 = std::clamp(s0, 0.0, length);
+  s1 = std::clamp(s1, s0, length);
+  if (s0 <= 0 && s1 >= length)
+    return *this;
+  if (kind == SegmentKind::Line)
+    return line(at(s0).p, at(s1).p);
+  Segment out = *this;
+  if (kind == SegmentKind::Arc) {
+    const double rise = sweep > 0 ? (end.z() - start.z()) / sweep : 0;
+    const double k = std::sqrt(radius * radius + rise * rise);
+    out.start = at(s0).p;
+    out.end = at(s1).p;
+    out.startAngle = startAngle + (ccw ? 1 : -1) * s0 / k;
+    out.sweep = (s1 - s0) / k;
+    out.length = s1 - s0;
+  }
+  return out;
+}
+
+Segment Segment::blend(const std::array<Vec3, 6> &ctrl) {
+  Segment s;
+  s.kind = SegmentKind::Blend;
+  s.ctrl = ctrl;
+  s.start = ctrl[0];
+  s.end = ctrl[5];
+  const QuinticCurve q(ctrl);
+  s.arcTable[0] = 0;
+  for (int i = 0; i < kBlendTable; ++i)
+    s.arcTable[i + 1] = s.arcTable[i] + q.length(double(i) / kBlendTable, double(i + 1) / kBlendTable);
+  s.length = s.arcTable[kBlendTable];
+  return s;
+}
+
+PathPoint Segment::at(double s) const {
+  s = std::clamp(s, 0.0, length);
+  switch (kind) {
+  case SegmentKind::Line: {
+    PathPoint out;
+    if (length > 0)
+      out.r1 = (end - start) / length;
+    out.p = s >= length ? end : Vec3(start + out.r1 * s);
+    return out;
+  }
+  case SegmentKind::Arc: {
+    const double rise = sweep > 0 ? (end.z() - start.z()) / sweep : 0;  // mm per radian
+    const double k = std::sqrt(radius * radius + rise * rise);         // mm per radian along the path
+    const double theta = k > 0 ? s / k : 0;
+    const double sigma = ccw ? 1 : -1;
+    const double phi = startAngle + sigma * theta;
+    const double c = std::cos(phi), sn = std::sin(phi);
+    PathPoint out;
+    out.p = s >= length ? end : Vec3(center.x() + radius * c, center.y() + radius * sn, start.z() + rise * theta);
+    if (k > 0) {
+      out.r1 = Vec3(-radius * sn * sigma / k, radius * c * sigma / k, rise / k);
+      out.r2 = Vec3(-radius * c / (k * k), -radius * sn / (k * k), 0);
+      out.r3 = Vec3(radius * sn * sigma / (k * k * k), -radius * c * sigma / (k * k * k), 0);
+    }
+    return out;
+  }
+  case SegmentKind::Blend: {
+    const QuinticCurve q(ctrl);
+    // The table interval holding s, then Newton on the arc length within it.
+    int i = int(std::upper_bound(arcTable.begin(), arcTable.end(), s) - arcTable.begin()) - 1;
+    i = std::clamp(i, 0, kBlendTable - 1);
+    const double u0 = double(i) / kBlendTable, u1 = double(i + 1) / kBlendTable;
+    const double span = arcTable[i + 1] - arcTable[i];
+    double u = span > 0 ? u0 + (u1 - u0) * (s - arcTable[i]) / span : u0;
+    for (int it = 0; it < 4; ++it) {
+      const double g = arcTable[i] + q.length(u0, u) - s;
+      const double sp = q.speed(u);
+      if (sp <= 0)
+        break;
+      u = std::clamp(u - g / sp, u0, u1);
+      if (std::abs(g) < 1e-13)
+        break;
+    }
+    PathPoint out = fromParameter(q.point(u), q.d1(u), q.d2(u), q.d3(u));
+    if (s >= length)
+      out.p = end;
+    return out;
+  }
+  }
+  return {};
+}
+
+AxisDemand Segment::demand() const {
+  AxisDemand d;
+  switch (kind) {
+  case SegmentKind::Line:
+    if (length > 0)
+      d.r1 = ((end - start) / length).cwiseAbs();
+    break;
+  case SegmentKind::Arc: {
+    const double rise = sweep > 0 ? (end.z() - start.z()) / sweep : 0;
+    const double k = std::sqrt(radius * radius + rise * rise);
+    if (k > 0) {
+      d.r1 = Vec3(radius / k, radius / k, std::abs(rise) / k);
+      d.r2 = Vec3(radius / (k * k), radius / (k * k), 0);
+      d.r3 = Vec3(radius / (k * k * k), radius / (k * k * k), 0);
+    }
+    break;
+  }
+  case SegmentKind::Blend: {
+    // Sampled densely in u; a quintic's derivatives vary smoothly, and the
+    // margin covers what lies between samples.
+    const QuinticCurve q(ctrl);
+    constexpr int kSamples = 32;
+    for (int i = 0; i <= kSamples; ++i) {
+      const double u = double(i) / kSamples;
+      const PathPoint pt = fromParameter(Vec3::Zero(), q.d1(u), q.d2(u), q.d3(u));
+      d.r1 = d.r1.cwiseMax(pt.r1.cwiseAbs());
+      d.r2 = d.r2.cwiseMax(pt.r2.cwiseAbs());
+      d.r3 = d.r3.cwiseMax(pt.r3.cwiseAbs());
+    }
+    constexpr double kMargin = 1.1;
+    d.r1 = (d.r1 * kMargin).cwiseMin(Vec3::Ones());
+    d.r2 *= kMargin;
+    d.r3 *= kMargin;
+    break;
+  }
+  }
+  return d;
+}
+
+} // namespace stepnc::runtime

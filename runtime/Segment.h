@@ -1,0 +1,102 @@
+// The geometry of motion segments: straight lines, circular arcs and helices
+// about an axis parallel to z, and quintic blends that join two pieces with
+// continuous tangent and curvature. A segment is parametrised by arc length s
+// in [0, length]; `at` gives the point and its first three derivatives with
+// respect to s (unit tangent, curvature vector, and its rate of change), from
+// which the player turns a path speed profile into axis velocities,
+// accelerations and jerks:
+//   v = s' r1,  a = s'' r1 + s'^2 r2,  j = s''' r1 + 3 s' s'' r2 + s'^3 r3.
+#pragma once
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+
+namespace stepnc::runtime {
+
+using Vec3 = Eigen::Vector3d;
+
+enum class SegmentKind : uint8_t { Line, Arc, Blend };
+
+/// A point of a path and its derivatives with respect to arc length.
+struct PathPoint {
+  Vec3 p = Vec3::Zero();   ///< mm
+  Vec3 r1 = Vec3::Zero();  ///< unit tangent
+  Vec3 r2 = Vec3::Zero();  ///< curvature vector, 1/mm
+  Vec3 r3 = Vec3::Zero();  ///< d r2 / ds, 1/mm^2
+};
+
+/// Per-axis bounds of |r1|, |r2|, |r3| over a segment: what its speed and
+/// acceleration demand of each axis.
+struct AxisDemand {
+  Vec3 r1 = Vec3::Zero();
+  Vec3 r2 = Vec3::Zero();
+  Vec3 r3 = Vec3::Zero();
+};
+
+/// A quintic Bezier curve (the blends) in power form: B(u) = sum c[k] u^k.
+struct QuinticCurve {
+  std::array<Vec3, 6> c;
+
+  explicit QuinticCurve(const std::array<Vec3, 6> &p) {
+    c[0] = p[0];
+    c[1] = 5 * (p[1] - p[0]);
+    c[2] = 10 * (p[2] - 2 * p[1] + p[0]);
+    c[3] = 10 * (p[3] - 3 * p[2] + 3 * p[1] - p[0]);
+    c[4] = 5 * (p[4] - 4 * p[3] + 6 * p[2] - 4 * p[1] + p[0]);
+    c[5] = p[5] - 5 * p[4] + 10 * p[3] - 10 * p[2] + 5 * p[1] - p[0];
+  }
+  Vec3 point(double u) const { return ((((c[5] * u + c[4]) * u + c[3]) * u + c[2]) * u + c[1]) * u + c[0]; }
+  Vec3 d1(double u) const { return (((5 * c[5] * u + 4 * c[4]) * u + 3 * c[3]) * u + 2 * c[2]) * u + c[1]; }
+  Vec3 d2(double u) const { return ((20 * c[5] * u + 12 * c[4]) * u + 6 * c[3]) * u + 2 * c[2]; }
+  Vec3 d3(double u) const { return (60 * c[5] * u + 24 * c[4]) * u + 6 * c[3]; }
+  double speed(double u) const { return d1(u).norm(); }
+  /// Arc length from u0 to u1 (five-point Gauss–Legendre).
+  double length(double u0, double u1) const;
+};
+
+struct Segment {
+  SegmentKind kind = SegmentKind::Line;
+  Vec3 start = Vec3::Zero();
+  Vec3 end = Vec3::Zero();
+  double length = 0;  ///< mm, along the path
+
+  // Arc (helix): the axis is parallel to z through `center` (its z unused);
+  // the arc turns `sweep` radians (> 0, whole turns included) from
+  // `startAngle`, counter-clockwise seen from +z when `ccw`, while z goes
+  // from start.z() to end.z() in proportion.
+  Vec3 center = Vec3::Zero();
+  double radius = 0;
+  double startAngle = 0;
+  double sweep = 0;
+  bool ccw = true;
+
+  // Blend: a quintic Bezier curve; ctrl[0] = start, ctrl[5] = end.
+  std::array<Vec3, 6> ctrl{Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
+  /// Blends: arc length at u = i / kBlendTable, for the s -> u inversion.
+  static constexpr int kBlendTable = 8;
+  std::array<double, kBlendTable + 1> arcTable{};
+
+  static Segment line(const Vec3 &from, const Vec3 &to);
+  /// An arc from `from` about the axis through `center` to `to`, turning
+  /// `sweep` radians. The centre is moved onto the bisector of from and to
+  /// (when they differ in the plane) so that the arc passes through both.
+  static Segment arc(const Vec3 &from, const Vec3 &to, const Vec3 &center, bool ccw, double sweep);
+  /// The same, with the sweep made of `turns` whole turns and the angle from
+  /// `from` to `to` (a whole turn when they are over each other), measured
+  /// about the moved centre.
+  static Segment arcTurns(const Vec3 &from, const Vec3 &to, const Vec3 &center, bool ccw, int64_t turns);
+  static Segment blend(const std::array<Vec3, 6> &ctrl);
+  /// The part of this segment from arc length s0 to s1 (a line, arc or blend
+  /// of the same curve; blends only whole).
+  Segment part(double s0, double s1) const;
+
+  /// The point at arc length s (clamped to [0, length]); `at(length).p` is
+  /// exactly `end`.
+  PathPoint at(double s) const;
+  /// Upper bounds of the derivatives per axis over the whole segment.
+  AxisDemand demand() const;
+};
+
+} // namespace stepnc::runtime

@@ -1,0 +1,60 @@
+// A planned motion: segments with their speed profiles, played one after the
+// other from `start`. This is what the planner produces, the native format
+// writes and the player samples.
+#pragma once
+
+#include "runtime/Profile.h"
+#include "runtime/Segment.h"
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace stepnc::runtime {
+
+/// What capped a segment's speed below the programmed feed (or, for rapids,
+/// what set the rapid speed).
+enum class SpeedLimit : uint8_t {
+  Feed,          ///< the programmed feed
+  MachineFeed,   ///< the controller's max_feed
+  AxisVelocity,  ///< an axis's velocity limit along the segment's direction
+  Acceleration,  ///< an axis's acceleration limit on the segment's curvature
+  Jerk,          ///< an axis's jerk limit on the segment's curvature or its change
+};
+std::string_view speedLimitName(SpeedLimit limit);  ///< the word in files: "axis_velocity"
+/// For people: "an axis's velocity limit".
+std::string_view speedLimitDescription(SpeedLimit limit);
+
+/// Why a segment starts with zero speed.
+enum class StopReason : uint8_t {
+  None,
+  Start,     ///< the first segment
+  Reversal,  ///< the path turns back on itself (no blend can stay in tolerance)
+  Tiny,      ///< the pieces are too short to blend within tolerance
+  Program,   ///< a tool change, a change of setup or spindle, a stop in the program
+};
+std::string_view stopReasonName(StopReason reason);
+
+struct SegmentInfo {
+  PathLimits limits;                    ///< v, a, j along the path used to plan it
+  SpeedLimit limitedBy = SpeedLimit::Feed;
+  double feed = 0;                      ///< mm/s programmed; 0 for rapids
+  uint32_t move = 0;                    ///< index of the programmed move it follows
+  uint32_t nextMove = 0;                ///< blends: the move it joins to (else = move)
+  StopReason stop = StopReason::None;   ///< why the segment starts at rest
+};
+
+struct Trajectory {
+  std::string machine;    ///< the machine's name
+  double tolerance = 0;   ///< mm, the path tolerance blends kept
+  double cycleTime = 0.001;  ///< s, the machine's interpolation period
+  Vec3 start = Vec3::Zero();
+  std::vector<Segment> segments;
+  std::vector<Profile> profiles;  ///< one per segment
+  std::vector<SegmentInfo> info;  ///< one per segment
+
+  double duration() const;
+};
+
+} // namespace stepnc::runtime

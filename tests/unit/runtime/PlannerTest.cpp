@@ -1,0 +1,233 @@
+// The motion planner, checked on sampled output (the reference player at
+// 1 kHz): on stress paths every axis keeps its velocity, acceleration and
+// jerk limits, the path stays within tolerance, the feed is never exceeded
+// and the tool ends at rest where the program ends; and the plan is not lazy:
+// long lines reach the feed, and simple paths take within 2 % of a lower
+// bound computed here, independently of the planner.
+#include "runtime/Planner.h"
+#include "runtime/Player.h"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+using namespace stepnc;
+using namespace stepnc::runtime;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+Machine shipped(const std::string &name) {
+  std::unique_ptr<SourceFile> file;
+  DiagnosticCollector collector;
+  DiagnosticEngine diags(collector);
+  auto m = loadMachine(name, file, diags);
+  REQUIRE(m);
+  return *m;
+}
+
+PathMove line(double x, double y, double z, double feed) {
+  PathMove m;
+  m.to = Vec3(x, y, z);
+  m.feed = feed;
+  return m;
+}
+
+PathMove arc(double x, double y, double z, double cx, double cy, bool ccw, double feed, int64_t turns = 0) {
+  PathMove m;
+  m.kind = PathMove::Kind::Arc;
+  m.to = Vec3(x, y, z);
+  m.center = Vec3(cx, cy, 0);
+  m.ccw = ccw;
+  m.feed = feed;
+  m.turns = turns;
+  return m;
+}
+
+/// Plans and plays `path`; every check of the issue holds.
+SimReport check(const PathInput &path, const Machine &machine) {
+  const Trajectory t = plan(path, machine);
+  SimOptions options;
+  options.programmed = &path;
+  const SimReport r = simulate(t, machine, options);
+  INFO("machine " << machine.name << ", " << t.segments.size() << " segments, " << r.duration << " s");
+  for (const Violation &v : r.violations)
+    INFO("violation " << violationKindName(v.kind) << " axis " << v.axis << " t=" << v.t << " segment " << v.segment
+                      << ": " << v.value << " > " << v.limit);
+  CHECK(r.violationCount == 0);
+  CHECK(r.maxDeviation <= machine.pathTolerance);
+  const Vec3 end = path.moves.empty() ? path.start : path.moves.back().to;
+  CHECK((r.endPosition - end).norm() < 1e-9);
+  for (int k = 0; k < 3; ++k) {
+    CHECK(r.maxVelocity[k] <= machine.axes[k].velocity / 60 * (1 + 1e-6));
+    CHECK(r.maxAcceleration[k] <= machine.axes[k].acceleration * (1 + 1e-6));
+    CHECK(r.maxJerk[k] <= machine.axes[k].jerk * (1 + 1e-6));
+  }
+  return r;
+}
+
+/// Rest-to-rest time over `length` for one axis-like motion with limits v,
+/// a, j, from the kinematics of the seven-phase profile: each speed change
+/// to vp is a jerk phase of tj = min(a/j, sqrt(vp/j)), a constant-
+/// acceleration phase of vp/(j tj) - tj, and a jerk phase of tj.
+double restToRest(double length, double v, double a, double j) {
+  auto rise = [&](double vp, double &dist) {
+    const double tj = std::min(a / j, std::sqrt(vp / j));
+    const double peakA = j * tj;
+    const double ta = vp / peakA - tj;
+    // Speed at the phase ends, then distance by the trapezoidal rule on each
+    // (exact for the quadratic pieces' mean, which is symmetric here).
+    const double time = 2 * tj + ta;
+    dist = vp * time / 2;  // the speed curve is point-symmetric about its middle
+    return time;
+  };
+  double d = 0;
+  double tRise = rise(v, d);
+  if (2 * d <= length)
+    return 2 * tRise + (length - 2 * d) / v;
+  double lo = 0, hi = v;
+  for (int i = 0; i < 200; ++i) {
+    const double mid = (lo + hi) / 2;
+    rise(mid, d);
+    (2 * d <= length ? lo : hi) = mid;
+  }
+  tRise = rise(lo, d);
+  return 2 * tRise;
+}
+
+} // namespace
+
+TEST_CASE("a long line reaches the feed and takes the time-optimal time", "[planner]") {
+  const Machine m = shipped("hsc-3axis");
+  PathInput p;
+  p.moves.push_back(line(300, 0, 0, 3000));
+  const SimReport r = check(p, m);
+  const Trajectory t = plan(p, m);
+  CHECK(t.profiles[0].peak() == Approx(50));
+  const double bound = restToRest(300, 50, m.axes[0].acceleration, m.axes[0].jerk);
+  CHECK(r.duration >= bound * (1 - 1e-9));
+  CHECK(r.duration <= bound * 1.02);
+  CHECK(r.duration == Approx(bound).epsilon(1e-9));  // one line: the planner is optimal
+}
+
+TEST_CASE("a diagonal line is limited by its binding axis", "[planner]") {
+  const Machine m = shipped("conventional-3axis");
+  PathInput p;
+  p.moves.push_back(line(200, 100, -50, 0));  // a rapid: the axes' own speeds
+  const SimReport r = check(p, m);
+  // z is the slowest axis along this direction: it reaches its limit.
+  const Vec3 dir = Vec3(200, 100, -50).normalized();
+  const double v = std::min({m.axes[0].velocity / 60 / dir.x(), m.axes[1].velocity / 60 / dir.y(),
+                             m.axes[2].velocity / 60 / -dir.z()});
+  CHECK(r.maxVelocity.cwiseQuotient(dir.cwiseAbs()).minCoeff() == Approx(v).epsilon(1e-6));
+}
+
+TEST_CASE("a rectangle takes within 2 % of the unrolled-perimeter lower bound", "[planner]") {
+  const Machine m = shipped("hsc-3axis");
+  PathInput p;
+  for (auto [x, y] : {std::pair{400.0, 0.0}, {400.0, 300.0}, {0.0, 300.0}, {0.0, 0.0}})
+    p.moves.push_back(line(x, y, 0, 3000));
+  const SimReport r = check(p, m);
+  // No path round the rectangle at 3000 mm/min with these limits is faster
+  // than its perimeter as one straight line (x and y have the same limits).
+  const double bound = restToRest(1400, 50, m.axes[0].acceleration, m.axes[0].jerk);
+  CHECK(r.duration >= bound);
+  CHECK(r.duration <= bound * 1.02);
+  CHECK(r.feedTime == Approx(r.duration));
+}
+
+TEST_CASE("stress paths hold every bound on both shipped machines", "[planner]") {
+  for (const std::string name : {"hsc-3axis", "conventional-3axis"}) {
+    const Machine m = shipped(name);
+    SECTION(name + ": tiny zigzag") {
+      PathInput p;
+      for (int i = 0; i < 400; ++i)
+        p.moves.push_back(line(0.05 * (i + 1), (i % 2) * 0.02, 0, 6000));
+      check(p, m);
+    }
+    SECTION(name + ": dense short segments on a circle") {
+      PathInput p;
+      p.start = Vec3(20, 0, 0);
+      for (int i = 1; i <= 3000; ++i) {
+        const double a = 2 * kPi * i / 3000;
+        p.moves.push_back(line(20 * std::cos(a), 20 * std::sin(a), 0, 4000));
+      }
+      check(p, m);
+    }
+    SECTION(name + ": small arcs and S-bends") {
+      PathInput p;
+      double x = 0;
+      for (int i = 0; i < 100; ++i) {
+        const double r = 0.2 + 0.3 * (i % 3);
+        p.moves.push_back(arc(x + 2 * r, 0, 0, x + r, 0, i % 2 == 0, 5000));
+        x += 2 * r;
+        p.moves.push_back(line(x + 1, 0, 0, 5000));
+        x += 1;
+      }
+      check(p, m);
+    }
+    SECTION(name + ": sharp reversals and near-reversals") {
+      PathInput p;
+      for (int i = 0; i < 50; ++i) {
+        p.moves.push_back(line(10, 0.01 * i, 0, 8000));
+        p.moves.push_back(line(0, 0.01 * i + (i % 2) * 0.001, 0, 8000));
+      }
+      check(p, m);
+    }
+    SECTION(name + ": helices, plunges and rapids") {
+      PathInput p;
+      p.start = Vec3(50, 50, 20);
+      p.moves.push_back(line(50, 50, 2, 0));
+      p.moves.push_back(arc(50, 50, -4, 47, 50, true, 1200, 1));  // two turns down
+      p.moves.push_back(line(80, 50, -4, 2400));
+      p.moves.push_back(arc(90, 60, -4, 80, 60, true, 2400));
+      p.moves.push_back(line(90, 60, 20, 0));
+      p.moves.push_back(line(0, 0, 20, 0));
+      check(p, m);
+    }
+    SECTION(name + ": random lines and arcs") {
+      std::mt19937 rng(2026);
+      std::uniform_real_distribution<double> step(-5, 5), small(0.01, 3), feed(100, 12000), pick(0, 1);
+      PathInput p;
+      Vec3 at(100, 100, 0);
+      p.start = at;
+      for (int i = 0; i < 300; ++i) {
+        if (pick(rng) < 0.5) {
+          const double s = pick(rng) < 0.3 ? 0.05 : 1.0;
+          at += Vec3(step(rng) * s, step(rng) * s, pick(rng) < 0.2 ? step(rng) * 0.2 : 0);
+          p.moves.push_back(line(at.x(), at.y(), at.z(), pick(rng) < 0.1 ? 0 : feed(rng)));
+        } else {
+          const double r = small(rng), a0 = 2 * kPi * pick(rng), sweep = 2 * kPi * pick(rng);
+          const Vec3 c = at - r * Vec3(std::cos(a0), std::sin(a0), 0);
+          const bool ccw = pick(rng) < 0.5;
+          const double a1 = a0 + (ccw ? sweep : -sweep);
+          at = Vec3(c.x() + r * std::cos(a1), c.y() + r * std::sin(a1), at.z());
+          p.moves.push_back(arc(at.x(), at.y(), at.z(), c.x(), c.y(), ccw, feed(rng)));
+        }
+      }
+      check(p, m);
+    }
+  }
+}
+
+TEST_CASE("the tool stops where the program says and at reversals", "[planner]") {
+  const Machine m = shipped("hsc-3axis");
+  PathInput p;
+  p.moves.push_back(line(10, 0, 0, 3000));
+  p.moves.push_back(line(0, 0, 0, 3000));  // straight back
+  PathMove change = line(0, 10, 0, 3000);
+  change.stopBefore = true;  // e.g. a tool change
+  p.moves.push_back(change);
+  const Trajectory t = plan(p, m);
+  REQUIRE(t.segments.size() == 3);
+  CHECK(t.info[0].stop == StopReason::Start);
+  CHECK(t.info[1].stop == StopReason::Reversal);
+  CHECK(t.info[2].stop == StopReason::Program);
+  for (const Profile &prof : t.profiles)
+    CHECK(prof.v0 == 0);
+  check(p, m);
+}

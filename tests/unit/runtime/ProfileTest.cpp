@@ -1,0 +1,93 @@
+// Jerk-limited profiles: the closed forms agree with the profiles built from
+// them, profiles cover exactly their length, keep within their limits and
+// end with zero acceleration.
+#include "runtime/Profile.h"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <random>
+
+using namespace stepnc::runtime;
+
+namespace {
+
+/// Integrates a profile's phases by small steps (not its closed form) and
+/// checks speed, acceleration and jerk against the limits on the way.
+struct Walk {
+  double s = 0, v = 0, a = 0, maxV = 0, maxA = 0, maxJ = 0;
+};
+Walk integrate(const Profile &p) {
+  Walk w;
+  w.v = p.v0;
+  w.maxV = p.v0;
+  for (const Phase &ph : p.phases) {
+    const int steps = 2000;
+    const double h = ph.duration / steps;
+    for (int i = 0; i < steps; ++i) {
+      w.s += w.v * h + w.a * h * h / 2 + ph.jerk * h * h * h / 6;
+      w.v += w.a * h + ph.jerk * h * h / 2;
+      w.a += ph.jerk * h;
+      w.maxV = std::max(w.maxV, w.v);
+      w.maxA = std::max(w.maxA, std::abs(w.a));
+    }
+    if (ph.duration > 0)
+      w.maxJ = std::max(w.maxJ, std::abs(ph.jerk));
+  }
+  return w;
+}
+
+} // namespace
+
+TEST_CASE("ramp time and distance follow the closed forms", "[profile]") {
+  // dv below a^2/j: the acceleration never reaches a.
+  CHECK(rampTime(100, 6000, 80000) == Approx(2 * std::sqrt(100.0 / 80000)));
+  // dv above: dv/a + a/j.
+  CHECK(rampTime(1000, 6000, 80000) == Approx(1000.0 / 6000 + 6000.0 / 80000));
+  CHECK(rampDistance(0, 1000, 6000, 80000) == Approx(500 * (1000.0 / 6000 + 6000.0 / 80000)));
+  CHECK(rampDistance(1000, 0, 6000, 80000) == Approx(rampDistance(0, 1000, 6000, 80000)));
+  CHECK(rampTime(0, 6000, 80000) == 0);
+}
+
+TEST_CASE("reachable speed inverts the ramp distance in both regimes", "[profile]") {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> v0s(0, 500), lengths(1e-4, 300);
+  for (int i = 0; i < 2000; ++i) {
+    const double v0 = v0s(rng), length = lengths(rng);
+    const double v1 = reachableSpeed(v0, length, 6000, 80000);
+    REQUIRE(v1 >= v0);
+    CHECK(rampDistance(v0, v1, 6000, 80000) == Approx(length).epsilon(1e-9));
+  }
+}
+
+TEST_CASE("profiles cover their length, keep their limits and end at rest acceleration", "[profile]") {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> lengths(1e-3, 200), speeds(0, 1), limitsV(1, 500);
+  const double a = 6000, j = 80000;
+  for (int i = 0; i < 300; ++i) {
+    const double length = lengths(rng);
+    const PathLimits limits{limitsV(rng), a, j};
+    // End speeds the look-ahead could hand over: reachable from each other.
+    double v0 = speeds(rng) * limits.v;
+    double v1 = std::min(speeds(rng) * limits.v, reachableSpeed(v0, length, a, j));
+    v0 = std::min(v0, reachableSpeed(v1, length, a, j));
+    const Profile p = planProfile(v0, v1, length, limits);
+    const Walk w = integrate(p);
+    INFO("v0 " << v0 << " v1 " << v1 << " length " << length << " vmax " << limits.v);
+    CHECK(w.s == Approx(length).epsilon(1e-6));
+    CHECK(p.at(p.duration()).s == Approx(length).epsilon(1e-9));
+    CHECK(p.v1() == Approx(v1).margin(1e-6));
+    CHECK(std::abs(p.at(p.duration()).a) < 1e-6);
+    CHECK(w.maxV <= limits.v * (1 + 1e-9) + 1e-9);
+    CHECK(w.maxA <= a * (1 + 1e-9));
+    CHECK(w.maxJ <= j * (1 + 1e-12));
+  }
+}
+
+TEST_CASE("a long profile cruises at its speed limit", "[profile]") {
+  const Profile p = planProfile(0, 0, 300, {50, 6000, 80000});
+  CHECK(p.peak() == Approx(50));
+  // Rise and fall each take 2 sqrt(50 / 80000) s over 50 * sqrt(50 / 80000) mm.
+  const double ramp = 2 * std::sqrt(50.0 / 80000);
+  CHECK(p.duration() == Approx(2 * ramp + (300 - 50 * ramp) / 50).epsilon(1e-12));
+}
