@@ -7,6 +7,7 @@
 #include "support/Diagnostics.h"
 
 #include <map>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -14,6 +15,9 @@ namespace stepnc::passes {
 
 /// Options given to a pass in a pipeline: `name<key=value,key=value>`.
 using PassOptions = std::map<std::string, std::string, std::less<>>;
+
+/// A pass option holding a positive length: "0.02" or "0.02mm"; nullopt otherwise.
+std::optional<double> parseLengthOption(std::string_view text);
 
 struct PassResult {
   bool ok = true;

@@ -3,9 +3,21 @@
 #include "ir/Printer.h"
 #include "ir/Verifier.h"
 
+#include <charconv>
+#include <cmath>
 #include <cstdlib>
 
 namespace stepnc::passes {
+
+std::optional<double> parseLengthOption(std::string_view text) {
+  if (text.size() > 2 && text.substr(text.size() - 2) == "mm")
+    text.remove_suffix(2);
+  double value = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
+  if (ec != std::errc() || end != text.data() + text.size() || !std::isfinite(value) || value <= 0)
+    return std::nullopt;
+  return value;
+}
 
 void PassManager::add(const std::vector<PipelineEntry> &pipeline) {
   for (const PipelineEntry &entry : pipeline)

@@ -82,17 +82,6 @@ std::string mm(double v) { return formatFixed(v, 4) + " mm"; }
 std::string mm2(double v) { return formatFixed(v, 3) + " mm2"; }
 std::string pointText(const ir::Vec3 &p) { return formatTuple({p.x(), p.y(), p.z()}, 4); }
 
-/// "0.02" or "0.02mm" as a positive length; nullopt otherwise.
-std::optional<double> parseLength(std::string_view text) {
-  if (text.size() > 2 && text.substr(text.size() - 2) == "mm")
-    text.remove_suffix(2);
-  double value = 0;
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (ec != std::errc() || end != text.data() + text.size() || !std::isfinite(value) || value <= 0)
-    return std::nullopt;
-  return value;
-}
-
 // --- Regions -----------------------------------------------------------------------
 
 /// The region grown (d > 0) or shrunk (d < 0) by |d|, with the exact Booleans.
@@ -834,7 +823,7 @@ std::unique_ptr<Pass> createVerifyToolpathsPass(const PassOptions &options) {
   std::optional<double> tolerance;
   std::string error;
   if (auto it = options.find("tolerance"); it != options.end()) {
-    tolerance = parseLength(it->second);
+    tolerance = parseLengthOption(it->second);
     if (!tolerance)
       error = "verify-toolpaths: tolerance='" + it->second +
               "' is not a length: expected a positive number of mm, such as tolerance=0.01";

@@ -13,7 +13,9 @@
 #include "ir/Printer.h"
 #include "ir/Verifier.h"
 #include "passes/PassManager.h"
+#include "runtime/Machine.h"
 #include "support/OutputFile.h"
+#include "tools/stepnc/Compile.h"
 #include "tools/stepnc/Driver.h"
 #include "tools/stepnc/SchemaSelection.h"
 
@@ -28,13 +30,10 @@ namespace stepnc::tool {
 
 namespace {
 
-/// What `compile --emit=toolpath-ir` runs.
-constexpr std::string_view kToolpathPipeline = "resolve-feeds,expand-strategies,verify-toolpaths";
-
 struct CompileOptions {
   std::string input;
   std::string output = "-";
-  std::string emit;  ///< feature-ir, toolpath-ir or program; empty: program with --target, else feature-ir
+  std::string emit;  ///< feature-ir, toolpath-ir, motion-ir or program; empty: program with --target, else feature-ir
   bool printLocations = false;
   // compile only: the controller target
   std::string target;
@@ -43,6 +42,7 @@ struct CompileOptions {
   std::optional<double> tolerance;
   std::vector<std::string> targetOptions;
   bool listTargets = false;
+  std::string machine;  ///< for motion-ir and the native target
   // opt only
   std::string passes;
   std::vector<std::string> printAfter;
@@ -53,42 +53,6 @@ struct CompileOptions {
   SchemaOptions schema;
   DiagnosticOptions diag;
 };
-
-// Reads `path` as IR text (a file that starts with the IR's comment line or
-// `project`) or as STEP-NC, which is checked and lowered. Returns null after
-// reporting errors.
-std::unique_ptr<ir::Module> loadModule(const SourceFile &source, const SchemaSelection &schemas,
-                                       DiagnosticEngine &diags, bool &usage) {
-  std::string_view text = source.text();
-  while (!text.empty() && (text[0] == ' ' || text[0] == '\n' || text[0] == '\r' || text[0] == '\t'))
-    text.remove_prefix(1);
-  if (text.starts_with(";") || text.starts_with("project")) {
-    auto module = ir::parseModule(source, diags);
-    if (!module || diags.hasErrors())
-      return nullptr;
-    return module;
-  }
-  auto file = p21::readPart21(source, diags);
-  if (diags.hasErrors())
-    return nullptr;
-  const express::Model *model = nullptr;
-  const express::Schema *schema = schemas.select(*file, diags, model);
-  if (!schema) {
-    printToolError("cannot compile " + std::string(source.name()) +
-                   " without a schema: give its EXPRESS file with --schema FILE.exp");
-    usage = true;
-    return nullptr;
-  }
-  binding::BindOptions bindOptions;
-  bindOptions.lenient = true;
-  auto bound = binding::bind(*file, *model, *schema, diags, bindOptions);
-  if (diags.hasErrors())
-    return nullptr;
-  auto module = lowering::lowerToFeatureIR(*bound, diags);
-  if (!module || diags.hasErrors())
-    return nullptr;
-  return module;
-}
 
 int writeText(const std::string &path, const std::string &text) {
   OutputFile out;
@@ -156,6 +120,15 @@ int runCompile(const CompileOptions &opts) {
       return kExitUsage;
     }
   }
+  const bool needsMotion = emit == "motion-ir" || opts.target == "native";
+  if (needsMotion && opts.machine.empty()) {
+    std::string names;
+    for (const std::string &n : runtime::shippedMachineNames())
+      names += (names.empty() ? "" : ", ") + n;
+    printToolError("compile: " + std::string(emit == "motion-ir" ? "--emit=motion-ir" : "--target=native") +
+                   " plans the motion on a machine: give --machine FILE.toml or a shipped machine (" + names + ")");
+    return kExitUsage;
+  }
   auto source = openInput(opts.input);
   if (!source)
     return kExitUsage;
@@ -176,30 +149,21 @@ int runCompile(const CompileOptions &opts) {
   }
   // The toolpath IR is the feature IR after the passes that make and check
   // moves; a program is written from the toolpath IR.
-  const std::string pipelineText =
+  // The motion IR and the native target add the motion planned on the machine.
+  std::string pipelineText =
       emit != "feature-ir" && opts.passes.empty() ? std::string(kToolpathPipeline) : opts.passes;
-  if (!pipelineText.empty() || opts.listPasses) {
-    std::string error;
-    auto pipeline = passes::parsePipeline(pipelineText, error);
-    if (!pipeline) {
-      printToolError(error);
-      return kExitUsage;
-    }
-    passes::PassManagerOptions pmOptions;
-    pmOptions.verifyEach = opts.verifyEach;
-    pmOptions.printAfterAll = opts.printAfterAll;
-    pmOptions.printAfter.insert(opts.printAfter.begin(), opts.printAfter.end());
-    pmOptions.print = [](std::string_view text) { std::cerr << text; };
-    passes::PassManager manager(std::move(pmOptions));
-    manager.add(*pipeline);
-    const bool ok = manager.run(*module, diags);
-    if (opts.stats)
-      for (const auto &[pass, counters] : manager.stats())
-        for (const auto &[what, n] : counters)
-          std::cerr << "stats: " << pass << ": " << n << ' ' << what << '\n';
-    if (!ok) {
-      std::cerr << "stepnc: the pass pipeline failed on " << opts.input << "; nothing written\n";
-      return kExitDiagnostics;
+  if (opts.passes.empty() && needsMotion)
+    pipelineText += "," + planMotionPipeline(opts.machine, opts.tolerance);
+  if (!pipelineText.empty()) {
+    PipelineRun run;
+    run.verifyEach = opts.verifyEach;
+    run.printAfterAll = opts.printAfterAll;
+    run.printAfter = opts.printAfter;
+    run.stats = opts.stats;
+    if (const int rc = runPipeline(*module, pipelineText, run, diags); rc != kExitOk) {
+      if (rc == kExitDiagnostics)
+        std::cerr << "stepnc: the pass pipeline failed on " << opts.input << "; nothing written\n";
+      return rc;
     }
   }
   if (backend) {
@@ -274,6 +238,68 @@ void addCommonOptions(CLI::App &cmd, const std::shared_ptr<CompileOptions> &opts
 
 } // namespace
 
+std::unique_ptr<ir::Module> loadModule(const SourceFile &source, const SchemaSelection &schemas,
+                                       DiagnosticEngine &diags, bool &usage) {
+  std::string_view text = source.text();
+  while (!text.empty() && (text[0] == ' ' || text[0] == '\n' || text[0] == '\r' || text[0] == '\t'))
+    text.remove_prefix(1);
+  if (text.starts_with(";") || text.starts_with("project")) {
+    auto module = ir::parseModule(source, diags);
+    if (!module || diags.hasErrors())
+      return nullptr;
+    return module;
+  }
+  auto file = p21::readPart21(source, diags);
+  if (diags.hasErrors())
+    return nullptr;
+  const express::Model *model = nullptr;
+  const express::Schema *schema = schemas.select(*file, diags, model);
+  if (!schema) {
+    printToolError("cannot compile " + std::string(source.name()) +
+                   " without a schema: give its EXPRESS file with --schema FILE.exp");
+    usage = true;
+    return nullptr;
+  }
+  binding::BindOptions bindOptions;
+  bindOptions.lenient = true;
+  auto bound = binding::bind(*file, *model, *schema, diags, bindOptions);
+  if (diags.hasErrors())
+    return nullptr;
+  auto module = lowering::lowerToFeatureIR(*bound, diags);
+  if (!module || diags.hasErrors())
+    return nullptr;
+  return module;
+}
+
+std::string planMotionPipeline(const std::string &machine, std::optional<double> tolerance) {
+  std::string text = "plan-motion<machine=" + machine;
+  if (tolerance)
+    text += ",tolerance=" + formatShortest(*tolerance);
+  return text + ">";
+}
+
+int runPipeline(ir::Module &module, const std::string &text, const PipelineRun &run, DiagnosticEngine &diags) {
+  std::string error;
+  auto pipeline = passes::parsePipeline(text, error);
+  if (!pipeline) {
+    printToolError(error);
+    return kExitUsage;
+  }
+  passes::PassManagerOptions pmOptions;
+  pmOptions.verifyEach = run.verifyEach;
+  pmOptions.printAfterAll = run.printAfterAll;
+  pmOptions.printAfter.insert(run.printAfter.begin(), run.printAfter.end());
+  pmOptions.print = [](std::string_view t) { std::cerr << t; };
+  passes::PassManager manager(std::move(pmOptions));
+  manager.add(*pipeline);
+  const bool ok = manager.run(module, diags);
+  if (run.stats)
+    for (const auto &[pass, counters] : manager.stats())
+      for (const auto &[what, n] : counters)
+        std::cerr << "stats: " << pass << ": " << n << ' ' << what << '\n';
+  return ok ? kExitOk : kExitDiagnostics;
+}
+
 void registerOpt(CLI::App &app, std::function<void(int)> setResult) {
   auto opts = std::make_shared<CompileOptions>();
   CLI::App *cmd = app.add_subcommand(
@@ -307,12 +333,16 @@ void registerCompile(CLI::App &app, std::function<void(int)> setResult) {
                  "a controller program for --target (or stop early with --emit). Without --target\n"
                  "the feature IR is written. Nothing is written when the input has errors.");
   cmd->add_option("input", opts->input, "STEP-NC file (Part 21)");
-  cmd->add_option("--target", opts->target, "Controller to write for: siemens-840d, heidenhain-tnc, rs274 "
-                                            "(--list-targets)");
+  cmd->add_option("--target", opts->target, "Controller to write for: siemens-840d, heidenhain-tnc, rs274, "
+                                            "native (--list-targets)");
   cmd->add_option("--emit", opts->emit,
                   "What to write: program (with --target, the default then), feature-ir (the lowered\n"
-                  "process IR; the default without --target) or toolpath-ir (with moves, verified)")
-      ->check(CLI::IsMember({"feature-ir", "toolpath-ir", "program"}));
+                  "process IR; the default without --target), toolpath-ir (with moves, verified) or\n"
+                  "motion-ir (with the motion planned on --machine)")
+      ->check(CLI::IsMember({"feature-ir", "toolpath-ir", "motion-ir", "program"}));
+  cmd->add_option("--machine", opts->machine,
+                  "Machine to plan the motion on, for --target=native and --emit=motion-ir: a TOML\n"
+                  "file (docs/machine-model.md) or a shipped machine (hsc-3axis, conventional-3axis)");
   cmd->add_option("--tool-table", opts->toolTable,
                   "Tool numbers and lengths by STEP-NC tool id (docs/tool-table.md); without one,\n"
                   "tools are numbered in order of first use");

@@ -12,6 +12,7 @@ void registerConvert(CLI::App &app, std::function<void(int)> setResult);
 void registerSchema(CLI::App &app, std::function<void(int)> setResult);
 void registerCompile(CLI::App &app, std::function<void(int)> setResult);
 void registerOpt(CLI::App &app, std::function<void(int)> setResult);
+void registerSim(CLI::App &app, std::function<void(int)> setResult);
 } // namespace stepnc::tool
 
 int main(int argc, char **argv) {
@@ -29,6 +30,7 @@ int main(int argc, char **argv) {
   registerConvert(app, setResult);
   registerSchema(app, setResult);
   registerOpt(app, setResult);
+  registerSim(app, setResult);
   // LLVM spells the pipeline option -passes=...; accept that spelling too.
   std::vector<std::string> rewritten;
   for (int i = 0; i < argc; ++i)

@@ -1,0 +1,262 @@
+#include "passes/MotionIR.h"
+
+#include "passes/MoveWalk.h"
+#include "support/Format.h"
+
+#include <map>
+
+namespace stepnc::passes {
+
+using runtime::PathMove;
+using runtime::Segment;
+using runtime::SegmentKind;
+using runtime::Vec3;
+
+namespace {
+
+void collect(const ir::Node &plan, std::vector<const ir::Node *> &out) {
+  for (const ir::Node &e : plan.children) {
+    if (e.kind == "workplan")
+      collect(e, out);
+    else if (e.kind == "workingstep" || e.kind == "rapid_movement" || e.kind == "program_stop" ||
+             e.kind == "optional_stop")
+      out.push_back(&e);
+  }
+}
+
+std::vector<double> numbers(const Vec3 &v) { return {v.x(), v.y(), v.z()}; }
+
+} // namespace
+
+ProgramPath programPath(const ir::Module &module) {
+  std::vector<const ir::Node *> execs;
+  for (const ir::Node &n : module.root.children)
+    if (n.kind == "workplan")
+      collect(n, execs);
+  ProgramPath out;
+  std::optional<Vec3> position;
+  bool stop = false;
+  std::string tool, setup;
+  std::optional<double> spindle;
+  for (const ir::Node *e : execs) {
+    if (e->kind == "program_stop" || e->kind == "optional_stop") {
+      stop = true;
+      continue;
+    }
+    const ir::Node *moves = e->child("moves");
+    if (!moves)
+      continue;
+    // A change of tool, setup or spindle happens at rest.
+    const std::string t = moves->text("tool").value_or(""), s = moves->text("setup").value_or("");
+    const double sp = moves->number("spindle").value_or(0);
+    if (!out.nodes.empty() && (t != tool || s != setup || !spindle || *spindle != sp))
+      stop = true;
+    tool = t;
+    setup = s;
+    spindle = sp;
+    for (const Move &m : walkMoves(*moves, position)) {
+      if (!position) {
+        out.path.start = m.to;  // the tool starts at rest at the first point named
+        position = m.to;
+      }
+      PathMove pm;
+      pm.kind = m.kind == MoveKind::Arc ? PathMove::Kind::Arc : PathMove::Kind::Line;
+      pm.to = m.to;
+      pm.center = m.center;
+      pm.ccw = m.ccw;
+      pm.turns = m.turns;
+      pm.feed = m.isFeed() ? m.feed : 0;
+      pm.stopBefore = stop;
+      stop = false;
+      out.path.moves.push_back(pm);
+      out.owners.push_back(e);
+      out.nodes.push_back(m.node);
+      position = m.to;
+    }
+  }
+  return out;
+}
+
+void attachMotion(ir::Module &module, const ProgramPath &program, const runtime::Trajectory &trajectory) {
+  // Executables are found by address: collect the mutable nodes in the same order.
+  std::map<const ir::Node *, ir::Node *> mutableOf;
+  std::vector<ir::Node *> stack{&module.root};
+  while (!stack.empty()) {
+    ir::Node *n = stack.back();
+    stack.pop_back();
+    mutableOf[n] = n;
+    for (ir::Node &c : n->children)
+      stack.push_back(&c);
+  }
+  // Old motion goes first.
+  for (auto &[key, node] : mutableOf) {
+    auto &cs = node->children;
+    cs.erase(std::remove_if(cs.begin(), cs.end(), [](const ir::Node &c) { return c.kind == "motion"; }), cs.end());
+  }
+  std::map<const ir::Node *, ir::Node> motions;
+  std::vector<const ir::Node *> order;
+  std::map<const ir::Node *, double> times;
+  for (size_t k = 0; k < trajectory.segments.size(); ++k) {
+    const Segment &seg = trajectory.segments[k];
+    const runtime::SegmentInfo &info = trajectory.info[k];
+    const runtime::Profile &prof = trajectory.profiles[k];
+    const ir::Node *owner = program.owners.at(info.move);
+    auto [it, fresh] = motions.try_emplace(owner, ir::Node("motion"));
+    ir::Node &motion = it->second;
+    if (fresh) {
+      order.push_back(owner);
+      motion.set("machine", ir::Value::string(trajectory.machine));
+      motion.set("tolerance", ir::Value::length(trajectory.tolerance));
+      motion.set("from", ir::Value::reals(numbers(seg.start)));
+    }
+    times[owner] += prof.duration();
+    ir::Node s("motion_segment");
+    s.set("shape", ir::Value::word(seg.kind == SegmentKind::Line  ? "line"
+                                   : seg.kind == SegmentKind::Arc ? "arc"
+                                                                  : "blend"));
+    s.set("to", ir::Value::reals(numbers(seg.end)));
+    if (seg.kind == SegmentKind::Arc) {
+      s.set("center", ir::Value::reals({seg.center.x(), seg.center.y()}));
+      s.set("dir", ir::Value::word(seg.ccw ? "ccw" : "cw"));
+      s.set("sweep", ir::Value::real(seg.sweep));
+    } else if (seg.kind == SegmentKind::Blend) {
+      std::vector<double> pts;
+      for (int i = 1; i <= 4; ++i)
+        for (int c = 0; c < 3; ++c)
+          pts.push_back(seg.ctrl[i][c]);
+      s.set("points", ir::Value::reals(std::move(pts)));
+    }
+    s.set("length", ir::Value::real(seg.length));
+    if (info.feed > 0)
+      s.set("feed", ir::Value::real(info.feed * 60));
+    s.set("move", ir::Value::integer(info.move));
+    if (info.nextMove != info.move)
+      s.set("next", ir::Value::integer(info.nextMove));
+    if (info.stop != runtime::StopReason::None)
+      s.set("stop", ir::Value::word(std::string(runtime::stopReasonName(info.stop))));
+    s.set("limited_by", ir::Value::word(std::string(runtime::speedLimitName(info.limitedBy))));
+    s.set("limits", ir::Value::reals({info.limits.v, info.limits.a, info.limits.j}));
+    s.set("v0", ir::Value::real(prof.v0));
+    std::vector<double> phases;
+    for (const runtime::Phase &ph : prof.phases) {
+      phases.push_back(ph.duration);
+      phases.push_back(ph.jerk);
+    }
+    s.set("phases", ir::Value::reals(std::move(phases)));
+    motion.add(std::move(s));
+  }
+  for (const ir::Node *owner : order) {
+    ir::Node &motion = motions.at(owner);
+    motion.set("time", ir::Value::time(times[owner]));
+    ir::Node *target = mutableOf.at(owner);
+    // After `moves`: the motion follows the moves it was planned from.
+    target->add(std::move(motion));
+  }
+}
+
+std::optional<runtime::Trajectory> readMotion(const ir::Module &module, DiagnosticEngine &diags) {
+  std::vector<const ir::Node *> execs;
+  for (const ir::Node &n : module.root.children)
+    if (n.kind == "workplan")
+      collect(n, execs);
+  runtime::Trajectory out;
+  bool any = false, ok = true;
+  Vec3 at = Vec3::Zero();
+  auto fail = [&](const ir::Node &n, const std::string &message) {
+    diags.error(n.origin.loc, message);
+    ok = false;
+  };
+  auto point = [&](const ir::Node &n, std::string_view name, size_t size) -> std::optional<std::vector<double>> {
+    const ir::Value *v = n.get(name);
+    if (!v || v->type != ir::ValueType::Reals || v->numbers.size() != size) {
+      fail(n, std::string(n.kind) + " needs '" + std::string(name) + "' with " + std::to_string(size) + " numbers");
+      return std::nullopt;
+    }
+    return v->numbers;
+  };
+  for (const ir::Node *e : execs) {
+    const ir::Node *motion = e->child("motion");
+    if (!motion)
+      continue;
+    const auto from = point(*motion, "from", 3);
+    if (!from)
+      continue;
+    const Vec3 start((*from)[0], (*from)[1], (*from)[2]);
+    if (!any) {
+      out.machine = motion->text("machine").value_or("");
+      out.tolerance = motion->number("tolerance").value_or(0);
+      out.start = start;
+      at = start;
+      any = true;
+    } else if ((start - at).norm() > 1e-9) {
+      fail(*motion, "motion starts at " + formatTuple({start.x(), start.y(), start.z()}, 6) +
+                        ", not where the previous motion ended, " + formatTuple({at.x(), at.y(), at.z()}, 6));
+    }
+    for (const ir::Node &s : motion->children) {
+      const auto to = point(s, "to", 3);
+      const auto limits = point(s, "limits", 3);
+      const auto phases = point(s, "phases", 14);
+      if (!to || !limits || !phases)
+        continue;
+      const Vec3 end((*to)[0], (*to)[1], (*to)[2]);
+      const std::string shape = s.text("shape").value_or("");
+      Segment seg;
+      if (shape == "line") {
+        seg = Segment::line(at, end);
+      } else if (shape == "arc") {
+        const auto c = point(s, "center", 2);
+        if (!c || !s.number("sweep") || !s.text("dir")) {
+          fail(s, "an arc segment needs 'center', 'dir' and 'sweep'");
+          continue;
+        }
+        seg = Segment::arc(at, end, Vec3((*c)[0], (*c)[1], 0), s.text("dir") == "ccw", *s.number("sweep"));
+      } else {
+        const auto pts = point(s, "points", 12);
+        if (!pts)
+          continue;
+        std::array<Vec3, 6> ctrl;
+        ctrl[0] = at;
+        ctrl[5] = end;
+        for (int i = 0; i < 4; ++i)
+          ctrl[i + 1] = Vec3((*pts)[3 * i], (*pts)[3 * i + 1], (*pts)[3 * i + 2]);
+        seg = Segment::blend(ctrl);
+      }
+      const double length = s.number("length").value_or(0);
+      if (!(std::abs(seg.length - length) <= 1e-9 * std::max(1.0, length))) {
+        fail(s, "segment length " + formatExact(length) + " mm does not match its geometry (" +
+                    formatExact(seg.length) + " mm)");
+        continue;
+      }
+      runtime::SegmentInfo info;
+      info.feed = s.number("feed").value_or(0) / 60;
+      info.move = uint32_t(s.count("move").value_or(0));
+      info.nextMove = uint32_t(s.count("next").value_or(info.move));
+      const std::string stop = s.text("stop").value_or("none");
+      for (auto r : {runtime::StopReason::Start, runtime::StopReason::Reversal, runtime::StopReason::Tiny,
+                     runtime::StopReason::Program})
+        if (runtime::stopReasonName(r) == stop)
+          info.stop = r;
+      const std::string by = s.text("limited_by").value_or("feed");
+      for (auto l : {runtime::SpeedLimit::Feed, runtime::SpeedLimit::MachineFeed, runtime::SpeedLimit::AxisVelocity,
+                     runtime::SpeedLimit::Acceleration, runtime::SpeedLimit::Jerk})
+        if (runtime::speedLimitName(l) == by)
+          info.limitedBy = l;
+      info.limits = {(*limits)[0], (*limits)[1], (*limits)[2]};
+      runtime::Profile prof;
+      prof.v0 = s.number("v0").value_or(0);
+      for (size_t i = 0; i < prof.phases.size(); ++i)
+        prof.phases[i] = {(*phases)[2 * i], (*phases)[2 * i + 1]};
+      out.segments.push_back(std::move(seg));
+      out.info.push_back(info);
+      out.profiles.push_back(prof);
+      at = end;
+    }
+  }
+  if (!any)
+    diags.error({}, "no motion to play: the IR has no 'motion' nodes (run plan-motion first)");
+  if (!any || !ok)
+    return std::nullopt;
+  return out;
+}
+
+} // namespace stepnc::passes

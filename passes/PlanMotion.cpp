@@ -1,0 +1,76 @@
+// plan-motion: plans the whole program's moves on a machine (runtime/Planner)
+// and writes the trajectory into the IR as `motion` nodes (passes/MotionIR).
+#include "passes/MotionIR.h"
+#include "passes/Pass.h"
+#include "runtime/Machine.h"
+#include "support/Format.h"
+
+namespace stepnc::passes {
+
+namespace {
+
+class PlanMotionPass final : public Pass {
+public:
+  PlanMotionPass(std::string machinePath, std::optional<double> tolerance, std::string error)
+      : machinePath_(std::move(machinePath)), tolerance_(tolerance), error_(std::move(error)) {}
+
+  std::string_view name() const override { return "plan-motion"; }
+
+  PassResult run(ir::Module &module, DiagnosticEngine &diags, PassStats &stats) override {
+    if (!error_.empty()) {
+      diags.error({}, error_);
+      return {false, false};
+    }
+    // Kept for the life of the pass: diagnostics point into it.
+    const auto machine = runtime::loadMachine(machinePath_, machineFile_, diags);
+    if (!machine)
+      return {false, false};
+    const ProgramPath program = programPath(module);
+    if (program.path.moves.empty()) {
+      diags.warning({}, "plan-motion: the program has no moves to plan (run expand-strategies first)");
+      return {true, false};
+    }
+    runtime::PlanOptions options;
+    if (tolerance_)
+      options.tolerance = *tolerance_;
+    const runtime::Trajectory trajectory = runtime::plan(program.path, *machine, options);
+    attachMotion(module, program, trajectory);
+    long long blends = 0, stops = 0;
+    for (size_t k = 0; k < trajectory.segments.size(); ++k) {
+      blends += trajectory.segments[k].kind == runtime::SegmentKind::Blend;
+      stops += trajectory.info[k].stop != runtime::StopReason::None;
+    }
+    stats["moves planned"] = (long long)program.path.moves.size();
+    stats["segments"] = (long long)trajectory.segments.size();
+    stats["blends"] = blends;
+    stats["stops"] = stops;
+    stats["cycle time (ms)"] = (long long)std::llround(trajectory.duration() * 1000);
+    return {true, true};
+  }
+
+private:
+  std::string machinePath_;
+  std::unique_ptr<SourceFile> machineFile_;
+  std::optional<double> tolerance_;
+  std::string error_;
+};
+
+} // namespace
+
+std::unique_ptr<Pass> createPlanMotionPass(const PassOptions &options) {
+  std::string machine, error;
+  std::optional<double> tolerance;
+  if (auto it = options.find("machine"); it != options.end())
+    machine = it->second;
+  else
+    error = "plan-motion needs a machine: plan-motion<machine=FILE> or a shipped machine, plan-motion<machine=hsc-3axis>";
+  if (auto it = options.find("tolerance"); it != options.end()) {
+    tolerance = parseLengthOption(it->second);
+    if (!tolerance)
+      error = "plan-motion: tolerance='" + it->second +
+              "' is not a length: expected a positive number of mm, such as tolerance=0.01";
+  }
+  return std::make_unique<PlanMotionPass>(std::move(machine), tolerance, std::move(error));
+}
+
+} // namespace stepnc::passes

@@ -1,0 +1,40 @@
+// What `compile`, `opt` and `sim` share: reading an input into the IR and
+// running a pass pipeline over it.
+#pragma once
+
+#include "ir/Node.h"
+#include "support/Diagnostics.h"
+#include "support/SourceFile.h"
+#include "tools/stepnc/SchemaSelection.h"
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace stepnc::tool {
+
+/// What `compile --emit=toolpath-ir` runs.
+inline constexpr std::string_view kToolpathPipeline = "resolve-feeds,expand-strategies,verify-toolpaths";
+
+/// The plan-motion pass for a machine (file or shipped name) and tolerance.
+std::string planMotionPipeline(const std::string &machine, std::optional<double> tolerance);
+
+/// Reads `source` as IR text (a file that starts with the IR's comment line
+/// or `project`) or as STEP-NC, which is checked and lowered. Returns null
+/// after reporting errors; `usage` is set when the command line is at fault.
+std::unique_ptr<ir::Module> loadModule(const SourceFile &source, const SchemaSelection &schemas,
+                                       DiagnosticEngine &diags, bool &usage);
+
+struct PipelineRun {
+  bool verifyEach = false;
+  bool printAfterAll = false;
+  std::vector<std::string> printAfter;
+  bool stats = false;  ///< print each pass's counters to stderr
+};
+
+/// Runs the pipeline `text` over `module`. Returns the exit code: kExitOk,
+/// kExitUsage for a bad pipeline, kExitDiagnostics when a pass fails.
+int runPipeline(ir::Module &module, const std::string &text, const PipelineRun &run, DiagnosticEngine &diags);
+
+} // namespace stepnc::tool

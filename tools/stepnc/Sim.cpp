@@ -1,0 +1,176 @@
+// `stepnc sim IN`: plays a program on a machine with the reference player
+// (runtime/Player.h) and reports its cycle time, the feed it actually
+// reaches, where and why it is slower, and any limit it breaks. IN may be the
+// native format, IR text (with motion, or moves to plan) or STEP-NC (compiled
+// to moves and planned first).
+#include "passes/MotionIR.h"
+#include "runtime/Machine.h"
+#include "runtime/NativeFormat.h"
+#include "runtime/Player.h"
+#include "support/Format.h"
+#include "support/OutputFile.h"
+#include "tools/stepnc/Compile.h"
+#include "tools/stepnc/Driver.h"
+
+#include <CLI/CLI.hpp>
+#include <iostream>
+
+namespace stepnc::tool {
+
+namespace {
+
+constexpr std::string_view kDefaultMachine = "hsc-3axis";
+
+struct SimCommandOptions {
+  std::string input;
+  std::string machine;
+  std::optional<double> tolerance;
+  std::optional<double> period;
+  std::string samples;  ///< CSV of every sample
+  std::string output = "-";
+  SchemaOptions schema;
+  DiagnosticOptions diag;
+};
+
+std::string label(const ir::Node &e) {
+  std::string s = e.kind + " " + e.symbol;
+  if (!e.label.empty())
+    s += " \"" + e.label + "\"";
+  return s;
+}
+
+int runSim(const SimCommandOptions &opts) {
+  auto source = openInput(opts.input);
+  if (!source)
+    return kExitUsage;
+  DiagnosticSession session(opts.diag);
+  DiagnosticEngine &diags = session.engine();
+  std::unique_ptr<SourceFile> machineFile;
+  const std::string machineName = opts.machine.empty() ? std::string(kDefaultMachine) : opts.machine;
+  const auto machine = runtime::loadMachine(machineName, machineFile, diags);
+  if (!machine)
+    return kExitUsage;
+
+  std::optional<runtime::Trajectory> trajectory;
+  std::unique_ptr<ir::Module> module;
+  std::optional<passes::ProgramPath> program;
+  if (source->text().starts_with("STEPNC-MOTION")) {
+    trajectory = runtime::readNative(*source, diags);
+  } else {
+    SchemaSelection schemas(opts.schema);
+    bool usage = false;
+    if (!schemas.load(diags, usage))
+      return usage ? kExitUsage : kExitDiagnostics;
+    module = loadModule(*source, schemas, diags, usage);
+    if (!module)
+      return usage ? kExitUsage : kExitDiagnostics;
+    // Whatever the input lacks is made: moves, then the motion.
+    bool hasMoves = false, hasMotion = false;
+    std::vector<const ir::Node *> stack{&module->root};
+    while (!stack.empty()) {
+      const ir::Node *n = stack.back();
+      stack.pop_back();
+      hasMoves |= n->kind == "moves";
+      hasMotion |= n->kind == "motion";
+      for (const ir::Node &c : n->children)
+        stack.push_back(&c);
+    }
+    std::string pipeline;
+    if (!hasMoves)
+      pipeline = std::string(kToolpathPipeline) + ",";
+    if (!hasMotion || opts.tolerance)
+      pipeline += planMotionPipeline(machineName, opts.tolerance);
+    else if (!pipeline.empty())
+      pipeline.pop_back();
+    if (!pipeline.empty())
+      if (const int rc = runPipeline(*module, pipeline, {}, diags); rc != kExitOk)
+        return rc;
+    trajectory = passes::readMotion(*module, diags);
+    program = passes::programPath(*module);
+  }
+  if (!trajectory || diags.hasErrors()) {
+    std::cerr << "stepnc: cannot simulate " << opts.input << '\n';
+    return kExitDiagnostics;
+  }
+  if (!trajectory->machine.empty() && trajectory->machine != machine->name)
+    diags.warning({}, "the motion was planned for \"" + trajectory->machine + "\" and is played on \"" +
+                          machine->name + "\"");
+
+  runtime::SimOptions simOptions;
+  if (opts.period)
+    simOptions.period = *opts.period;
+  if (program)
+    simOptions.programmed = &program->path;
+  if (opts.tolerance)
+    simOptions.tolerance = *opts.tolerance;
+
+  OutputFile samplesOut;
+  std::string error;
+  std::function<void(const runtime::Sample &)> onSample;
+  if (!opts.samples.empty()) {
+    if (!samplesOut.open(opts.samples, error)) {
+      printToolError(error);
+      return kExitUsage;
+    }
+    samplesOut.write("t_s,segment,x_mm,y_mm,z_mm,vx_mm_s,vy_mm_s,vz_mm_s,ax_mm_s2,ay_mm_s2,az_mm_s2,jx_mm_s3,jy_mm_s3,"
+                     "jz_mm_s3,speed_mm_s\n");
+    onSample = [&](const runtime::Sample &s) {
+      std::string line = formatFixed(s.t, 6) + "," + std::to_string(s.segment);
+      for (const runtime::Vec3 *v : {&s.p, &s.v, &s.a, &s.j})
+        for (int k = 0; k < 3; ++k)
+          line += "," + formatFixed((*v)[k], 6);
+      line += "," + formatFixed(s.speed, 6) + "\n";
+      samplesOut.write(line);
+    };
+  }
+  const runtime::SimReport report = runtime::simulate(*trajectory, *machine, simOptions, onSample);
+  auto nameMove = [&](uint32_t move) -> std::string {
+    if (!program || move >= program->owners.size())
+      return "move " + std::to_string(move);
+    // The move's place within its executable, counted from 1 as a reader counts lines.
+    uint32_t first = move;
+    while (first > 0 && program->owners[first - 1] == program->owners[move])
+      --first;
+    return label(*program->owners[move]) + ", move " + std::to_string(move - first + 1);
+  };
+  const std::string text = runtime::formatReport(report, *trajectory, *machine, nameMove);
+  if (!opts.samples.empty() && !samplesOut.commit(error)) {
+    printToolError(error);
+    return kExitUsage;
+  }
+  OutputFile out;
+  if (!out.open(opts.output, error)) {
+    printToolError(error);
+    return kExitUsage;
+  }
+  out.write(text);
+  if (!out.commit(error)) {
+    printToolError(error);
+    return kExitUsage;
+  }
+  return report.violationCount == 0 ? kExitOk : kExitDiagnostics;
+}
+
+} // namespace
+
+void registerSim(CLI::App &app, std::function<void(int)> setResult) {
+  auto opts = std::make_shared<SimCommandOptions>();
+  CLI::App *cmd = app.add_subcommand(
+      "sim", "Play a program on a machine at the controller cycle and report its cycle time,\n"
+             "the feed it reaches (where and why it is slower than programmed) and every limit\n"
+             "it breaks. IN is native motion, IR text or STEP-NC (planned first). Exit code 1\n"
+             "when a limit is broken.");
+  cmd->add_option("input", opts->input, "Native motion file, IR text or STEP-NC file")->required();
+  cmd->add_option("--machine", opts->machine,
+                  "Machine: a TOML file (docs/machine-model.md) or a shipped machine (hsc-3axis, the\n"
+                  "default, or conventional-3axis)");
+  cmd->add_option("--tolerance", opts->tolerance, "Path tolerance for blending and the deviation check, mm");
+  cmd->add_option("--period", opts->period, "Sampling period, s (default: the machine's cycle time)");
+  cmd->add_option("--samples", opts->samples, "Write every sample (position, velocity, acceleration, jerk) as CSV");
+  cmd->add_option("-o,--output", opts->output, "Report file ('-', the default, for standard output)");
+  addSchemaOptions(*cmd, opts->schema);
+  addDiagnosticOptions(*cmd, opts->diag);
+  cmd->callback([opts, setResult] { setResult(runSim(*opts)); });
+}
+
+} // namespace stepnc::tool
