@@ -1,6 +1,9 @@
 #include "runtime/Planner.h"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
+#include <optional>
 #include <cmath>
 #include <limits>
 
@@ -32,6 +35,10 @@ struct Piece {
   uint32_t move = 0;
   bool stopBefore = false;
   double cutStart = 0, cutEnd = 0;  ///< mm taken by blends at either end
+  /// A line wholly taken by the blends at its ends, inside a chain of short
+  /// lines: the curvature the two blends share at its middle (see
+  /// smoothChains).
+  std::optional<Vec3> midCurvature;
 };
 
 /// Distance from p to the part [s0, s1] of a line or arc; for helices an
@@ -59,8 +66,7 @@ double distanceTo(const Segment &seg, double s0, double s1, const Vec3 &p) {
 /// A quintic joining a's point at s = a.length - la to b's at lb, matching
 /// tangent and curvature at both ends (quintic Hermite, end derivatives
 /// scaled by the chord).
-std::array<Vec3, 6> blendPoints(const Segment &a, double la, const Segment &b, double lb) {
-  const PathPoint p0 = a.at(a.length - la), p1 = b.at(lb);
+std::array<Vec3, 6> blendPoints(const PathPoint &p0, const PathPoint &p1) {
   const double m = (p1.p - p0.p).norm();
   std::array<Vec3, 6> c;
   c[0] = p0.p;
@@ -70,6 +76,10 @@ std::array<Vec3, 6> blendPoints(const Segment &a, double la, const Segment &b, d
   c[4] = c[5] - p1.r1 * (m / 5);
   c[3] = 2 * c[4] - c[5] + p1.r2 * (m * m / 20);
   return c;
+}
+
+std::array<Vec3, 6> blendPoints(const Segment &a, double la, const Segment &b, double lb) {
+  return blendPoints(a.at(a.length - la), b.at(lb));
 }
 
 /// How far a blend strays from the two pieces it replaces (sampled along
@@ -205,6 +215,90 @@ void limitsFor(const Segment &seg, double feed, const Machine &machine, SegmentI
   info.limitedBy = by;
 }
 
+/// The curvature vector of the circle through the vertex between lines a and
+/// b and the vertices before and after it; zero when either is not a line.
+Vec3 vertexCurvature(const Piece &a, const Piece &b) {
+  if (a.seg.kind != SegmentKind::Line || b.seg.kind != SegmentKind::Line)
+    return Vec3::Zero();
+  const Vec3 ta = (a.seg.end - a.seg.start) / a.seg.length, tb = (b.seg.end - b.seg.start) / b.seg.length;
+  const Vec3 turn = tb - ta;
+  const double chord = (a.seg.end - a.seg.start + b.seg.end - b.seg.start).norm();
+  const double sinTurn = ta.cross(tb).norm();
+  if (turn.norm() <= 0 || chord <= 0)
+    return Vec3::Zero();
+  return turn.normalized() * (2 * sinTurn / chord);
+}
+
+/// Dense polylines (CAM output, a curve as many short lines) would become
+/// a chain of blends whose curvature falls to zero at every line's middle,
+/// the lines' own curvature, and rises again: the jerk that takes holds the
+/// speed far below the feed. Where a line is wholly taken by its two blends,
+/// nothing needs zero curvature there: both blends are made again sharing
+/// the curvature of the curve the vertices describe (the mean of the circles
+/// through the neighbouring vertices). A remade blend that leaves the
+/// tolerance is given back its zero-curvature ends, and so is its neighbour
+/// across each such middle, until every blend is within tolerance and every
+/// middle's two blends agree.
+void smoothChains(std::vector<Piece> &pieces, std::vector<Junction> &joins, double tolerance) {
+  const size_t n = pieces.size();
+  auto consumed = [&](size_t i) {
+    const Piece &p = pieces[i];
+    return p.seg.kind == SegmentKind::Line && i > 0 && i + 1 < n && joins[i].blended && joins[i + 1].blended &&
+           std::abs(p.cutStart + p.cutEnd - p.seg.length) <= 1e-12 * p.seg.length;
+  };
+  for (size_t i = 0; i < n; ++i) {
+    if (!consumed(i))
+      continue;
+    const Vec3 t = (pieces[i].seg.end - pieces[i].seg.start) / pieces[i].seg.length;
+    Vec3 k = (vertexCurvature(pieces[i - 1], pieces[i]) + vertexCurvature(pieces[i], pieces[i + 1])) / 2;
+    k -= t * k.dot(t);  // normal to the line, as curvature is
+    pieces[i].midCurvature = k;
+  }
+  // The end of a blend: the piece's own point, with the shared curvature at
+  // a smoothed middle.
+  auto endPoint = [&](const Piece &p, double s) {
+    PathPoint pt = p.seg.at(s);
+    if (p.midCurvature)
+      pt.r2 = *p.midCurvature;
+    return pt;
+  };
+  const double target = tolerance * kToleranceShare;
+  const std::vector<Junction> original = joins;  // every blend in it is within tolerance
+  std::vector<char> pending(n, 0);
+  for (size_t j = 1; j < n; ++j)
+    pending[j] = joins[j].blended && (pieces[j - 1].midCurvature || pieces[j].midCurvature);
+  for (bool again = true; again;) {
+    again = false;
+    for (size_t j = 1; j < n; ++j) {
+      if (!pending[j])
+        continue;
+      pending[j] = 0;
+      Piece &a = pieces[j - 1], &b = pieces[j];
+      if (!a.midCurvature && !b.midCurvature) {
+        joins[j].blend = original[j].blend;
+        continue;
+      }
+      const double la = a.cutEnd, lb = b.cutStart;
+      const std::array<Vec3, 6> ctrl = blendPoints(endPoint(a, a.seg.length - la), endPoint(b, lb));
+      if (blendDeviation(ctrl, a.seg, la, b.seg, lb) <= target) {
+        joins[j].blend = Segment::blend(ctrl);
+        continue;
+      }
+      // Back to zero curvature at both ends; the blends across those
+      // middles are made again to match.
+      for (size_t side : {j - 1, j}) {
+        if (!pieces[side].midCurvature)
+          continue;
+        pieces[side].midCurvature.reset();
+        pending[side] = 1;          // the blend at the piece's start
+        if (side + 1 < n)
+          pending[side + 1] = 1;    // and at its end
+        again = true;
+      }
+    }
+  }
+}
+
 } // namespace
 
 Trajectory plan(const PathInput &input, const Machine &machine, const PlanOptions &options) {
@@ -242,6 +336,7 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   std::vector<Junction> joins(pieces.size());
   for (size_t i = 1; i < pieces.size(); ++i)
     joins[i] = join(pieces[i - 1], pieces[i], tolerance);
+  smoothChains(pieces, joins, tolerance);
 
   // 3. Segments with their caps; `atRest[k]`: segment k starts at rest.
   std::vector<char> atRest;
