@@ -328,6 +328,7 @@ std::vector<KindSpec> makeTable() {
         {"limited_by", T::Word, true, "feed machine_feed axis_velocity acceleration jerk"},
         {"limits", T::Reals, true},
         {"v0", T::Real, true},
+        {"a0", T::Real},
         {"phases", T::Reals, true}},
        {}});
   return t;

@@ -137,6 +137,8 @@ void attachMotion(ir::Module &module, const ProgramPath &program, const runtime:
     s.set("limited_by", ir::Value::word(std::string(runtime::speedLimitName(info.limitedBy))));
     s.set("limits", ir::Value::reals({info.limits.v, info.limits.a, info.limits.j}));
     s.set("v0", ir::Value::real(prof.v0));
+    if (prof.a0 != 0)
+      s.set("a0", ir::Value::real(prof.a0));
     std::vector<double> phases;
     for (const runtime::Phase &ph : prof.phases) {
       phases.push_back(ph.duration);
@@ -244,6 +246,7 @@ std::optional<runtime::Trajectory> readMotion(const ir::Module &module, Diagnost
       info.limits = {(*limits)[0], (*limits)[1], (*limits)[2]};
       runtime::Profile prof;
       prof.v0 = s.number("v0").value_or(0);
+      prof.a0 = s.number("a0").value_or(0);
       for (size_t i = 0; i < prof.phases.size(); ++i)
         prof.phases[i] = {(*phases)[2 * i], (*phases)[2 * i + 1]};
       out.segments.push_back(std::move(seg));

@@ -141,6 +141,7 @@ std::string writeNative(const Trajectory &trajectory, const std::string &source)
     appendNumbers(out, {info.limits.v, info.limits.a, info.limits.j});
     out += " limited_by " + std::string(speedLimitName(info.limitedBy));
     out += " v0 " + number(prof.v0);
+    out += " a0 " + number(prof.a0);
     // All seven phases, empty ones too: the profile reads back slot for slot.
     out += " phases " + std::to_string(prof.phases.size());
     for (const Phase &ph : prof.phases)
@@ -206,7 +207,7 @@ private:
   bool header(Trajectory &t);
   void segment(Trajectory &t, bool first);
   void recoverEnd();
-  void checkProfile(const Profile &prof, double length, bool first, uint64_t v0At, uint64_t phasesAt);
+  void checkProfile(const Profile &prof, double length, bool first, uint64_t v0At, uint64_t a0At, uint64_t phasesAt);
 
   const SourceFile &file_;
   DiagnosticEngine &diags_;
@@ -221,9 +222,10 @@ private:
 
   uint32_t announced_ = 0;  ///< the header's segment count
   Vec3 at_ = Vec3::Zero();  ///< where the next segment starts
-  /// The speed the previous segment ends at; NaN after a segment that could
-  /// not be read (its speeds are not compared).
+  /// The speed and acceleration the previous segment ends with; NaN after a
+  /// segment that could not be read (they are not compared).
   double v1_ = 0;
+  double a1_ = 0;
   uint64_t lastPhasesAt_ = 0;  ///< the last segment's `phases`, for the end-at-rest check
 };
 
@@ -570,6 +572,9 @@ void Reader::segment(Trajectory &t, bool first) {
   keyword("v0");
   prof.v0 = nonNegative("the start speed v0");
   const uint64_t v0At = last_;
+  keyword("a0");
+  prof.a0 = real("the start acceleration a0");
+  const uint64_t a0At = last_;
   keyword("phases");
   const uint64_t phasesAt = last_;
   const uint32_t phases = integer("the number of phases");
@@ -626,19 +631,24 @@ void Reader::segment(Trajectory &t, bool first) {
                        formatFixed(seg.length, 9) + " mm)");
   seg.length = length;
 
-  // The profile: continuous speed, zero end acceleration, the whole length.
+  // The profile: continuous speed and acceleration, the whole length.
   if (ok_)
-    checkProfile(prof, length, first, v0At, phasesAt);
+    checkProfile(prof, length, first, v0At, a0At, phasesAt);
   if (ok_ && info.stop != StopReason::None && prof.v0 > kAbsTolerance)
     fail(v0At, "a segment that stops first (stop " + std::string(stopReasonName(info.stop)) +
                    ") must start at rest, not at v0 " + number(prof.v0));
+  if (ok_ && info.stop != StopReason::None && std::abs(prof.a0) > kAbsTolerance)
+    fail(a0At, "a segment that stops first (stop " + std::string(stopReasonName(info.stop)) +
+                   ") must start at rest, not with acceleration a0 " + number(prof.a0));
   lastPhasesAt_ = phasesAt;
   if (!ok_) {
     recoverEnd();
     v1_ = std::nan("");
+    a1_ = std::nan("");
     return;
   }
   v1_ = prof.v1();
+  a1_ = prof.a1();
   t.segments.push_back(seg);
   t.profiles.push_back(prof);
   t.info.push_back(info);
@@ -663,11 +673,26 @@ void Reader::recoverEnd() {
   }
 }
 
-/// A profile must pick up the speed the previous segment ends at, end with
-/// zero acceleration (so the next one can start its own profile without a
-/// jump) and cover the segment's length: a player that trusts it then never
-/// jumps in position, speed or acceleration.
-void Reader::checkProfile(const Profile &prof, double length, bool first, uint64_t v0At, uint64_t phasesAt) {
+/// The highest |acceleration| a profile reaches (at a phase boundary: it is
+/// linear within a phase), the scale of what rounding leaves of a difference
+/// in acceleration that should be zero.
+double accelScale(const Profile &prof) {
+  double a = prof.a0, scale = std::abs(a);
+  for (const Phase &ph : prof.phases) {
+    a += ph.jerk * ph.duration;
+    scale = std::max(scale, std::abs(a));
+  }
+  return scale;
+}
+
+/// A profile must pick up the speed and the acceleration the previous
+/// segment ends with (the first starts at rest) and cover the segment's
+/// length: a player that trusts it then never jumps in position, speed or
+/// acceleration. Only the last must end with zero acceleration (read()): a
+/// profile planned over a run of short segments is cut into slices that end
+/// where the next one starts.
+void Reader::checkProfile(const Profile &prof, double length, bool first, uint64_t v0At, uint64_t a0At,
+                          uint64_t phasesAt) {
   const double before = std::isnan(v1_) ? 0 : v1_;
   // What rounding may leave of a difference that should be zero, at this
   // profile's scale of speed and of acceleration.
@@ -678,13 +703,13 @@ void Reader::checkProfile(const Profile &prof, double length, bool first, uint64
                            formatFixed(v1_, 9) + " mm/s");
     return;
   }
-  double a = 0, accelScale = 0;
-  for (const Phase &ph : prof.phases) {
-    a += ph.jerk * ph.duration;
-    accelScale += std::abs(ph.jerk * ph.duration);
-  }
-  if (std::abs(a) > kRelTolerance * accelScale + kAbsTolerance) {
-    fail(phasesAt, "the profile ends with acceleration " + formatFixed(a, 9) + " mm/s^2; it must end with 0");
+  const double accelBefore = std::isnan(a1_) ? 0 : std::abs(a1_);
+  const double accelSlack = kRelTolerance * std::max(accelScale(prof), accelBefore) + kAbsTolerance;
+  if (!std::isnan(a1_) && std::abs(prof.a0 - a1_) > accelSlack) {
+    fail(a0At, first ? "a0 " + number(prof.a0) + " mm/s^2: the first segment starts at rest, with zero acceleration"
+                     : "a0 " + number(prof.a0) +
+                           " mm/s^2 does not continue the previous segment, which ends with acceleration " +
+                           formatFixed(a1_, 9) + " mm/s^2");
     return;
   }
   const double covered = prof.at(prof.duration()).s;
@@ -699,6 +724,7 @@ std::optional<Trajectory> Reader::read() {
     return std::nullopt;
   at_ = t.start;
   v1_ = 0;  // the trajectory starts at rest
+  a1_ = 0;
   uint32_t seen = 0;
   for (;;) {
     if (diags_.limitReached())
@@ -728,9 +754,13 @@ std::optional<Trajectory> Reader::read() {
   if (nextLine())
     fail(words_[0].offset, "unexpected '" + shown(words_[0].text) + "' after 'end'");
   if (!anyError_ && !std::isnan(v1_) && seen > 0) {
-    const double slack = kRelTolerance * t.profiles.back().peak() + kAbsTolerance;
-    if (std::abs(v1_) > slack)
+    // At rest: zero speed and zero acceleration.
+    const Profile &last = t.profiles.back();
+    if (std::abs(v1_) > kRelTolerance * last.peak() + kAbsTolerance)
       fail(lastPhasesAt_, "the last segment ends at " + formatFixed(v1_, 9) + " mm/s; a trajectory ends at rest");
+    else if (std::abs(a1_) > kRelTolerance * accelScale(last) + kAbsTolerance)
+      fail(lastPhasesAt_, "the last segment ends with acceleration " + formatFixed(a1_, 9) +
+                              " mm/s^2; a trajectory ends at rest");
   }
   if (anyError_)
     return std::nullopt;

@@ -28,6 +28,8 @@ constexpr double kReversal = 179.0 * 3.14159265358979323846 / 180.0;
 constexpr double kTinyBlend = 1e-6;
 /// Share of the tolerance blends use; sampled deviations may miss a little.
 constexpr double kToleranceShare = 0.9;
+/// Segments whose caps differ by more than this factor are not one run.
+constexpr double kRunCapSpread = 0.8;
 
 struct Piece {
   Segment seg;
@@ -244,7 +246,7 @@ void smoothChains(std::vector<Piece> &pieces, std::vector<Junction> &joins, doub
   auto consumed = [&](size_t i) {
     const Piece &p = pieces[i];
     return p.seg.kind == SegmentKind::Line && i > 0 && i + 1 < n && joins[i].blended && joins[i + 1].blended &&
-           std::abs(p.cutStart + p.cutEnd - p.seg.length) <= 1e-12 * p.seg.length;
+           p.seg.length - p.cutStart - p.cutEnd <= 1e-9;  // what is left is dropped (plan, step 3)
   };
   for (size_t i = 0; i < n; ++i) {
     if (!consumed(i))
@@ -378,24 +380,72 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
     }
   }
 
-  // 4. Junction speeds: caps, then backward and forward look-ahead.
+  // 4. Runs: consecutive segments too short to reach their caps on their
+  // own, none starting at rest, with caps within kRunCapSpread of each other,
+  // share one profile planned over their total length with the least of
+  // their limits (each member's bounds then hold) and cut at the members'
+  // ends: speed changes spread over many short segments instead of each
+  // starting and ending with zero acceleration.
   const size_t n = out.segments.size();
-  std::vector<double> vj(n + 1, 0.0);
-  for (size_t k = 1; k < n; ++k)
-    vj[k] = atRest[k] ? 0 : std::min(out.info[k - 1].limits.v, out.info[k].limits.v);
-  for (size_t k = n; k-- > 0;) {
-    const PathLimits &lim = out.info[k].limits;
-    vj[k] = std::min(vj[k], reachableSpeed(vj[k + 1], out.segments[k].length, lim.a, lim.j));
-  }
-  for (size_t k = 0; k < n; ++k) {
-    const PathLimits &lim = out.info[k].limits;
-    vj[k + 1] = std::min(vj[k + 1], reachableSpeed(vj[k], out.segments[k].length, lim.a, lim.j));
+  struct Run {
+    size_t first = 0, last = 0;
+    double length = 0;
+    PathLimits limits;
+  };
+  auto isShort = [&](size_t k) {
+    const PathLimits &l = out.info[k].limits;
+    return out.segments[k].length < rampDistance(0, l.v, l.a, l.j);
+  };
+  std::vector<Run> runs;
+  for (size_t k = 0; k < n;) {
+    Run r;
+    r.first = r.last = k;
+    r.length = out.segments[k].length;
+    r.limits = out.info[k].limits;
+    double highest = r.limits.v;
+    if (isShort(k)) {
+      while (r.last + 1 < n && !atRest[r.last + 1] && isShort(r.last + 1)) {
+        const PathLimits &l = out.info[r.last + 1].limits;
+        if (std::min(r.limits.v, l.v) < kRunCapSpread * std::max(highest, l.v))
+          break;
+        ++r.last;
+        r.length += out.segments[r.last].length;
+        highest = std::max(highest, l.v);
+        r.limits = {std::min(r.limits.v, l.v), std::min(r.limits.a, l.a), std::min(r.limits.j, l.j)};
+      }
+    }
+    runs.push_back(r);
+    k = r.last + 1;
   }
 
-  // 5. Profiles.
+  // 5. Speeds where runs meet: caps, then backward and forward look-ahead.
+  const size_t m = runs.size();
+  std::vector<double> vj(m + 1, 0.0);
+  for (size_t r = 1; r < m; ++r)
+    vj[r] = atRest[runs[r].first] ? 0 : std::min(runs[r - 1].limits.v, runs[r].limits.v);
+  for (size_t r = m; r-- > 0;)
+    vj[r] = std::min(vj[r], reachableSpeed(vj[r + 1], runs[r].length, runs[r].limits.a, runs[r].limits.j));
+  for (size_t r = 0; r < m; ++r)
+    vj[r + 1] = std::min(vj[r + 1], reachableSpeed(vj[r], runs[r].length, runs[r].limits.a, runs[r].limits.j));
+
+  // 6. Profiles: one per run, cut at its members' ends.
   out.profiles.reserve(n);
-  for (size_t k = 0; k < n; ++k)
-    out.profiles.push_back(planProfile(vj[k], vj[k + 1], out.segments[k].length, out.info[k].limits));
+  for (size_t r = 0; r < m; ++r) {
+    const Run &run = runs[r];
+    const Profile whole = planProfile(vj[r], vj[r + 1], run.length, run.limits);
+    if (run.first == run.last) {
+      out.profiles.push_back(whole);
+      continue;
+    }
+    double t0 = 0, along = 0;
+    for (size_t k = run.first; k <= run.last; ++k) {
+      along += out.segments[k].length;
+      const double t1 = k == run.last ? whole.duration() : whole.timeAt(along);
+      out.profiles.push_back(whole.slice(t0, t1));
+      out.info[k].limits = run.limits;
+      t0 = t1;
+    }
+  }
   return out;
 }
 

@@ -5,16 +5,20 @@
 //     change of direction or of curvature, both are cut back and joined by a
 //     quintic blend that matches position, tangent and curvature at each end
 //     and stays within the path tolerance; where the path turns back on
-//     itself the tool stops instead.
+//     itself the tool stops instead. Chains of short lines keep the curve's
+//     curvature at each line's middle.
 //  2. Speed caps. Each segment gets the highest speed, and the path
 //     acceleration and jerk, that keep every axis within its limits given
 //     the segment's direction, curvature and change of curvature, and never
 //     above the programmed feed.
-//  3. Look-ahead. A backward then a forward pass over the whole path bound
-//     the speed at each junction by what the neighbouring segments can reach
+//  3. Runs. Consecutive segments too short to reach their caps on their
+//     own, with similar caps, share one profile (the least of their limits),
+//     cut at their ends; elsewhere a segment is a run of its own.
+//  4. Look-ahead. A backward then a forward pass over the whole path bound
+//     the speed where runs meet by what the neighbouring runs can reach
 //     with jerk-limited speed changes (closed forms, Profile.h).
-//  4. Profiles. Each segment gets its fastest seven-phase profile between its
-//     junction speeds, with zero acceleration at both ends.
+//  5. Profiles. Each run gets its fastest seven-phase profile between those
+//     speeds, with zero acceleration at both ends.
 #pragma once
 
 #include "runtime/Machine.h"

@@ -13,7 +13,7 @@ double Profile::duration() const {
 }
 
 PathState Profile::at(double t) const {
-  PathState st{0, v0, 0, 0};
+  PathState st{0, v0, a0, 0};
   if (t <= 0) {
     st.j = phases[0].jerk;
     return st;
@@ -35,7 +35,7 @@ PathState Profile::at(double t) const {
 }
 
 double Profile::v1() const {
-  double v = v0, a = 0;
+  double v = v0, a = a0;
   for (const Phase &ph : phases) {
     v += a * ph.duration + ph.jerk * ph.duration * ph.duration / 2;
     a += ph.jerk * ph.duration;
@@ -44,15 +44,78 @@ double Profile::v1() const {
 }
 
 double Profile::peak() const {
-  // Speed is extreme only where acceleration is zero, which in these
-  // profiles is at phase boundaries.
-  double v = v0, a = 0, best = v0;
+  // Speed is extreme at the phase boundaries or where the acceleration
+  // passes zero inside a phase (slices of a run may start mid-phase).
+  double v = v0, a = a0, best = v0;
   for (const Phase &ph : phases) {
+    if (ph.jerk != 0) {
+      const double t = -a / ph.jerk;
+      if (t > 0 && t < ph.duration)
+        best = std::max(best, v + a * t + ph.jerk * t * t / 2);
+    }
     v += a * ph.duration + ph.jerk * ph.duration * ph.duration / 2;
     a += ph.jerk * ph.duration;
     best = std::max(best, v);
   }
   return best;
+}
+
+double Profile::a1() const {
+  double a = a0;
+  for (const Phase &ph : phases)
+    a += ph.jerk * ph.duration;
+  return a;
+}
+
+double Profile::timeAt(double target) const {
+  double t = 0, s = 0, v = v0, a = a0;
+  for (const Phase &ph : phases) {
+    const double d = ph.duration, j = ph.jerk;
+    if (d <= 0)
+      continue;
+    const double sEnd = s + v * d + a * d * d / 2 + j * d * d * d / 6;
+    if (target <= sEnd) {
+      // s is non-decreasing here: Newton inside a shrinking bracket.
+      double lo = 0, hi = d, x = v > 0 ? std::min(d, (target - s) / v) : d / 2;
+      for (int it = 0; it < 100 && hi - lo > 1e-15 * (t + d); ++it) {
+        const double f = s + v * x + a * x * x / 2 + j * x * x * x / 6 - target;
+        if (f < 0)
+          lo = x;
+        else
+          hi = x;
+        const double df = v + a * x + j * x * x / 2;
+        double next = df > 0 ? x - f / df : (lo + hi) / 2;
+        if (!(next > lo && next < hi))
+          next = (lo + hi) / 2;
+        if (f == 0)
+          break;
+        x = next;
+      }
+      return t + x;
+    }
+    s = sEnd;
+    v += a * d + j * d * d / 2;
+    a += j * d;
+    t += d;
+  }
+  return t;
+}
+
+Profile Profile::slice(double t0, double t1) const {
+  const PathState start = at(t0);
+  Profile out;
+  out.v0 = start.v;
+  out.a0 = start.a;
+  double begin = 0;
+  size_t k = 0;
+  for (const Phase &ph : phases) {
+    const double end = begin + ph.duration;
+    const double from = std::max(begin, t0), to = std::min(end, t1);
+    if (to > from && k < out.phases.size())
+      out.phases[k++] = {to - from, ph.jerk};
+    begin = end;
+  }
+  return out;
 }
 
 double rampTime(double dv, double a, double j) {

@@ -3,7 +3,9 @@
 // planner's profiles have seven (jerk +J, 0, -J to accelerate, a cruise, then
 // -J, 0, +J to slow down), some of them empty, and end with zero
 // acceleration. Zero acceleration at both ends is what lets the next segment
-// start its own profile without a jump in acceleration.
+// start its own profile without a jump in acceleration. A profile planned
+// over a run of short segments is cut into slices, one per segment, that
+// start and end with the acceleration the whole has there.
 //
 // The closed forms (REFERENCES: jerk-limited speed change with zero end
 // accelerations): a change dv takes T = dv/A + A/J when dv >= A^2/J, else
@@ -30,6 +32,10 @@ struct PathState {
 
 struct Profile {
   double v0 = 0;  ///< mm/s at the start
+  /// mm/s^2 at the start: zero, except for a slice of a profile planned
+  /// over a run of short segments (Planner.h), which starts where the
+  /// previous slice ended.
+  double a0 = 0;
   std::array<Phase, 7> phases{};
 
   double duration() const;
@@ -37,6 +43,14 @@ struct Profile {
   PathState at(double t) const;
   /// The speed at the end.
   double v1() const;
+  /// The acceleration at the end.
+  double a1() const;
+  /// The time at which the profile has covered distance s (clamped to the
+  /// profile; the first such time where it dwells at zero speed).
+  double timeAt(double s) const;
+  /// The part of this profile from time t0 to t1: it starts with the speed
+  /// and acceleration the whole has at t0.
+  Profile slice(double t0, double t1) const;
   /// The highest speed reached.
   double peak() const;
 };

@@ -7,13 +7,13 @@ import math
 import sys
 
 KEYS = {"to", "center", "radius", "start_angle", "sweep", "dir", "ctrl", "length", "programmed_feed",
-        "move", "next", "stop", "limits", "limited_by", "v0", "phases"}
+        "move", "next", "stop", "limits", "limited_by", "v0", "a0", "phases"}
 GX = (0.0, -0.5384693101056831, 0.5384693101056831, -0.906179845938664, 0.906179845938664)
 GW = (0.5688888888888889, 0.4786286704993665, 0.4786286704993665, 0.2369268850561891, 0.2369268850561891)
 
 
-def distance(v0, phases, t):  # s(t): constant jerk per phase, from v0 with zero acceleration
-    s, v, a = 0.0, v0, 0.0
+def distance(v0, a0, phases, t):  # s(t): constant jerk per phase, from speed v0 and acceleration a0
+    s, v, a = 0.0, v0, a0
     for d, j in phases:
         d = max(0.0, min(t, d))
         s, v, a, t = s + v * d + a * d * d / 2 + j * d ** 3 / 6, v + a * d + j * d * d / 2, a + j * d, t - d
@@ -41,10 +41,10 @@ def point(seg, s):
         return [p + (q - p) * s / length for p, q in zip(a, b)]
     if kind == "arc":
         (cx, cy), r = map(float, f["center"]), float(f["radius"][0])
-        sweep, a0 = float(f["sweep"][0]), float(f["start_angle"][0])
+        sweep, phi0 = float(f["sweep"][0]), float(f["start_angle"][0])
         rise = (b[2] - a[2]) / sweep  # mm per radian
         theta = s / math.hypot(r, rise)
-        phi = a0 + (theta if f["dir"][0] == "ccw" else -theta)
+        phi = phi0 + (theta if f["dir"][0] == "ccw" else -theta)
         return [cx + r * math.cos(phi), cy + r * math.sin(phi), a[2] + rise * theta]
     c = [float(x) for x in f["ctrl"]]
     P = [a] + [c[i:i + 3] for i in range(0, 12, 3)] + [b]
@@ -81,7 +81,7 @@ def main(path):
         phases = list(zip(ph[0::2], ph[1::2]))
         t1 = t0 + sum(d for d, _ in phases)
         while k * cycle < t1:
-            p = point(seg, distance(float(f["v0"][0]), phases, k * cycle - t0))
+            p = point(seg, distance(float(f["v0"][0]), float(f["a0"][0]), phases, k * cycle - t0))
             print(fmt(k * cycle), *map(fmt, p))
             k += 1
         t0, at = t1, [float(x) for x in f["to"]]

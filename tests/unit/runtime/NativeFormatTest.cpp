@@ -3,6 +3,8 @@
 // reported at its line and column.
 #include "runtime/NativeFormat.h"
 
+#include "support/Format.h"
+
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -75,6 +77,42 @@ Trajectory sample() {
   return t;
 }
 
+/// Three lines along one direction that share one profile planned over
+/// their whole length, cut into slices: the first two end, and the last two
+/// start, with the acceleration the whole has at the cuts (positive while
+/// speeding up, negative while slowing down).
+Trajectory sliced() {
+  Trajectory t;
+  t.machine = "M";
+  t.tolerance = 0.01;
+  t.cycleTime = 0.001;
+  t.start = Vec3(0.1, -0.2, 1.0 / 3);
+  const PathLimits limits{25.0 / 3, 1500.5, 20000.25};
+  const Profile whole = planProfile(0, 0, 12.3, limits);
+  // Within the first phase (acceleration rising from zero) and the last
+  // (acceleration returning to zero from below): neither cut is at zero.
+  const double tc = whole.phases[0].duration / 3, tc2 = whole.duration() - whole.phases[6].duration / 3;
+  const Vec3 dir = Vec3(3, 4, 1.0 / 7).normalized();
+  Vec3 at = t.start;
+  const Profile slices[] = {whole.slice(0, tc), whole.slice(tc, tc2), whole.slice(tc2, whole.duration())};
+  for (size_t i = 0; i < 3; ++i) {
+    const Profile &p = slices[i];
+    const Vec3 end = at + dir * p.at(p.duration()).s;
+    t.segments.push_back(Segment::line(at, end));
+    t.profiles.push_back(p);
+    SegmentInfo info;
+    info.limits = limits;
+    info.limitedBy = SpeedLimit::Acceleration;
+    info.feed = 1000.0 / 60;
+    info.move = 2;
+    info.nextMove = 2;
+    info.stop = i == 0 ? StopReason::Start : StopReason::None;
+    t.info.push_back(info);
+    at = end;
+  }
+  return t;
+}
+
 void requireSame(const Trajectory &a, const Trajectory &b) {
   CHECK(a.machine == b.machine);
   CHECK(a.tolerance == b.tolerance);
@@ -101,6 +139,7 @@ void requireSame(const Trajectory &a, const Trajectory &b) {
     }
     const Profile &p = a.profiles[i], &q = b.profiles[i];
     CHECK(p.v0 == q.v0);
+    CHECK(p.a0 == q.a0);
     for (size_t k = 0; k < p.phases.size(); ++k) {
       CHECK(p.phases[k].duration == q.phases[k].duration);
       CHECK(p.phases[k].jerk == q.phases[k].jerk);
@@ -129,7 +168,7 @@ const std::string kSmall = "STEPNC-MOTION 1\n"
                            "start 0 0 0\n"
                            "segments 1\n"
                            "line to 3 4 0 length 5 programmed_feed 2.5 move 0 next 0 stop start limits 2 4 2 "
-                           "limited_by acceleration v0 0 phases 7 1 2 0 0 1 -2 0.5 0 1 -2 0 0 1 2\n"
+                           "limited_by acceleration v0 0 a0 0 phases 7 1 2 0 0 1 -2 0.5 0 1 -2 0 0 1 2\n"
                            "end\n";
 
 std::string replaced(const std::string &text, const std::string &from, const std::string &to) {
@@ -164,6 +203,24 @@ TEST_CASE("a trajectory reads back value for value and byte for byte", "[native]
   CHECK_FALSE(r.trajectory->segments[2].ccw);
   CHECK(r.trajectory->segments[3].arcTable.back() > 0);
   CHECK(r.trajectory->profiles[1].phases[1].jerk == -1.25e-20);
+}
+
+TEST_CASE("slices of one profile read back with their start acceleration", "[native]") {
+  const Trajectory t = sliced();
+  REQUIRE(t.profiles[1].a0 > 1);
+  REQUIRE(t.profiles[2].a0 < -1);
+  CHECK(t.profiles[0].a1() == t.profiles[1].a0);
+  const std::string text = writeNative(t, "run");
+  INFO(text);
+  CHECK(text.find(" v0 0 a0 0 phases 7 ") != std::string::npos);  // the first starts at rest
+  CHECK(text.find(" a0 -") != std::string::npos);  // the last starts braking
+  Read r = read(text);
+  REQUIRE(r.errors.empty());
+  REQUIRE(r.trajectory);
+  requireSame(t, *r.trajectory);
+  CHECK(r.trajectory->profiles[1].a0 == t.profiles[1].a0);
+  CHECK(r.trajectory->profiles[2].a0 == t.profiles[2].a0);
+  CHECK(writeNative(*r.trajectory, "run") == text);
 }
 
 TEST_CASE("native numbers are plain decimals, never -0 or exponents", "[native]") {
@@ -243,18 +300,26 @@ TEST_CASE("native format mistakes are located", "[native]") {
         "10:1: unknown segment kind 'circle' (known: line, arc, blend)");
   CHECK(error(replaced(kSmall, "stop start", "stop halt")) ==
         "10:63: unknown stop reason 'halt' (known: none, start, reversal, tiny, program)");
-  CHECK(error(replaced(kSmall, " 1 2\n", " 1 2 3\n")) == "10:152: unexpected '3' after the last phase");
+  CHECK(error(replaced(kSmall, " 1 2\n", " 1 2 3\n")) == "10:157: unexpected '3' after the last phase");
   CHECK(error(replaced(kSmall, " 1 2\n", " 1\n")) ==
-        "10:149: the line ends where a phase's jerk should follow");
+        "10:154: the line ends where a phase's jerk should follow");
   // A length the geometry does not have.
   CHECK(error(replaced(kSmall, "length 5 ", "length 5.1 ")) ==
         "10:22: length 5.1 does not match the line's geometry (5.000000000 mm)");
   // Profiles that would make a player jump.
   CHECK(error(replaced(kSmall, "phases 7 1 2 0 0 1 -2 0.5 0", "phases 7 1 2 0 0 1 -2 0.6 0")) ==
-        "10:111: the profile covers 5.200000000 mm, not the segment's length 5 mm");
+        "10:116: the profile covers 5.200000000 mm, not the segment's length 5 mm");
   CHECK(error(replaced(kSmall, "v0 0", "v0 0.5")) == "10:109: v0 0.5 mm/s: the first segment starts at rest");
-  CHECK(error(replaced(kSmall, " 1 2\n", " 1 2.5\n")) ==
-        "10:111: the profile ends with acceleration 0.500000000 mm/s^2; it must end with 0");
+  CHECK(error(replaced(kSmall, "a0 0 ", "a0 0.5 ")) ==
+        "10:114: a0 0.5 mm/s^2: the first segment starts at rest, with zero acceleration");
+  CHECK(error(replaced(kSmall, "a0 0 ", "a0 ")) ==
+        "10:114: expected the start acceleration a0 (a decimal number such as -12.5, without exponent), found "
+        "'phases'");
+  // Ending at zero speed is not enough: the last segment ends with zero
+  // acceleration too (here it brakes at -2 mm/s^2 to the end, with a longer
+  // cruise to make up the length).
+  CHECK(error(replaced(kSmall, " 0.5 0 1 -2 0 0 1 2\n", " 0.5416666666666666 0 1 -2 0 0 0.5 0\n")) ==
+        "10:116: the last segment ends with acceleration -2.000000000 mm/s^2; a trajectory ends at rest");
   // Strings.
   CHECK(error(replaced(kSmall, "\nmachine \"M\"", "\nmachine \"M")) == "5:9: the string has no closing quote");
   CHECK(error(replaced(kSmall, "\nmachine \"M\"", "\nmachine \"M\\q\"")) ==
@@ -321,4 +386,39 @@ TEST_CASE("native segments join in speed", "[native]") {
   REQUIRE(two.errors.size() == 2);
   CHECK(two.errors[0] == "10:1: unknown segment kind 'lime' (known: line, arc, blend)");
   CHECK(two.errors[1] == "13:7: expected 'to', found 'too'");
+}
+
+TEST_CASE("native segments join in acceleration", "[native]") {
+  const Trajectory good = sliced();
+  REQUIRE(read(writeNative(good, "p")).errors.empty());
+  // The middle slice starting from zero acceleration: a jump of a0 at line 11.
+  Trajectory jump = good;
+  jump.profiles[1].a0 = 0;
+  const std::string e = error(writeNative(jump, "p"));
+  INFO(e);
+  CHECK(e.rfind("11:", 0) == 0);
+  CHECK(e.find("a0 0 mm/s^2 does not continue the previous segment, which ends with acceleration " +
+               formatFixed(good.profiles[0].a1(), 9) + " mm/s^2") != std::string::npos);
+  // Reported at the a0 value.
+  const std::string text = writeNative(jump, "p");
+  const size_t line11 = text.find("\nline", text.find("\nline") + 1) + 1;
+  CHECK(e.rfind("11:" + std::to_string(text.find(" a0 ", line11) + 5 - line11) + ": ", 0) == 0);
+  // Cut short after a slice that ends braking: still at speed, reported
+  // at the last segment's phases.
+  Trajectory cut = good;
+  cut.segments.pop_back();
+  cut.profiles.pop_back();
+  cut.info.pop_back();
+  const std::string unfinished = error(writeNative(cut, "p"));
+  INFO(unfinished);
+  CHECK(unfinished.rfind("11:", 0) == 0);
+  CHECK(unfinished.find("the last segment ends at ") != std::string::npos);
+  // A segment that stops first must start at rest: the speed is reported
+  // before the acceleration.
+  Trajectory stops = good;
+  stops.info[1].stop = StopReason::Reversal;
+  const std::string stopError = error(writeNative(stops, "p"));
+  CHECK(stopError.rfind("11:", 0) == 0);
+  CHECK(stopError.find("a segment that stops first (stop reversal) must start at rest, not at v0 ") !=
+        std::string::npos);
 }
