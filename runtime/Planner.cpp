@@ -43,27 +43,55 @@ struct Piece {
   std::optional<Vec3> midCurvature;
 };
 
-/// Distance from p to the part [s0, s1] of a line or arc; for helices an
-/// upper bound (a point of the helix at p's angle).
-double distanceTo(const Segment &seg, double s0, double s1, const Vec3 &p) {
-  if (seg.kind == SegmentKind::Line) {
-    const PathPoint a = seg.at(s0);
-    const double s = std::clamp((p - a.p).dot(a.r1), 0.0, s1 - s0);
-    return (a.p + a.r1 * s - p).norm();
+/// The part [s0, s1] of a line or arc, ready for many distance queries.
+/// Distances to helices are an upper bound (a point of the helix at the
+/// query's angle).
+class PartDistance {
+public:
+  PartDistance(const Segment &seg, double s0, double s1) {
+    first_ = seg.at(s0).p;
+    last_ = seg.at(s1).p;
+    line_ = seg.kind == SegmentKind::Line;
+    if (line_) {
+      dir_ = seg.length > 0 ? Vec3((seg.end - seg.start) / seg.length) : Vec3::Zero();
+      span_ = s1 - s0;
+      return;
+    }
+    const double rise = seg.sweep > 0 ? (seg.end.z() - seg.start.z()) / seg.sweep : 0;
+    const double k = std::sqrt(seg.radius * seg.radius + rise * rise);
+    sigma_ = seg.ccw ? 1 : -1;
+    t0_ = s0 / k;
+    t1_ = s1 / k;
+    centre_ = seg.center;
+    radius_ = seg.radius;
+    startAngle_ = seg.startAngle;
+    z0_ = seg.start.z();
+    rise_ = rise;
   }
-  // Arc: the angle of p about the axis, taken into the swept range.
-  const double rise = seg.sweep > 0 ? (seg.end.z() - seg.start.z()) / seg.sweep : 0;
-  const double k = std::sqrt(seg.radius * seg.radius + rise * rise);
-  const double sigma = seg.ccw ? 1 : -1;
-  double theta = sigma * (std::atan2(p.y() - seg.center.y(), p.x() - seg.center.x()) - seg.startAngle);
-  const double turn = 2 * 3.14159265358979323846;
-  const double t0 = s0 / k, t1 = s1 / k;
-  theta = t0 + std::fmod(std::fmod(theta - t0, turn) + turn, turn);  // the first at or after t0
-  double best = std::min((seg.at(s0).p - p).norm(), (seg.at(s1).p - p).norm());
-  for (double t = theta; t <= t1; t += turn)
-    best = std::min(best, (seg.at(t * k).p - p).norm());
-  return best;
-}
+
+  double operator()(const Vec3 &p) const {
+    if (line_) {
+      const double s = std::clamp((p - first_).dot(dir_), 0.0, span_);
+      return (first_ + dir_ * s - p).norm();
+    }
+    constexpr double kTurn = 2 * 3.14159265358979323846;
+    double best = std::min((first_ - p).norm(), (last_ - p).norm());
+    // The angle of p about the axis, from the part's start, taken into [0, 2 pi).
+    double theta = sigma_ * (std::atan2(p.y() - centre_.y(), p.x() - centre_.x()) - startAngle_) - t0_;
+    theta -= kTurn * std::floor(theta / kTurn);
+    for (double t = t0_ + theta; t <= t1_; t += kTurn) {
+      const double phi = startAngle_ + sigma_ * t;
+      const Vec3 q(centre_.x() + radius_ * std::cos(phi), centre_.y() + radius_ * std::sin(phi), z0_ + rise_ * t);
+      best = std::min(best, (q - p).norm());
+    }
+    return best;
+  }
+
+private:
+  Vec3 first_, last_, dir_ = Vec3::Zero(), centre_ = Vec3::Zero();
+  bool line_ = true;
+  double span_ = 0, sigma_ = 1, t0_ = 0, t1_ = 0, radius_ = 0, startAngle_ = 0, z0_ = 0, rise_ = 0;
+};
 
 /// A quintic joining a's point at s = a.length - la to b's at lb, matching
 /// tangent and curvature at both ends (quintic Hermite, end derivatives
@@ -89,10 +117,11 @@ std::array<Vec3, 6> blendPoints(const Segment &a, double la, const Segment &b, d
 double blendDeviation(const std::array<Vec3, 6> &ctrl, const Segment &a, double la, const Segment &b, double lb) {
   constexpr int kSamples = 24;
   const QuinticCurve curve(ctrl);
+  const PartDistance toA(a, a.length - la, a.length), toB(b, 0, lb);
   double worst = 0;
   for (int i = 1; i < kSamples; ++i) {
     const Vec3 p = curve.point(double(i) / kSamples);
-    worst = std::max(worst, std::min(distanceTo(a, a.length - la, a.length, p), distanceTo(b, 0, lb, p)));
+    worst = std::max(worst, std::min(toA(p), toB(p)));
   }
   return worst;
 }
