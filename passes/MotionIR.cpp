@@ -3,6 +3,7 @@
 #include "passes/MoveWalk.h"
 #include "support/Format.h"
 
+#include <algorithm>
 #include <map>
 
 namespace stepnc::passes {
@@ -14,31 +15,17 @@ using runtime::Vec3;
 
 namespace {
 
-void collect(const ir::Node &plan, std::vector<const ir::Node *> &out) {
-  for (const ir::Node &e : plan.children) {
-    if (e.kind == "workplan")
-      collect(e, out);
-    else if (e.kind == "workingstep" || e.kind == "rapid_movement" || e.kind == "program_stop" ||
-             e.kind == "optional_stop")
-      out.push_back(&e);
-  }
-}
-
 std::vector<double> numbers(const Vec3 &v) { return {v.x(), v.y(), v.z()}; }
 
 } // namespace
 
 ProgramPath programPath(const ir::Module &module) {
-  std::vector<const ir::Node *> execs;
-  for (const ir::Node &n : module.root.children)
-    if (n.kind == "workplan")
-      collect(n, execs);
   ProgramPath out;
   std::optional<Vec3> position;
   bool stop = false;
   std::string tool, setup;
   std::optional<double> spindle;
-  for (const ir::Node *e : execs) {
+  for (const ir::Node *e : programOrder(module)) {
     if (e->kind == "program_stop" || e->kind == "optional_stop") {
       stop = true;
       continue;
@@ -78,19 +65,12 @@ ProgramPath programPath(const ir::Module &module) {
 }
 
 void attachMotion(ir::Module &module, const ProgramPath &program, const runtime::Trajectory &trajectory) {
-  // Executables are found by address: collect the mutable nodes in the same order.
-  std::map<const ir::Node *, ir::Node *> mutableOf;
-  std::vector<ir::Node *> stack{&module.root};
-  while (!stack.empty()) {
-    ir::Node *n = stack.back();
-    stack.pop_back();
-    mutableOf[n] = n;
-    for (ir::Node &c : n->children)
-      stack.push_back(&c);
-  }
-  // Old motion goes first.
-  for (auto &[key, node] : mutableOf) {
-    auto &cs = node->children;
+  // The owners point into `module`, which is ours to change. Old motion
+  // goes first; only children of executables change, so the owners stay
+  // valid (the move nodes of `program` do not).
+  auto mutableNode = [](const ir::Node *n) { return const_cast<ir::Node *>(n); };
+  for (const ir::Node *e : programOrder(module)) {
+    auto &cs = mutableNode(e)->children;
     cs.erase(std::remove_if(cs.begin(), cs.end(), [](const ir::Node &c) { return c.kind == "motion"; }), cs.end());
   }
   std::map<const ir::Node *, ir::Node> motions;
@@ -150,17 +130,12 @@ void attachMotion(ir::Module &module, const ProgramPath &program, const runtime:
   for (const ir::Node *owner : order) {
     ir::Node &motion = motions.at(owner);
     motion.set("time", ir::Value::time(times[owner]));
-    ir::Node *target = mutableOf.at(owner);
     // After `moves`: the motion follows the moves it was planned from.
-    target->add(std::move(motion));
+    mutableNode(owner)->add(std::move(motion));
   }
 }
 
 std::optional<runtime::Trajectory> readMotion(const ir::Module &module, DiagnosticEngine &diags) {
-  std::vector<const ir::Node *> execs;
-  for (const ir::Node &n : module.root.children)
-    if (n.kind == "workplan")
-      collect(n, execs);
   runtime::Trajectory out;
   bool any = false, ok = true;
   Vec3 at = Vec3::Zero();
@@ -168,7 +143,7 @@ std::optional<runtime::Trajectory> readMotion(const ir::Module &module, Diagnost
     diags.error(n.origin.loc, message);
     ok = false;
   };
-  auto point = [&](const ir::Node &n, std::string_view name, size_t size) -> std::optional<std::vector<double>> {
+  auto numbersOf = [&](const ir::Node &n, std::string_view name, size_t size) -> std::optional<std::vector<double>> {
     const ir::Value *v = n.get(name);
     if (!v || v->type != ir::ValueType::Reals || v->numbers.size() != size) {
       fail(n, std::string(n.kind) + " needs '" + std::string(name) + "' with " + std::to_string(size) + " numbers");
@@ -176,11 +151,11 @@ std::optional<runtime::Trajectory> readMotion(const ir::Module &module, Diagnost
     }
     return v->numbers;
   };
-  for (const ir::Node *e : execs) {
+  for (const ir::Node *e : programOrder(module)) {
     const ir::Node *motion = e->child("motion");
     if (!motion)
       continue;
-    const auto from = point(*motion, "from", 3);
+    const auto from = numbersOf(*motion, "from", 3);
     if (!from)
       continue;
     const Vec3 start((*from)[0], (*from)[1], (*from)[2]);
@@ -195,9 +170,9 @@ std::optional<runtime::Trajectory> readMotion(const ir::Module &module, Diagnost
                         ", not where the previous motion ended, " + formatTuple({at.x(), at.y(), at.z()}, 6));
     }
     for (const ir::Node &s : motion->children) {
-      const auto to = point(s, "to", 3);
-      const auto limits = point(s, "limits", 3);
-      const auto phases = point(s, "phases", 14);
+      const auto to = numbersOf(s, "to", 3);
+      const auto limits = numbersOf(s, "limits", 3);
+      const auto phases = numbersOf(s, "phases", 14);
       if (!to || !limits || !phases)
         continue;
       const Vec3 end((*to)[0], (*to)[1], (*to)[2]);
@@ -206,14 +181,14 @@ std::optional<runtime::Trajectory> readMotion(const ir::Module &module, Diagnost
       if (shape == "line") {
         seg = Segment::line(at, end);
       } else if (shape == "arc") {
-        const auto c = point(s, "center", 2);
+        const auto c = numbersOf(s, "center", 2);
         if (!c || !s.number("sweep") || !s.text("dir")) {
           fail(s, "an arc segment needs 'center', 'dir' and 'sweep'");
           continue;
         }
         seg = Segment::arc(at, end, Vec3((*c)[0], (*c)[1], 0), s.text("dir") == "ccw", *s.number("sweep"));
       } else {
-        const auto pts = point(s, "points", 12);
+        const auto pts = numbersOf(s, "points", 12);
         if (!pts)
           continue;
         std::array<Vec3, 6> ctrl;
@@ -233,16 +208,10 @@ std::optional<runtime::Trajectory> readMotion(const ir::Module &module, Diagnost
       info.feed = s.number("feed").value_or(0) / 60;
       info.move = uint32_t(s.count("move").value_or(0));
       info.nextMove = uint32_t(s.count("next").value_or(info.move));
-      const std::string stop = s.text("stop").value_or("none");
-      for (auto r : {runtime::StopReason::Start, runtime::StopReason::Reversal, runtime::StopReason::Tiny,
-                     runtime::StopReason::Program})
-        if (runtime::stopReasonName(r) == stop)
-          info.stop = r;
-      const std::string by = s.text("limited_by").value_or("feed");
-      for (auto l : {runtime::SpeedLimit::Feed, runtime::SpeedLimit::MachineFeed, runtime::SpeedLimit::AxisVelocity,
-                     runtime::SpeedLimit::Acceleration, runtime::SpeedLimit::Jerk})
-        if (runtime::speedLimitName(l) == by)
-          info.limitedBy = l;
+      // The kind table allows only the names these read.
+      info.stop = runtime::stopReasonNamed(s.text("stop").value_or("none")).value_or(runtime::StopReason::None);
+      info.limitedBy =
+          runtime::speedLimitNamed(s.text("limited_by").value_or("feed")).value_or(runtime::SpeedLimit::Feed);
       info.limits = {(*limits)[0], (*limits)[1], (*limits)[2]};
       runtime::Profile prof;
       prof.v0 = s.number("v0").value_or(0);

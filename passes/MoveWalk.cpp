@@ -98,6 +98,28 @@ std::vector<geom::Seg> Move::planar() const {
   return segs;
 }
 
+namespace {
+
+void collectExecutables(const ir::Node &plan, std::vector<const ir::Node *> &out) {
+  for (const ir::Node &e : plan.children) {
+    if (e.kind == "workplan")
+      collectExecutables(e, out);
+    else if (e.kind == "workingstep" || e.kind == "rapid_movement" || e.kind == "program_stop" ||
+             e.kind == "optional_stop" || e.kind == "display_message")
+      out.push_back(&e);
+  }
+}
+
+} // namespace
+
+std::vector<const ir::Node *> programOrder(const ir::Module &module) {
+  std::vector<const ir::Node *> out;
+  for (const ir::Node &n : module.root.children)
+    if (n.kind == "workplan")
+      collectExecutables(n, out);
+  return out;
+}
+
 std::vector<Move> walkMoves(const ir::Node &moves, std::optional<ir::Vec3> start) {
   std::vector<Move> out;
   std::optional<ir::Vec3> at = start;

@@ -42,4 +42,9 @@ struct Move {
 /// where the tool is before the first one, when known).
 std::vector<Move> walkMoves(const ir::Node &moves, std::optional<ir::Vec3> start = std::nullopt);
 
+/// The executables the machine runs, in program order: every workingstep,
+/// rapid movement, program stop, optional stop and display message of the
+/// module's workplans, nested workplans flattened where they stand.
+std::vector<const ir::Node *> programOrder(const ir::Module &module);
+
 } // namespace stepnc::passes

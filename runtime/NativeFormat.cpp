@@ -34,26 +34,13 @@ constexpr double kRelTolerance = 1e-6;
 /// mm/s^2), where a relative bound means nothing.
 constexpr double kAbsTolerance = 1e-9;
 
-constexpr SpeedLimit kSpeedLimits[] = {SpeedLimit::Feed, SpeedLimit::MachineFeed, SpeedLimit::AxisVelocity,
-                                       SpeedLimit::Acceleration, SpeedLimit::Jerk};
-constexpr StopReason kStopReasons[] = {StopReason::None, StopReason::Start, StopReason::Reversal, StopReason::Tiny,
-                                       StopReason::Program};
 
 // ---------------------------------------------------------------------------
 // Writing
 
-/// The shortest fixed-point text that reads back as `v` (to_chars in fixed
-/// format without a precision), so no exponent and no lost bits; `-0` is
-/// written as 0. The longest such text has 327 characters (-4.9e-324 written
-/// out); values that large or small never occur in a trajectory but must not
-/// overflow the buffer either.
-std::string number(double v) {
-  if (v == 0)
-    v = 0;  // folds -0
-  char buf[400];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v, std::chars_format::fixed);
-  return std::string(buf, r.ptr);
-}
+/// Numbers are written exactly: the shortest fixed-point text that reads
+/// back as the same double, no exponent, no -0.
+std::string number(double v) { return formatExact(v); }
 
 /// A string in double quotes: `\` and `"` escaped with a backslash, control
 /// characters as `\xHH`, so the name stays on its line whatever it holds.

@@ -3,9 +3,9 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
-#include <optional>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 namespace stepnc::runtime {
 
@@ -294,7 +294,6 @@ void smoothChains(std::vector<Piece> &pieces, std::vector<Junction> &joins, doub
     return pt;
   };
   const double target = tolerance * kToleranceShare;
-  const std::vector<Junction> original = joins;  // every blend in it is within tolerance
   std::vector<char> pending(n, 0);
   for (size_t j = 1; j < n; ++j)
     pending[j] = joins[j].blended && (pieces[j - 1].midCurvature || pieces[j].midCurvature);
@@ -306,7 +305,8 @@ void smoothChains(std::vector<Piece> &pieces, std::vector<Junction> &joins, doub
       pending[j] = 0;
       Piece &a = pieces[j - 1], &b = pieces[j];
       if (!a.midCurvature && !b.midCurvature) {
-        joins[j].blend = original[j].blend;
+        // Zero-curvature ends again: the blend join() made and checked.
+        joins[j].blend = Segment::blend(blendPoints(a.seg, a.cutEnd, b.seg, b.cutStart));
         continue;
       }
       const double la = a.cutEnd, lb = b.cutStart;
@@ -369,8 +369,7 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
     joins[i] = join(pieces[i - 1], pieces[i], tolerance);
   smoothChains(pieces, joins, tolerance);
 
-  // 3. Segments with their caps; `atRest[k]`: segment k starts at rest.
-  std::vector<char> atRest;
+  // 3. Segments with their caps.
   auto push = [&](Segment seg, double feed, uint32_t move, uint32_t next, StopReason stop) {
     SegmentInfo info;
     info.feed = feed;
@@ -380,7 +379,6 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
     limitsFor(seg, feed, machine, info);
     out.segments.push_back(std::move(seg));
     out.info.push_back(info);
-    atRest.push_back(stop != StopReason::None);
   };
   out.segments.reserve(pieces.size() * 2);
   out.info.reserve(pieces.size() * 2);
@@ -433,7 +431,7 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
     r.limits = out.info[k].limits;
     double highest = r.limits.v;
     if (isShort(k)) {
-      while (r.last + 1 < n && !atRest[r.last + 1] && isShort(r.last + 1)) {
+      while (r.last + 1 < n && out.info[r.last + 1].stop == StopReason::None && isShort(r.last + 1)) {
         const PathLimits &l = out.info[r.last + 1].limits;
         if (std::min(r.limits.v, l.v) < kRunCapSpread * std::max(highest, l.v))
           break;
@@ -451,7 +449,7 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   const size_t m = runs.size();
   std::vector<double> vj(m + 1, 0.0);
   for (size_t r = 1; r < m; ++r)
-    vj[r] = atRest[runs[r].first] ? 0 : std::min(runs[r - 1].limits.v, runs[r].limits.v);
+    vj[r] = out.info[runs[r].first].stop != StopReason::None ? 0 : std::min(runs[r - 1].limits.v, runs[r].limits.v);
   for (size_t r = m; r-- > 0;)
     vj[r] = std::min(vj[r], reachableSpeed(vj[r + 1], runs[r].length, runs[r].limits.a, runs[r].limits.j));
   for (size_t r = 0; r < m; ++r)

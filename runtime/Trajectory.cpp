@@ -35,6 +35,20 @@ std::string_view stopReasonName(StopReason reason) {
   return "none";
 }
 
+std::optional<SpeedLimit> speedLimitNamed(std::string_view name) {
+  for (SpeedLimit l : kSpeedLimits)
+    if (speedLimitName(l) == name)
+      return l;
+  return std::nullopt;
+}
+
+std::optional<StopReason> stopReasonNamed(std::string_view name) {
+  for (StopReason r : kStopReasons)
+    if (stopReasonName(r) == name)
+      return r;
+  return std::nullopt;
+}
+
 double Trajectory::duration() const {
   double t = 0;
   for (const Profile &p : profiles)

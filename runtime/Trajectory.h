@@ -7,6 +7,7 @@
 #include "runtime/Segment.h"
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -22,7 +23,10 @@ enum class SpeedLimit : uint8_t {
   Acceleration,  ///< an axis's acceleration limit on the segment's curvature
   Jerk,          ///< an axis's jerk limit on the segment's curvature or its change
 };
+inline constexpr SpeedLimit kSpeedLimits[] = {SpeedLimit::Feed, SpeedLimit::MachineFeed, SpeedLimit::AxisVelocity,
+                                              SpeedLimit::Acceleration, SpeedLimit::Jerk};
 std::string_view speedLimitName(SpeedLimit limit);  ///< the word in files: "axis_velocity"
+std::optional<SpeedLimit> speedLimitNamed(std::string_view name);
 /// For people: "an axis's velocity limit".
 std::string_view speedLimitDescription(SpeedLimit limit);
 
@@ -34,7 +38,10 @@ enum class StopReason : uint8_t {
   Tiny,      ///< the pieces are too short to blend within tolerance
   Program,   ///< a tool change, a change of setup or spindle, a stop in the program
 };
+inline constexpr StopReason kStopReasons[] = {StopReason::None, StopReason::Start, StopReason::Reversal,
+                                              StopReason::Tiny, StopReason::Program};
 std::string_view stopReasonName(StopReason reason);
+std::optional<StopReason> stopReasonNamed(std::string_view name);
 
 struct SegmentInfo {
   PathLimits limits;                    ///< v, a, j along the path used to plan it

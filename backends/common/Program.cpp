@@ -92,12 +92,11 @@ public:
   std::optional<Program> build() {
     program_.name = module_.root.label.empty() ? module_.root.symbol : module_.root.label;
     program_.toolsFromTable = table_ != nullptr;
-    for (const ir::Node &n : module_.root.children) {
+    for (const ir::Node &n : module_.root.children)
       if (n.kind == "workpiece" && !program_.blank)
         blank(n);
-      if (n.kind == "workplan")
-        workplan(n);
-    }
+    for (const ir::Node *e : passes::programOrder(module_))
+      executable(*e);
     if (!ok_)
       return std::nullopt;
     return std::move(program_);
@@ -120,28 +119,22 @@ private:
                                Vec3(box.hi.x(), box.hi.y(), frame.frame->z + size.z()));
   }
 
-  void workplan(const ir::Node &plan) {
-    for (const ir::Node &e : plan.children) {
-      if (e.kind == "workplan") {
-        workplan(e);
-      } else if (e.kind == "display_message") {
-        Step s;
-        s.kind = Step::Kind::Message;
-        s.exec = &e;
-        s.label = e.text("message").value_or("");
-        program_.steps.push_back(std::move(s));
-      } else if (e.kind == "program_stop" || e.kind == "optional_stop") {
-        Step s;
-        s.kind = e.kind == "program_stop" ? Step::Kind::Stop : Step::Kind::OptionalStop;
-        s.exec = &e;
-        program_.steps.push_back(std::move(s));
-      } else if (e.kind == "workingstep" || e.kind == "rapid_movement") {
-        executable(e);
-      }
-    }
-  }
-
   void executable(const ir::Node &e) {
+    if (e.kind == "display_message") {
+      Step s;
+      s.kind = Step::Kind::Message;
+      s.exec = &e;
+      s.label = e.text("message").value_or("");
+      program_.steps.push_back(std::move(s));
+      return;
+    }
+    if (e.kind == "program_stop" || e.kind == "optional_stop") {
+      Step s;
+      s.kind = e.kind == "program_stop" ? Step::Kind::Stop : Step::Kind::OptionalStop;
+      s.exec = &e;
+      program_.steps.push_back(std::move(s));
+      return;
+    }
     const ir::Node *moves = e.child("moves");
     if (!moves) {
       diags_.error(e.origin.loc, e.kind + " " + e.symbol +

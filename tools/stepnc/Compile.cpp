@@ -14,7 +14,6 @@
 #include "ir/Verifier.h"
 #include "passes/PassManager.h"
 #include "runtime/Machine.h"
-#include "support/OutputFile.h"
 #include "tools/stepnc/Compile.h"
 #include "tools/stepnc/Driver.h"
 #include "tools/stepnc/SchemaSelection.h"
@@ -53,21 +52,6 @@ struct CompileOptions {
   SchemaOptions schema;
   DiagnosticOptions diag;
 };
-
-int writeText(const std::string &path, const std::string &text) {
-  OutputFile out;
-  std::string error;
-  if (!out.open(path, error)) {
-    printToolError(error);
-    return kExitUsage;
-  }
-  out.write(text);
-  if (!out.commit(error)) {
-    printToolError(error);
-    return kExitUsage;
-  }
-  return kExitOk;
-}
 
 std::string targetList();
 

@@ -1,5 +1,7 @@
 #include "tools/stepnc/Driver.h"
 
+#include "support/OutputFile.h"
+
 #include <CLI/CLI.hpp>
 #include <iostream>
 
@@ -32,6 +34,21 @@ DiagnosticSession::~DiagnosticSession() { engine_->finish(); }
 void printToolError(const std::string &message) {
   std::cout.flush();
   std::cerr << "stepnc: error: " << message << '\n';
+}
+
+int writeText(const std::string &path, const std::string &text) {
+  OutputFile out;
+  std::string error;
+  if (!out.open(path, error)) {
+    printToolError(error);
+    return kExitUsage;
+  }
+  out.write(text);
+  if (!out.commit(error)) {
+    printToolError(error);
+    return kExitUsage;
+  }
+  return kExitOk;
 }
 
 std::unique_ptr<SourceFile> openInput(const std::string &path) {

@@ -45,6 +45,10 @@ private:
 /// Opens an input file; on failure prints "stepnc: error: ..." and returns null.
 std::unique_ptr<SourceFile> openInput(const std::string &path);
 
+/// Writes `text` to `path` ('-': standard output) atomically; on failure
+/// prints "stepnc: error: ..." and returns kExitUsage, else kExitOk.
+int writeText(const std::string &path, const std::string &text);
+
 /// Prints "stepnc: error: message" to stderr.
 void printToolError(const std::string &message);
 

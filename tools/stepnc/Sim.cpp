@@ -4,6 +4,7 @@
 // native format, IR text (with motion, or moves to plan) or STEP-NC (compiled
 // to moves and planned first).
 #include "passes/MotionIR.h"
+#include "passes/MoveWalk.h"
 #include "runtime/Machine.h"
 #include "runtime/NativeFormat.h"
 #include "runtime/Player.h"
@@ -66,14 +67,9 @@ int runSim(const SimCommandOptions &opts) {
       return usage ? kExitUsage : kExitDiagnostics;
     // Whatever the input lacks is made: moves, then the motion.
     bool hasMoves = false, hasMotion = false;
-    std::vector<const ir::Node *> stack{&module->root};
-    while (!stack.empty()) {
-      const ir::Node *n = stack.back();
-      stack.pop_back();
-      hasMoves |= n->kind == "moves";
-      hasMotion |= n->kind == "motion";
-      for (const ir::Node &c : n->children)
-        stack.push_back(&c);
+    for (const ir::Node *e : passes::programOrder(*module)) {
+      hasMoves |= e->child("moves") != nullptr;
+      hasMotion |= e->child("motion") != nullptr;
     }
     std::string pipeline;
     if (!hasMoves)
@@ -138,16 +134,8 @@ int runSim(const SimCommandOptions &opts) {
     printToolError(error);
     return kExitUsage;
   }
-  OutputFile out;
-  if (!out.open(opts.output, error)) {
-    printToolError(error);
-    return kExitUsage;
-  }
-  out.write(text);
-  if (!out.commit(error)) {
-    printToolError(error);
-    return kExitUsage;
-  }
+  if (const int rc = writeText(opts.output, text); rc != kExitOk)
+    return rc;
   return report.violationCount == 0 ? kExitOk : kExitDiagnostics;
 }
 

@@ -2,6 +2,8 @@
 // mistake is reported at its line and column.
 #include "runtime/Machine.h"
 
+#include "../TestSupport.h"
+
 #include <catch2/catch.hpp>
 
 #include <fstream>
@@ -23,10 +25,7 @@ Read read(const std::string &text) {
   DiagnosticCollector collector;
   DiagnosticEngine diags(collector);
   r.machine = runtime::readMachine(*r.file, diags);
-  for (const Diagnostic &d : collector.diags) {
-    const LineCol lc = r.file->lineCol(d.loc.offset);
-    r.errors.push_back(std::to_string(lc.line) + ":" + std::to_string(lc.col) + ": " + d.message);
-  }
+  r.errors = test::locatedMessages(collector, *r.file);
   return r;
 }
 

@@ -5,6 +5,8 @@
 
 #include "support/Format.h"
 
+#include "../TestSupport.h"
+
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -30,10 +32,7 @@ Read read(const std::string &text) {
   DiagnosticCollector collector;
   DiagnosticEngine diags(collector);
   r.trajectory = readNative(*r.file, diags);
-  for (const Diagnostic &d : collector.diags) {
-    const LineCol lc = r.file->lineCol(d.loc.offset);
-    r.errors.push_back(std::to_string(lc.line) + ":" + std::to_string(lc.col) + ": " + d.message);
-  }
+  r.errors = test::locatedMessages(collector, *r.file);
   return r;
 }
 

@@ -11,9 +11,7 @@
 
 #include <cctype>
 #include <cmath>
-#include <fstream>
 #include <numbers>
-#include <sstream>
 
 using namespace stepnc;
 using namespace stepnc::runtime;
@@ -109,13 +107,6 @@ size_t count(const SimReport &r, ViolationKind kind, int axis = -2) {
     if (v.kind == kind && (axis == -2 || v.axis == axis))
       ++n;
   return n;
-}
-
-std::string slurp(const std::string &path) {
-  std::ifstream in(path);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
 }
 
 } // namespace
@@ -490,9 +481,8 @@ TEST_CASE("slow places and why", "[player]") {
 TEST_CASE("a planned rectangle plays without violations", "[player]") {
   DiagnosticCollector collector;
   DiagnosticEngine diags(collector);
-  const auto file = SourceFile::fromString("hsc-3axis.toml", slurp(std::string(STEPNC_SOURCE_DIR) +
-                                                                   "/machines/hsc-3axis.toml"));
-  const std::optional<Machine> m = readMachine(*file, diags);
+  std::unique_ptr<SourceFile> file;
+  const std::optional<Machine> m = loadMachine("hsc-3axis", file, diags);
   REQUIRE(m);
   PathInput in;
   in.start = Vec3(10, 10, -5);
