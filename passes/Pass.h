@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace stepnc::passes {
 
@@ -32,6 +33,10 @@ public:
   virtual ~Pass() = default;
   virtual std::string_view name() const = 0;
   virtual PassResult run(ir::Module &module, DiagnosticEngine &diags, PassStats &stats) = 0;
+  /// Figures of the last run that counters cannot hold (a table per
+  /// workingstep, say), printed by `--stats` after the counters; one
+  /// line per entry.
+  virtual std::vector<std::string> report() const { return {}; }
 };
 
 } // namespace stepnc::passes

@@ -33,6 +33,8 @@ bool PassManager::run(ir::Module &module, DiagnosticEngine &diags) {
     const unsigned errorsBefore = diags.errorCount();
     const PassResult result = pass->run(module, diags, stats);
     stats_.emplace_back(std::string(pass->name()), std::move(stats));
+    if (std::vector<std::string> lines = pass->report(); !lines.empty())
+      reports_.emplace_back(std::string(pass->name()), std::move(lines));
     if (!result.ok || diags.errorCount() > errorsBefore)
       return false;
     if (verifyEach && !ir::verifyModule(module, diags)) {

@@ -30,11 +30,14 @@ public:
   bool run(ir::Module &module, DiagnosticEngine &diags);
   /// Counters per pass, in pipeline order.
   const std::vector<std::pair<std::string, PassStats>> &stats() const { return stats_; }
+  /// Report lines per pass that gave any, in pipeline order.
+  const std::vector<std::pair<std::string, std::vector<std::string>>> &reports() const { return reports_; }
 
 private:
   PassManagerOptions options_;
   std::vector<std::unique_ptr<Pass>> passes_;
   std::vector<std::pair<std::string, PassStats>> stats_;
+  std::vector<std::pair<std::string, std::vector<std::string>>> reports_;
 };
 
 } // namespace stepnc::passes

@@ -1,122 +1,8 @@
 #include "runtime/Machine.h"
 
-#include "support/Format.h"
-
-// Debian's libtomlplusplus is built with exceptions: parse errors arrive as
-// toml::parse_error and are turned into located diagnostics here.
-#include <toml++/toml.h>
-
-#include <set>
+#include "runtime/TomlReader.h"
 
 namespace stepnc::runtime {
-
-namespace {
-
-/// A limit as people write it: "1000000", "0.00001", never an exponent.
-std::string plain(double v) {
-  std::string s = formatFixed(v, 6);
-  while (s.back() == '0')
-    s.pop_back();
-  if (s.back() == '.')
-    s.pop_back();
-  return s;
-}
-
-/// Reads one table of the file, checking that it holds only known keys.
-class Reader {
-public:
-  Reader(const SourceFile &file, DiagnosticEngine &diags) : file_(file), diags_(diags) {}
-
-  bool ok() const { return ok_; }
-
-  /// A located error at a TOML node (its first character), or at the file start.
-  void error(const toml::source_region &where, const std::string &message) {
-    diags_.error(locate(where.begin), message);
-    ok_ = false;
-  }
-
-  /// Every key of `table` must be one of `known`; `what` names the table in messages.
-  void onlyKnown(const toml::table &table, std::initializer_list<std::string_view> known, const std::string &what) {
-    const std::set<std::string_view> names(known);
-    for (const auto &[key, value] : table)
-      if (!names.count(key.str()))
-        error(key.source(), "unknown key '" + std::string(key.str()) + "' in " + what + " (known: " + join(known) +
-                                ")");
-  }
-
-  /// A number (integer or float) at `key`, within [lo, hi]; `unit` is shown in messages.
-  std::optional<double> number(const toml::table &table, std::string_view key, const std::string &what,
-                               const char *unit, double lo, double hi, bool required) {
-    const toml::node *n = table.get(key);
-    if (!n) {
-      if (required)
-        error(table.source(), what + " needs '" + std::string(key) + "' (" + unit + ")");
-      return std::nullopt;
-    }
-    std::optional<double> v = n->value<double>();
-    if (!v || !(*v >= lo && *v <= hi)) {
-      error(n->source(), what + "." + std::string(key) + " must be a number of " + unit + " from " +
-                             plain(lo) + " to " + plain(hi));
-      return std::nullopt;
-    }
-    return v;
-  }
-
-  std::optional<std::string> text(const toml::table &table, std::string_view key, const std::string &what,
-                                  bool required) {
-    const toml::node *n = table.get(key);
-    if (!n) {
-      if (required)
-        error(table.source(), what + " needs '" + std::string(key) + "' (a string)");
-      return std::nullopt;
-    }
-    if (auto s = n->value<std::string>())
-      return s;
-    error(n->source(), what + "." + std::string(key) + " must be a string");
-    return std::nullopt;
-  }
-
-  const toml::table *table(const toml::table &parent, std::string_view key, const std::string &what) {
-    const toml::node *n = parent.get(key);
-    if (!n) {
-      error(parent.source(), "the machine file needs a [" + what + "] table");
-      return nullptr;
-    }
-    if (!n->is_table()) {
-      error(n->source(), "'" + what + "' must be a table ([" + what + "])");
-      return nullptr;
-    }
-    return n->as_table();
-  }
-
-  SourceLoc locate(const toml::source_position &p) const {
-    // Line and column (1-based) back to a byte offset, so the engine prints the line.
-    const std::string_view text = file_.text();
-    uint64_t offset = 0;
-    for (uint32_t line = 1; line < p.line && offset < text.size(); ++offset)
-      if (text[offset] == '\n')
-        ++line;
-    if (p.line == 0)
-      offset = 0;
-    else
-      offset = std::min<uint64_t>(offset + (p.column > 0 ? p.column - 1 : 0), text.size());
-    return SourceLoc{&file_, offset};
-  }
-
-private:
-  static std::string join(std::initializer_list<std::string_view> names) {
-    std::string out;
-    for (std::string_view n : names)
-      out += (out.empty() ? "" : ", ") + std::string(n);
-    return out;
-  }
-
-  const SourceFile &file_;
-  DiagnosticEngine &diags_;
-  bool ok_ = true;
-};
-
-} // namespace
 
 const Axis *Machine::axis(std::string_view axisName) const {
   for (const Axis &a : axes)
@@ -126,14 +12,11 @@ const Axis *Machine::axis(std::string_view axisName) const {
 }
 
 std::optional<Machine> readMachine(const SourceFile &file, DiagnosticEngine &diags) {
-  Reader r(file, diags);
-  toml::table root;
-  try {
-    root = toml::parse(file.text(), std::string(file.name()));
-  } catch (const toml::parse_error &e) {
-    r.error(e.source(), "the machine file is not valid TOML: " + std::string(e.description()));
+  TomlReader r(file, diags, "the machine file");
+  std::optional<toml::table> parsed = r.parse();
+  if (!parsed)
     return std::nullopt;
-  }
+  const toml::table &root = *parsed;
   r.onlyKnown(root, {"format", "name", "kinematics", "controller", "spindle", "axes"}, "the machine file");
   Machine m;
   if (auto format = r.number(root, "format", "the machine file", "format version", 1, 1, true); !format)
@@ -158,8 +41,8 @@ std::optional<Machine> readMachine(const SourceFile &file, DiagnosticEngine &dia
     m.spindlePower = r.number(*s, "power", "spindle", "kW", 0.01, 1e4, true).value_or(0);
     m.spindleTorque = r.number(*s, "torque", "spindle", "N m", 0.01, 1e6, false);
     if (r.ok() && m.spindleMin >= m.spindleMax)
-      r.error(s->get("min_speed")->source(), "spindle.min_speed " + plain(m.spindleMin) +
-                                                 " rev/min is not below max_speed " + plain(m.spindleMax));
+      r.error(s->get("min_speed")->source(), "spindle.min_speed " + plainNumber(m.spindleMin) +
+                                                 " rev/min is not below max_speed " + plainNumber(m.spindleMax));
   }
   if (const toml::table *axes = r.table(root, "axes", "axes")) {
     r.onlyKnown(*axes, {"x", "y", "z"}, "[axes]");

@@ -41,7 +41,10 @@ struct CompileOptions {
   std::optional<double> tolerance;
   std::vector<std::string> targetOptions;
   bool listTargets = false;
-  std::string machine;  ///< for motion-ir and the native target
+  std::string machine;  ///< for motion-ir and the native target; bounds adapt-feed
+  bool noAdaptFeed = false;
+  std::string cuttingData;
+  bool allowFeedIncrease = false;
   // opt only
   std::string passes;
   std::vector<std::string> printAfter;
@@ -134,8 +137,12 @@ int runCompile(const CompileOptions &opts) {
   // The toolpath IR is the feature IR after the passes that make and check
   // moves; a program is written from the toolpath IR.
   // The motion IR and the native target add the motion planned on the machine.
-  std::string pipelineText =
-      emit != "feature-ir" && opts.passes.empty() ? std::string(kToolpathPipeline) : opts.passes;
+  ToolpathPipelineOptions toolpath;
+  toolpath.machine = opts.machine;
+  toolpath.adaptFeed = !opts.noAdaptFeed;
+  toolpath.cuttingData = opts.cuttingData;
+  toolpath.allowFeedIncrease = opts.allowFeedIncrease;
+  std::string pipelineText = emit != "feature-ir" && opts.passes.empty() ? toolpathPipeline(toolpath) : opts.passes;
   if (opts.passes.empty() && needsMotion)
     pipelineText += "," + planMotionPipeline(opts.machine, opts.tolerance);
   if (!pipelineText.empty()) {
@@ -255,6 +262,22 @@ std::unique_ptr<ir::Module> loadModule(const SourceFile &source, const SchemaSel
   return module;
 }
 
+std::string toolpathPipeline(const ToolpathPipelineOptions &options) {
+  std::string text = "resolve-feeds,expand-strategies,";
+  if (options.adaptFeed) {
+    std::string adapt;
+    auto add = [&](const std::string &o) { adapt += (adapt.empty() ? "<" : ",") + o; };
+    if (!options.machine.empty())
+      add("machine=" + options.machine);
+    if (!options.cuttingData.empty())
+      add("data=" + options.cuttingData);
+    if (options.allowFeedIncrease)
+      add("allow-increase=true");
+    text += "adapt-feed" + adapt + (adapt.empty() ? "" : ">") + ",";
+  }
+  return text + "verify-toolpaths";
+}
+
 std::string planMotionPipeline(const std::string &machine, std::optional<double> tolerance) {
   std::string text = "plan-motion<machine=" + machine;
   if (tolerance)
@@ -277,10 +300,14 @@ int runPipeline(ir::Module &module, const std::string &text, const PipelineRun &
   passes::PassManager manager(std::move(pmOptions));
   manager.add(*pipeline);
   const bool ok = manager.run(module, diags);
-  if (run.stats)
+  if (run.stats) {
     for (const auto &[pass, counters] : manager.stats())
       for (const auto &[what, n] : counters)
         std::cerr << "stats: " << pass << ": " << n << ' ' << what << '\n';
+    for (const auto &[pass, lines] : manager.reports())
+      for (const std::string &line : lines)
+        std::cerr << "report: " << pass << ": " << line << '\n';
+  }
   return ok ? kExitOk : kExitDiagnostics;
 }
 
@@ -326,7 +353,14 @@ void registerCompile(CLI::App &app, std::function<void(int)> setResult) {
       ->check(CLI::IsMember({"feature-ir", "toolpath-ir", "motion-ir", "program"}));
   cmd->add_option("--machine", opts->machine,
                   "Machine to plan the motion on, for --target=native and --emit=motion-ir: a TOML\n"
-                  "file (docs/machine-model.md) or a shipped machine (hsc-3axis, conventional-3axis)");
+                  "file (docs/machine-model.md) or a shipped machine (hsc-3axis, conventional-3axis);\n"
+                  "feed adaptation also keeps feeds within its dynamics and spindle");
+  cmd->add_flag("--no-adapt-feed", opts->noAdaptFeed,
+                "Keep the programmed feeds: leave out the adapt-feed pass (docs/feed-adaptation.md)");
+  cmd->add_option("--cutting-data", opts->cuttingData,
+                  "Cutting data (materials, tool overhangs) on top of the shipped data (docs/cutting-data.md)");
+  cmd->add_flag("--allow-feed-increase", opts->allowFeedIncrease,
+                "Let feed adaptation raise feeds above the programmed ones where the cut allows");
   cmd->add_option("--tool-table", opts->toolTable,
                   "Tool numbers and lengths by STEP-NC tool id (docs/tool-table.md); without one,\n"
                   "tools are numbered in order of first use");

@@ -14,8 +14,18 @@
 
 namespace stepnc::tool {
 
-/// What `compile --emit=toolpath-ir` runs.
-inline constexpr std::string_view kToolpathPipeline = "resolve-feeds,expand-strategies,verify-toolpaths";
+/// What shapes the toolpath pipeline: the machine (for adapt-feed's bounds
+/// and cycle times; may be empty) and the feed-adaptation choices.
+struct ToolpathPipelineOptions {
+  std::string machine;
+  bool adaptFeed = true;
+  std::string cuttingData;  ///< a user cutting-data file, or empty
+  bool allowFeedIncrease = false;
+};
+
+/// What `compile --emit=toolpath-ir` runs: resolve-feeds, expand-strategies,
+/// adapt-feed (unless turned off), verify-toolpaths.
+std::string toolpathPipeline(const ToolpathPipelineOptions &options);
 
 /// The plan-motion pass for a machine (file or shipped name) and tolerance.
 std::string planMotionPipeline(const std::string &machine, std::optional<double> tolerance);

@@ -73,7 +73,7 @@ int runSim(const SimCommandOptions &opts) {
     }
     std::string pipeline;
     if (!hasMoves)
-      pipeline = std::string(kToolpathPipeline) + ",";
+      pipeline = toolpathPipeline({machineName}) + ",";
     if (!hasMotion || opts.tolerance)
       pipeline += planMotionPipeline(machineName, opts.tolerance);
     else if (!pipeline.empty())

@@ -1,0 +1,358 @@
+// The cutting model of a program (see CuttingModel.h).
+//
+// Stock: one height field per setup, from the workpiece's block raw piece
+// (else a block to the highest feature top over the toolpath's extent),
+// cut by every feed move in program order: a milling move as the disc of
+// its cutter, a hole-making move as the disc of its tool down to where the
+// point reaches full diameter. Each horizontal milling move is measured
+// before it is cut, at samples along it, each sample on the stock as the
+// move left it up to the sample before: the material in front of a line is
+// never what the line itself removed.
+#include "passes/CuttingModel.h"
+
+#include "ir/Kinds.h"
+#include "passes/FeatureShape.h"
+#include "support/Format.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <optional>
+
+namespace stepnc::passes {
+
+namespace {
+
+using geom::Vec2;
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+bool isMill(const std::string &type) { return type.find("mill") != std::string::npos; }
+
+const ir::Node *findResource(const ir::Module &module, std::string_view kind, std::string_view symbol) {
+  for (const ir::Node &n : module.root.children)
+    if (n.kind == kind && n.symbol == symbol)
+      return &n;
+  return nullptr;
+}
+
+/// The workpiece a setup holds (its first workpiece_setup), else the only
+/// workpiece.
+const ir::Node *setupWorkpiece(const ir::Module &module, const std::string &setup) {
+  if (const ir::Node *s = findResource(module, "setup", setup))
+    for (const ir::Node *ws : s->childrenOf("workpiece_setup"))
+      if (auto w = ws->text("workpiece"))
+        if (const ir::Node *wp = findResource(module, "workpiece", *w))
+          return wp;
+  const ir::Node *only = nullptr;
+  for (const ir::Node &n : module.root.children)
+    if (n.kind == "workpiece") {
+      if (only)
+        return nullptr;
+      only = &n;
+    }
+  return only;
+}
+
+MaterialChoice chooseMaterial(const ir::Node *workpiece, const cutting::CuttingData &data) {
+  MaterialChoice c;
+  const std::string id = workpiece ? workpiece->text("material").value_or("") : "";
+  const std::string standard = workpiece ? workpiece->text("material_standard").value_or("") : "";
+  std::string alias;
+  if (const cutting::Material *m = data.match(id, standard, alias)) {
+    c.material = m;
+    c.note = "material '" + id + (standard.empty() ? "" : "' ('" + standard) + (standard.empty() ? "'" : "')") +
+             " read as " + m->key + " (" + m->name + ", matched '" + alias + "')";
+    return c;
+  }
+  const auto it = data.materials.find(data.defaultMaterial);
+  c.material = it != data.materials.end() ? &it->second : nullptr;
+  c.defaulted = true;
+  c.note = (workpiece ? "material '" + id + "' ('" + standard + "') is not in the cutting data"
+                      : std::string("no workpiece names a material")) +
+           ": defaulted to " + data.defaultMaterial;
+  return c;
+}
+
+/// The block raw piece of a workpiece in its coordinates: corners and top.
+std::optional<std::pair<geom::Box, double>> rawBlock(const ir::Node *workpiece) {
+  const ir::Node *raw = workpiece ? workpiece->child("rawpiece") : nullptr;
+  if (!raw || raw->text("shape") != "block" || !raw->has("size"))
+    return std::nullopt;
+  FrameResult fr = planeFrame(*raw);
+  if (!fr.frame)
+    return std::nullopt;
+  const ir::Vec3 size = *raw->vec("size");
+  geom::Box box;
+  for (const Vec2 &c : {Vec2(0, 0), Vec2(size.x(), 0), Vec2(size.x(), size.y()), Vec2(0, size.y())})
+    box.add(fr.frame->map(c));
+  return std::make_pair(box, fr.frame->z + size.z());
+}
+
+/// Samples along a move's plane path: (distance from start, point, direction).
+struct PathPoint {
+  double s;
+  Vec2 at, dir;
+};
+
+std::vector<PathPoint> samplePath(const std::vector<geom::Seg> &segs, double step) {
+  std::vector<PathPoint> out;
+  double offset = 0;
+  for (const geom::Seg &seg : segs) {
+    const double len = seg.length();
+    const int n = std::max(1, int(std::ceil(len / step)));
+    for (int i = 0; i < n; ++i) {
+      // The first sample a little past the start, so that the direction is the
+      // move's own.
+      const double t = std::min(1.0, (i + 0.5) / n);
+      out.push_back({offset + t * len, seg.at(t), seg.tangent(t)});
+    }
+    offset += len;
+  }
+  return out;
+}
+
+const std::string &operationKind(const ir::Node &executable, std::string &storage) {
+  storage.clear();
+  for (const ir::Node &c : executable.children)
+    if (const ir::KindSpec *spec = ir::findKind(c.kind); spec && spec->category == "operation") {
+      storage = c.kind;
+      break;
+    }
+  return storage;
+}
+
+} // namespace
+
+double spindleTorqueLimit(const runtime::Machine &machine, double rpm) {
+  double limit = machine.spindleTorque.value_or(kInf);
+  const double omega = 2 * std::numbers::pi * rpm / 60; // rad/s
+  if (omega > 0 && machine.spindlePower > 0)
+    limit = std::min(limit, machine.spindlePower * 1000 / omega);
+  return limit;
+}
+
+CutterSetup cutterSetup(const ir::Node &tool, const cutting::CuttingData &data) {
+  CutterSetup t;
+  t.symbol = tool.symbol;
+  const std::string type = tool.text("type").value_or("");
+  t.mill = isMill(type);
+  const std::string key = tool.symbol.size() > 1 ? tool.symbol.substr(1) : tool.symbol;
+  const cutting::ToolData *user = nullptr;
+  if (auto it = data.tools.find(key); it != data.tools.end())
+    user = &it->second;
+  const double d = tool.number("diameter").value_or(0);
+  t.cutter.radius = d / 2;
+  if (auto n = tool.count("flutes"); n && *n > 0) {
+    t.cutter.flutes = int(*n);
+  } else {
+    t.cutter.flutes = 2;
+    t.defaulted.push_back("flutes 2 (the file gives none)");
+  }
+  double flute = tool.number("cutting_edge_length").value_or(0);
+  if (user && user->fluteLength) {
+    flute = *user->fluteLength;
+  } else if (!(flute > 0)) {
+    flute = 2 * d;
+    t.defaulted.push_back("flute length " + formatShortest(flute) + " mm (2 x diameter)");
+  }
+  t.cutter.fluteLength = flute;
+  double overhang = flute + d;
+  if (user && user->overhang) {
+    overhang = *user->overhang;
+  } else {
+    // STEP-NC gives the tool's length from its gauge line, not how far it
+    // stands out of the holder; a tool is clamped as short as its flutes allow.
+    const double length = tool.number("overall_length").value_or(tool.number("offset_length").value_or(0));
+    if (length > flute)
+      overhang = std::min(overhang, length);
+    t.defaulted.push_back("overhang " + formatShortest(overhang) + " mm (flute length + diameter)");
+  }
+  t.beam.overhang = std::max(overhang, flute);
+  t.beam.fluteLength = flute;
+  t.beam.diameter = d;
+  t.beam.fluteDiameter = 0.8 * d;
+  t.toolMaterial = user && user->material ? *user->material : "carbide";
+  if (!(user && user->material))
+    t.defaulted.push_back("material carbide");
+  cutting::ToolMaterial tm;
+  if (auto it = data.toolMaterials.find(t.toolMaterial); it != data.toolMaterials.end())
+    tm = it->second;
+  t.beam.modulus = tm.modulus;
+  if (user && user->maxForce) {
+    t.maxForce = *user->maxForce;
+  } else {
+    // The force at mid-flute that stresses the shank at the clamp to the
+    // material's allowed bending stress.
+    t.maxForce = d > 0 ? cutting::forceForClampStress(t.beam, tm.allowedStress, flute / 2) : kInf;
+    t.defaulted.push_back("max force " + formatFixed(t.maxForce, 0) + " N (" + formatShortest(tm.allowedStress) +
+                          " N/mm2 bending at the clamp)");
+  }
+  return t;
+}
+
+CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
+  const cutting::CuttingData &data = *options.data;
+  CutAnalysis out;
+  for (const ir::Node &n : module.root.children)
+    if (n.kind == "tool")
+      out.tools.emplace(n.symbol, cutterSetup(n, data));
+
+  // The steps in program order, grouped by setup for the stock's extent.
+  struct Pending {
+    const ir::Node *exec;
+    const ir::Node *moves;
+    std::string setup;
+  };
+  std::vector<Pending> pending;
+  double smallest = kInf;
+  for (const ir::Node *e : programOrder(module))
+    if (const ir::Node *m = e->child("moves")) {
+      pending.push_back({e, m, m->text("setup").value_or("")});
+      if (auto t = out.tools.find(m->text("tool").value_or(""));
+          t != out.tools.end() && t->second.mill && t->second.cutter.radius > 0)
+        smallest = std::min(smallest, t->second.cutter.radius);
+    }
+  out.cell = std::clamp(std::isfinite(smallest) ? smallest / 60 : 0.1, 0.02, 0.25);
+
+  std::map<std::string, cutting::HeightMap> stocks;
+  std::map<std::string, MaterialChoice> materials;
+  std::optional<ir::Vec3> position;
+  for (const Pending &p : pending) {
+    CutStep step;
+    step.executable = p.exec;
+    step.movesNode = p.moves;
+    std::string storage;
+    step.operation = operationKind(*p.exec, storage);
+    step.finishing = step.operation.find("finish") != std::string::npos;
+    if (auto t = out.tools.find(p.moves->text("tool").value_or("")); t != out.tools.end())
+      step.tool = &t->second;
+    const double spindle = p.moves->number("spindle").value_or(0);
+    step.spindle = std::abs(spindle);
+    for (const Move &m : walkMoves(*p.moves, position)) {
+      CutMove cm;
+      cm.move = m;
+      step.moves.push_back(std::move(cm));
+      position = m.to;
+    }
+
+    auto mat = materials.find(p.setup);
+    if (mat == materials.end()) {
+      const ir::Node *wp = setupWorkpiece(module, p.setup);
+      mat = materials.emplace(p.setup, chooseMaterial(wp, data)).first;
+      out.notes.push_back(mat->second.note);
+    }
+    step.material = mat->second.material;
+
+    auto stock = stocks.find(p.setup);
+    if (stock == stocks.end()) {
+      // The stock's extent: the raw piece and everything this setup's moves
+      // sweep.
+      const ir::Node *wp = setupWorkpiece(module, p.setup);
+      const auto raw = rawBlock(wp);
+      geom::Box box = raw ? raw->first : geom::Box{};
+      double top = raw ? raw->second : -kInf;
+      for (const Pending &q : pending) {
+        if (q.setup != p.setup)
+          continue;
+        double r = 0;
+        if (auto t = out.tools.find(q.moves->text("tool").value_or("")); t != out.tools.end())
+          r = t->second.cutter.radius;
+        for (const Move &m : walkMoves(*q.moves))
+          if (m.isFeed()) {
+            box.add(geom::Box{m.to.head<2>(), m.to.head<2>()}.grown(r + 1));
+            if (!raw) {
+              // No block raw piece: material up to the highest feature top.
+              if (auto f = q.exec->text("feature"))
+                if (const ir::Node *feature = findFeature(module, *f))
+                  if (auto shape = featureShape(module, *feature).shape)
+                    top = std::max(top, shape->top);
+            }
+          }
+      }
+      if (box.empty())
+        box = geom::Box{Vec2(0, 0), Vec2(1, 1)};
+      // Keep the grid within about 25 million cells.
+      double cell = out.cell;
+      const Vec2 size = box.hi - box.lo;
+      while (size.x() / cell * size.y() / cell > 25e6)
+        cell *= 1.25;
+      cutting::HeightMap map(box.grown(2 * cell), cell);
+      if (raw) {
+        map.addBlock(raw->first.lo, raw->first.hi, raw->second);
+      } else if (std::isfinite(top)) {
+        map.addBlock(box.lo, box.hi, top);
+        out.notes.push_back("setup " + (p.setup.empty() ? std::string("(none)") : p.setup) +
+                            ": no block raw piece; material assumed up to the highest feature "
+                            "top, z=" +
+                            formatFixed(top, 3) + " mm, over the toolpath's extent");
+      }
+      stock = stocks.emplace(p.setup, std::move(map)).first;
+    }
+    cutting::HeightMap &map = stock->second;
+
+    const CutterSetup *tool = step.tool;
+    const double radius = tool ? tool->cutter.radius : 0;
+    cutting::Cutter cutter = tool ? tool->cutter : cutting::Cutter{};
+    cutter.clockwise = spindle <= 0;
+    const cutting::Material *material = step.material;
+    const bool model = tool && tool->mill && radius > 0 && material && step.spindle > 0;
+    const double torqueLimit = options.machine ? spindleTorqueLimit(*options.machine, step.spindle) : kInf;
+    const double sampleStep = std::max(2 * map.cell(), std::min(radius / 4, 1.0));
+    // Hole-making tools cut to where their point reaches full diameter.
+    const double point = tool && !tool->mill ? pointLength(*findResource(module, "tool", tool->symbol)) : 0;
+    for (CutMove &cm : step.moves) {
+      const Move &m = cm.move;
+      if (!m.isFeed() || !m.from || radius <= 0)
+        continue;
+      const std::vector<geom::Seg> segs = m.planar();
+      if (model && !m.changesHeight() && !segs.empty()) {
+        cm.measured = true;
+        cm.fz = m.feed / (cutter.flutes * step.spindle);
+        const cutting::CuttingCoefficients k{material->ktc, material->krc, material->kte, material->kre};
+        const double z = m.to.z();
+        for (const PathPoint &pp : samplePath(segs, sampleStep)) {
+          const cutting::Engagement e = cutting::measureEngagement(map, pp.at, z, pp.dir, cutter);
+          CutSample s;
+          s.s = pp.s;
+          s.at = pp.at;
+          s.dir = pp.dir;
+          if (e.cutting()) {
+            const cutting::ForceModel f(e, cutter, k);
+            s.chipFactor = e.chipFactor();
+            s.ae = e.radialDepth(radius);
+            s.ap = e.axialDepth();
+            s.side = e.side();
+            s.fzForce = f.fzForForce(tool->maxForce);
+            s.fzTorque = f.fzForTorque(torqueLimit);
+            s.force = f.peakForce(cm.fz);
+            s.torque = f.meanTorque(cm.fz);
+          } else {
+            s.fzForce = s.fzTorque = kInf;
+          }
+          cm.samples.push_back(s);
+        }
+      }
+      // Cut the move into the stock.
+      const double step_ = std::max(map.cell(), 0.05);
+      if (segs.empty()) {
+        map.cutDisc(m.to.head<2>(), radius, std::min(m.from->z(), m.to.z()) + point);
+        continue;
+      }
+      double zAt = m.from->z(), total = 0, run = 0;
+      for (const geom::Seg &seg : segs)
+        total += seg.length();
+      for (const geom::Seg &seg : segs) {
+        const double z0 = zAt;
+        run += seg.length();
+        zAt = m.from->z() + (m.to.z() - m.from->z()) * std::min(1.0, run / std::max(total, 1e-12));
+        map.cutAlong(seg, radius, z0 + point, zAt + point, step_);
+      }
+    }
+    out.steps.push_back(std::move(step));
+  }
+  return out;
+}
+
+} // namespace stepnc::passes

@@ -1,0 +1,99 @@
+// The cutting model of a program (cutting/) read from the IR: each tool as a
+// cutter and a beam, each workpiece's material, and the in-process stock,
+// cut move by move in program order, so that every horizontal milling move
+// knows the engagement, chip, forces and torque along it. Shared by
+// adapt-feed and compensate-deflection.
+//
+// Values STEP-NC does not carry come from the cutting data (shipped or a
+// user file) or from documented defaults; each one defaulted is listed in
+// the tool's `defaulted` so the passes can say so.
+#pragma once
+
+#include "cutting/CuttingData.h"
+#include "cutting/Deflection.h"
+#include "cutting/Mechanics.h"
+#include "ir/Node.h"
+#include "passes/MoveWalk.h"
+#include "runtime/Machine.h"
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace stepnc::passes {
+
+struct CutterSetup {
+  std::string symbol;
+  bool mill = false; ///< a milling cutter (the model applies); drills and the
+                     ///< like are only cut into the stock
+  cutting::Cutter cutter;
+  cutting::ToolBeam beam;
+  std::string toolMaterial;
+  double maxForce = 0;                ///< N, peak force the tool may take
+  std::vector<std::string> defaulted; ///< "overhang 38 mm (flute length + diameter)", ...
+};
+
+/// One place along a horizontal milling move, measured on the stock the
+/// moves before it left.
+struct CutSample {
+  double s = 0; ///< mm from the move's start, along its path
+  geom::Vec2 at = geom::Vec2::Zero(), dir = geom::Vec2::UnitX();
+  double chipFactor = 0; ///< chip thickness = fz x this
+  double ae = 0, ap = 0; ///< mm, radial (equivalent) and axial depth
+  int side = 0;          ///< +1 material on the left, -1 right, 0 none or both
+  double fzForce = 0;    ///< largest fz whose peak force stays within the tool's limit (mm)
+  double fzTorque = 0;   ///< largest fz within the spindle's torque and power
+                         ///< (mm; inf without a machine)
+  double force = 0;      ///< N, peak at the move's feed
+  double torque = 0;     ///< N m, mean at the move's feed
+};
+
+struct CutMove {
+  Move move;
+  bool measured = false; ///< a horizontal feed move of a milling cutter
+  double fz = 0;         ///< mm per tooth at the move's feed
+  std::vector<CutSample> samples;
+};
+
+struct CutStep {
+  const ir::Node *executable = nullptr;
+  const ir::Node *movesNode = nullptr;
+  const CutterSetup *tool = nullptr; ///< null when the tool is unknown
+  const cutting::Material *material = nullptr;
+  double spindle = 0; ///< rev/min, unsigned
+  std::string operation;
+  bool finishing = false; ///< a finishing operation (side or bottom-and-side finish)
+  std::vector<CutMove> moves;
+};
+
+struct CutOptions {
+  const cutting::CuttingData *data = nullptr;
+  const runtime::Machine *machine = nullptr; ///< spindle torque and power limits; none when null
+};
+
+struct CutAnalysis {
+  std::vector<CutStep> steps;
+  std::map<std::string, CutterSetup, std::less<>> tools;
+  double cell = 0;                ///< mm, the stock's grid
+  std::vector<std::string> notes; ///< assumptions about materials and raw pieces
+};
+
+/// The material of the workpiece a setup holds, and how it was chosen.
+struct MaterialChoice {
+  const cutting::Material *material = nullptr;
+  std::string note; ///< "C45E 1.1191 read as steel_1045 (alias C45E)" or why it
+                    ///< was defaulted
+  bool defaulted = false;
+};
+
+CutterSetup cutterSetup(const ir::Node &tool, const cutting::CuttingData &data);
+
+/// Cuts the whole program into the stock and measures every horizontal
+/// milling move. Feeds are read from the moves as they stand.
+CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options);
+
+/// The spindle torque limit (N m) at `rpm` on `machine`: its torque, and its
+/// power over the angular speed, whichever is lower.
+double spindleTorqueLimit(const runtime::Machine &machine, double rpm);
+
+} // namespace stepnc::passes

@@ -1,0 +1,192 @@
+// The adapt-feed pass against closed forms (a straight slot, a wall taken to
+// a constant radial depth), on a pocket whose corners must get lower feeds
+// than its walls, and its invariants on every corpus file that reaches the
+// toolpath IR.
+#include "passes/CuttingModel.h"
+#include "passes/MotionIR.h"
+#include "passes/PassManager.h"
+
+#include "tests/unit/TestSupport.h"
+#include "tests/unit/ir/SampleModule.h"
+#include "tools/stepnc/Compile.h"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <numbers>
+
+using namespace stepnc;
+using namespace stepnc::passes;
+using ir::Node;
+using ir::Value;
+using ir::Vec3;
+
+namespace {
+
+// A 100 x 50 x 20 block of SAE 1020 (steel_1020: h* = 0.10 mm), its top at z = 0;
+// a D10 four-flute end mill; moves written by hand under one workingstep.
+constexpr const char *kModule = R"(project "ADAPT"
+  workpiece %wp "WP" material="id" material_standard="SAE 1020" global_tolerance=0.0100mm
+    rawpiece shape=block size=(100.0000,50.0000,20.0000)mm at=(0.0000,0.0000,-20.0000)mm axis=(0.000000,0.000000,1.000000) ref=(1.000000,0.000000,0.000000)
+    closed_pocket %pocket "POCKET" at=(50.0000,25.0000,0.0000)mm axis=(0.000000,0.000000,1.000000) ref=(1.000000,0.000000,0.000000) depth=10.0000mm bottom=planar orthogonal_radius=5.0000mm
+      rectangular_profile width=30.0000mm length=40.0000mm
+  tool %mill10 "MILL 10" type=endmill diameter=10.0000mm cutting_edge_length=20.0000mm flutes=4
+  setup %s1 "S1" at=(0.0000,0.0000,0.0000)mm axis=(0.000000,0.000000,1.000000) ref=(1.000000,0.000000,0.000000) secplane=20.0000mm
+    workpiece_setup workpiece=%wp at=(0.0000,0.0000,0.0000)mm axis=(0.000000,0.000000,1.000000) ref=(1.000000,0.000000,0.000000)
+  workplan @plan "PLAN" setup=%s1
+    workingstep @ws "WS" feature=%pocket secplane=20.0000mm
+      bottom_and_side_rough_milling "OP" tool=%mill10
+)";
+
+ir::test::Parsed parsed() {
+  ir::test::Parsed p = ir::test::parse(kModule);
+  for (const std::string &e : p.errors)
+    FAIL(e);
+  REQUIRE(p.module);
+  return p;
+}
+
+/// Moves under the workingstep: rapid above `from`, down to z at feed, then a
+/// line to `to` at `feed`, up and away.
+void straightCut(ir::Module &m, const Vec3 &from, const Vec3 &to, double feed, double spindle = -3000) {
+  Node &ws = ir::test::find(m.root, "@ws");
+  Node moves("moves");
+  moves.set("tool", Value::ref("%mill10"))
+      .set("spindle", Value::spindle(spindle))
+      .set("coolant", Value::word("flood"))
+      .set("setup", Value::ref("%s1"))
+      .set("secplane", Value::length(20));
+  auto add = [&](const char *kind, const Vec3 &p, double f) {
+    Node &n = moves.add(Node(kind));
+    n.set("to", Value::point(p));
+    if (f > 0)
+      n.set("feed", Value::feed(f));
+  };
+  add("rapid", Vec3(from.x(), from.y(), 20), 0);
+  add("linear", from, feed);
+  add("linear", to, feed);
+  add("rapid", Vec3(to.x(), to.y(), 20), 0);
+  ws.add(std::move(moves));
+}
+
+bool runPasses(ir::Module &m, const std::string &pipeline, std::vector<std::string> *errors = nullptr) {
+  std::string error;
+  auto entries = parsePipeline(pipeline, error);
+  INFO(error);
+  REQUIRE(entries);
+  DiagnosticCollector c;
+  DiagnosticEngine diags(c);
+  PassManager pm({});
+  pm.add(*entries);
+  const bool ok = pm.run(m, diags);
+  for (const Diagnostic &d : c.diags)
+    if (d.severity == Severity::Error && errors)
+      errors->push_back(d.message);
+  return ok;
+}
+
+/// Feeds of the feed moves of a moves node, in order.
+std::vector<double> feeds(const Node &moves) {
+  std::vector<double> out;
+  for (const Node &n : moves.children)
+    if (n.kind != "rapid")
+      out.push_back(*n.number("feed"));
+  return out;
+}
+
+} // namespace
+
+TEST_CASE("adapt-feed: a straight slot gets fz = h*", "[adapt-feed]") {
+  ir::test::Parsed p = parsed();
+  // Programmed 0.2 mm per tooth: 0.2 x 4 x 3000 = 2400 mm/min. Slotting 5 deep.
+  straightCut(*p.module, Vec3(-10, 25, -5), Vec3(110, 25, -5), 2400);
+  REQUIRE(runPasses(*p.module, "adapt-feed"));
+  const std::vector<double> f = feeds(*ir::test::find(p.module->root, "@ws").child("moves"));
+  // The plunge outside the block is kept; the slot in full engagement gets
+  // h* x flutes x rev/min = 0.10 x 4 x 3000 = 1200 mm/min; where the tool
+  // enters and leaves the block it is engaged less, so the pieces there are
+  // no slower.
+  REQUIRE(f.size() >= 2);
+  CHECK(f.front() == 2400);
+  double lowest = 1e9;
+  for (size_t i = 1; i < f.size(); ++i)
+    lowest = std::min(lowest, f[i]);
+  CHECK(lowest == Approx(1200).margin(1));
+  for (double v : f)
+    CHECK(v <= 2400);
+}
+
+TEST_CASE("adapt-feed: a wall at constant radial depth gets the chip-thinning feed", "[adapt-feed]") {
+  for (const double ae : {0.5, 1.0, 2.0}) {
+    ir::test::Parsed p = parsed();
+    // Along the block's side y = 50, the tool's edge 1 mm into it, 5 deep, well
+    // over the chip target (1 mm per tooth programmed).
+    const double y = 50 + 5 - ae;
+    straightCut(*p.module, Vec3(-10, y, -5), Vec3(110, y, -5), 12000);
+    REQUIRE(runPasses(*p.module, "adapt-feed"));
+    const std::vector<double> f = feeds(*ir::test::find(p.module->root, "@ws").child("moves"));
+    // fz = h* / sin(phi_e), phi_e = acos(1 - ae / R) (REFERENCES: chip thinning).
+    const double expected = 0.10 / std::sin(std::acos(1 - ae / 5)) * 4 * 3000;
+    // The piece along the middle of the wall (the ends, where the tool enters
+    // and leaves the block, take less).
+    double middle = 0;
+    for (const Move &m : walkMoves(*ir::test::find(p.module->root, "@ws").child("moves")))
+      if (m.isFeed() && m.from && !m.changesHeight() && m.from->x() < 50 && m.to.x() > 50)
+        middle = m.feed;
+    INFO("ae " << ae << " feeds " << f.size());
+    // The height field places the wall to a cell (R / 60): at ae = 0.5 that is
+    // 5 % of the chip factor, less for wider cuts.
+    CHECK(middle == Approx(expected).epsilon(ae < 1 ? 0.06 : 0.04));
+  }
+}
+
+TEST_CASE("adapt-feed: pocket corners get lower feeds than the walls", "[adapt-feed]") {
+  ir::test::Parsed p = parsed();
+  // Contour-parallel roughing of the 40 x 30 pocket, 3 mm stepover at one level.
+  Node &op = ir::test::find(p.module->root, "bottom_and_side_rough_milling");
+  op.set("axial_depth", Value::length(10)).set("radial_depth", Value::length(3));
+  Node &tech = op.add(Node("technology"));
+  tech.set("feed", Value::feed(12000)).set("spindle", Value::spindle(-3000));
+  op.add(Node("strategy")).set("type", Value::word("contour_parallel"));
+  std::vector<std::string> errors;
+  REQUIRE(runPasses(*p.module, "expand-strategies,adapt-feed,verify-toolpaths", &errors));
+  const Node &moves = *ir::test::find(p.module->root, "@ws").child("moves");
+  // The outermost ring at the floor: the tool centre runs round [35, 65] x
+  // [15, 35]. Along the middles of its sides the tool takes the 3 mm left by
+  // the ring inside it; coming into a corner it meets the side ahead too, so
+  // the engagement and the chip factor rise and the feed must drop.
+  double wallLow = 1e9, cornerLow = 1e9;
+  for (const Move &m : walkMoves(moves)) {
+    if (!m.isFeed() || !m.from || m.changesHeight() || std::abs(m.to.z() + 10) > 1e-6)
+      continue;
+    auto onRing = [](const Vec3 &q) {
+      return std::abs(q.x() - 35) < 1e-3 || std::abs(q.x() - 65) < 1e-3 || std::abs(q.y() - 15) < 1e-3 ||
+             std::abs(q.y() - 35) < 1e-3;
+    };
+    if (!onRing(*m.from) || !onRing(m.to))
+      continue;
+    double nearest = 1e9;
+    for (const Vec3 &c : {Vec3(35, 15, 0), Vec3(65, 15, 0), Vec3(65, 35, 0), Vec3(35, 35, 0)})
+      nearest = std::min(nearest, (m.to.head<2>() - c.head<2>()).norm());
+    const Vec3 mid = (*m.from + m.to) / 2;
+    double midNearest = 1e9;
+    for (const Vec3 &c : {Vec3(35, 15, 0), Vec3(65, 15, 0), Vec3(65, 35, 0), Vec3(35, 35, 0)})
+      midNearest = std::min(midNearest, (mid.head<2>() - c.head<2>()).norm());
+    if (nearest < 1e-3)
+      cornerLow = std::min(cornerLow, m.feed);  // the piece that ends in a corner
+    else if (midNearest > 8)
+      wallLow = std::min(wallLow, m.feed);
+  }
+  REQUIRE(wallLow < 1e9);
+  REQUIRE(cornerLow < 1e9);
+  CHECK(cornerLow < 0.9 * wallLow);
+}
+
+TEST_CASE("adapt-feed: options are checked", "[adapt-feed]") {
+  ir::test::Parsed p = parsed();
+  std::vector<std::string> errors;
+  CHECK_FALSE(runPasses(*p.module, "adapt-feed<allow-increase=maybe>", &errors));
+  REQUIRE(errors.size() == 1);
+  CHECK(errors[0] == "adapt-feed: allow-increase='maybe' must be true or false");
+}
