@@ -75,12 +75,4 @@ void HeightMap::cutAlong(const geom::Seg &s, double r, double z0, double z1, dou
   }
 }
 
-double HeightMap::volumeAbove(double floor) const {
-  double v = 0;
-  for (float h : h_)
-    if (h > floor)
-      v += h - floor;
-  return v * cell_ * cell_;
-}
-
 } // namespace stepnc::cutting

@@ -54,9 +54,6 @@ public:
   /// strays from the segment, or changes height, by more than `step`.
   void cutAlong(const geom::Seg &s, double r, double z0, double z1, double step);
 
-  /// Volume of material above height `floor` (mm^3), for tests and reports.
-  double volumeAbove(double floor) const;
-
 private:
   geom::Box box_;
   double cell_ = 1, inv_ = 1;

@@ -23,8 +23,6 @@ const std::array<Vec2, Engagement::kAngles> &directions() {
 
 } // namespace
 
-Vec2 Engagement::direction(int k) { return directions()[((k % kAngles) + kAngles) % kAngles]; }
-
 bool Engagement::cutting() const {
   for (int k = 0; k < kAngles; ++k)
     if (depth[k] > 0 && directions()[k].dot(feedDir) > 0)

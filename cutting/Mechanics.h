@@ -43,7 +43,6 @@ struct Engagement {
   std::array<float, kAngles> depth{};
   Vec2 feedDir = Vec2::UnitX(); ///< unit, direction of travel
 
-  static Vec2 direction(int k);
   /// Whether any edge in front of the cutter meets material.
   bool cutting() const;
   /// The largest cos(theta) over the engaged directions in front of the

@@ -189,4 +189,20 @@ bool equal(const Node &a, const Node &b) {
   return true;
 }
 
+void replaceCommentPart(Node &node, std::initializer_list<std::string_view> prefixes, std::string_view text) {
+  std::string kept;
+  std::string_view rest = node.comment;
+  while (!rest.empty()) {
+    const size_t end = rest.find("; ");
+    const std::string_view part = rest.substr(0, end);
+    bool ours = false;
+    for (std::string_view p : prefixes)
+      ours = ours || part.starts_with(p);
+    if (!ours)
+      kept += std::string(part) + "; ";
+    rest = end == std::string_view::npos ? std::string_view() : rest.substr(end + 2);
+  }
+  node.comment = kept + std::string(text);
+}
+
 } // namespace stepnc::ir

@@ -18,6 +18,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <cstdint>
+#include <initializer_list>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -129,5 +130,10 @@ struct Module {
 
 /// Structural equality (kinds, symbols, labels, attributes, children; not origins).
 bool equal(const Node &a, const Node &b);
+
+/// Passes that report figures in a node's comment keep them as parts joined
+/// by "; ": this drops the parts that start with any of `prefixes` (a
+/// pass's figures from an earlier run) and appends `text`, keeping the rest.
+void replaceCommentPart(Node &node, std::initializer_list<std::string_view> prefixes, std::string_view text);
 
 } // namespace stepnc::ir

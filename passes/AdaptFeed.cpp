@@ -322,16 +322,7 @@ private:
                        " mm, F_max " + formatFixed(f.forceBefore, 0) + " -> " + formatFixed(f.forceAfter, 0) + " N";
     if (timed)
       text += ", time " + formatFixed(f.timeBefore, 2) + " -> " + formatFixed(f.timeAfter, 2) + " s";
-    std::string kept;
-    std::string_view rest = movesNode.comment;
-    while (!rest.empty()) {
-      const size_t end = rest.find("; ");
-      const std::string_view part = rest.substr(0, end);
-      if (!part.starts_with("adapt-feed:"))
-        kept += std::string(part) + "; ";
-      rest = end == std::string_view::npos ? std::string_view() : rest.substr(end + 2);
-    }
-    movesNode.comment = kept + text;
+    ir::replaceCommentPart(movesNode, {"adapt-feed:"}, text);
   }
 
   void writeReport(const CutAnalysis &before, const CutAnalysis &after,

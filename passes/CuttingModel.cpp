@@ -68,26 +68,10 @@ MaterialChoice chooseMaterial(const ir::Node *workpiece, const cutting::CuttingD
   }
   const auto it = data.materials.find(data.defaultMaterial);
   c.material = it != data.materials.end() ? &it->second : nullptr;
-  c.defaulted = true;
   c.note = (workpiece ? "material '" + id + "' ('" + standard + "') is not in the cutting data"
                       : std::string("no workpiece names a material")) +
            ": defaulted to " + data.defaultMaterial;
   return c;
-}
-
-/// The block raw piece of a workpiece in its coordinates: corners and top.
-std::optional<std::pair<geom::Box, double>> rawBlock(const ir::Node *workpiece) {
-  const ir::Node *raw = workpiece ? workpiece->child("rawpiece") : nullptr;
-  if (!raw || raw->text("shape") != "block" || !raw->has("size"))
-    return std::nullopt;
-  FrameResult fr = planeFrame(*raw);
-  if (!fr.frame)
-    return std::nullopt;
-  const ir::Vec3 size = *raw->vec("size");
-  geom::Box box;
-  for (const Vec2 &c : {Vec2(0, 0), Vec2(size.x(), 0), Vec2(size.x(), size.y()), Vec2(0, size.y())})
-    box.add(fr.frame->map(c));
-  return std::make_pair(box, fr.frame->z + size.z());
 }
 
 /// Samples along a move's plane path: (distance from start, point, direction).
@@ -113,14 +97,11 @@ std::vector<PathPoint> samplePath(const std::vector<geom::Seg> &segs, double ste
   return out;
 }
 
-const std::string &operationKind(const ir::Node &executable, std::string &storage) {
-  storage.clear();
+std::string operationKind(const ir::Node &executable) {
   for (const ir::Node &c : executable.children)
-    if (const ir::KindSpec *spec = ir::findKind(c.kind); spec && spec->category == "operation") {
-      storage = c.kind;
-      break;
-    }
-  return storage;
+    if (const ir::KindSpec *spec = ir::findKind(c.kind); spec && spec->category == "operation")
+      return c.kind;
+  return {};
 }
 
 } // namespace
@@ -223,8 +204,7 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
     CutStep step;
     step.executable = p.exec;
     step.movesNode = p.moves;
-    std::string storage;
-    step.operation = operationKind(*p.exec, storage);
+    step.operation = operationKind(*p.exec);
     step.finishing = step.operation.find("finish") != std::string::npos;
     if (auto t = out.tools.find(p.moves->text("tool").value_or("")); t != out.tools.end())
       step.tool = &t->second;
@@ -250,9 +230,9 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
       // The stock's extent: the raw piece and everything this setup's moves
       // sweep.
       const ir::Node *wp = setupWorkpiece(module, p.setup);
-      const auto raw = rawBlock(wp);
-      geom::Box box = raw ? raw->first : geom::Box{};
-      double top = raw ? raw->second : -kInf;
+      const std::optional<RawBlock> raw = rawBlock(wp);
+      geom::Box box = raw ? raw->box : geom::Box{};
+      double top = raw ? raw->top : -kInf;
       for (const Pending &q : pending) {
         if (q.setup != p.setup)
           continue;
@@ -260,16 +240,14 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
         if (auto t = out.tools.find(q.moves->text("tool").value_or("")); t != out.tools.end())
           r = t->second.cutter.radius;
         for (const Move &m : walkMoves(*q.moves))
-          if (m.isFeed()) {
+          if (m.isFeed())
             box.add(geom::Box{m.to.head<2>(), m.to.head<2>()}.grown(r + 1));
-            if (!raw) {
-              // No block raw piece: material up to the highest feature top.
-              if (auto f = q.exec->text("feature"))
-                if (const ir::Node *feature = findFeature(module, *f))
-                  if (auto shape = featureShape(module, *feature).shape)
-                    top = std::max(top, shape->top);
-            }
-          }
+        // No block raw piece: material up to the highest feature top.
+        if (!raw)
+          if (auto f = q.exec->text("feature"))
+            if (const ir::Node *feature = findFeature(module, *f))
+              if (auto shape = featureShape(module, *feature).shape)
+                top = std::max(top, shape->top);
       }
       if (box.empty())
         box = geom::Box{Vec2(0, 0), Vec2(1, 1)};
@@ -280,7 +258,7 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
         cell *= 1.25;
       cutting::HeightMap map(box.grown(2 * cell), cell);
       if (raw) {
-        map.addBlock(raw->first.lo, raw->first.hi, raw->second);
+        map.addBlock(raw->box.lo, raw->box.hi, raw->top);
       } else if (std::isfinite(top)) {
         map.addBlock(box.lo, box.hi, top);
         out.notes.push_back("setup " + (p.setup.empty() ? std::string("(none)") : p.setup) +
@@ -335,7 +313,7 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
         }
       }
       // Cut the move into the stock.
-      const double step_ = std::max(map.cell(), 0.05);
+      const double cutStep = std::max(map.cell(), 0.05);
       if (segs.empty()) {
         map.cutDisc(m.to.head<2>(), radius, std::min(m.from->z(), m.to.z()) + point);
         continue;
@@ -347,7 +325,7 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
         const double z0 = zAt;
         run += seg.length();
         zAt = m.from->z() + (m.to.z() - m.from->z()) * std::min(1.0, run / std::max(total, 1e-12));
-        map.cutAlong(seg, radius, z0 + point, zAt + point, step_);
+        map.cutAlong(seg, radius, z0 + point, zAt + point, cutStep);
       }
     }
     out.steps.push_back(std::move(step));

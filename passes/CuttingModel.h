@@ -24,8 +24,7 @@ namespace stepnc::passes {
 
 struct CutterSetup {
   std::string symbol;
-  bool mill = false; ///< a milling cutter (the model applies); drills and the
-                     ///< like are only cut into the stock
+  bool mill = false; ///< a milling cutter (the model applies); drills and the like are only cut into the stock
   cutting::Cutter cutter;
   cutting::ToolBeam beam;
   std::string toolMaterial;
@@ -42,8 +41,7 @@ struct CutSample {
   double ae = 0, ap = 0; ///< mm, radial (equivalent) and axial depth
   int side = 0;          ///< +1 material on the left, -1 right, 0 none or both
   double fzForce = 0;    ///< largest fz whose peak force stays within the tool's limit (mm)
-  double fzTorque = 0;   ///< largest fz within the spindle's torque and power
-                         ///< (mm; inf without a machine)
+  double fzTorque = 0;   ///< largest fz within the spindle's torque and power (mm; inf without a machine)
   double force = 0;      ///< N, peak at the move's feed
   double torque = 0;     ///< N m, mean at the move's feed
 };
@@ -81,9 +79,7 @@ struct CutAnalysis {
 /// The material of the workpiece a setup holds, and how it was chosen.
 struct MaterialChoice {
   const cutting::Material *material = nullptr;
-  std::string note; ///< "C45E 1.1191 read as steel_1045 (alias C45E)" or why it
-                    ///< was defaulted
-  bool defaulted = false;
+  std::string note; ///< "C45E 1.1191 read as steel_1045 (alias C45E)" or why it was defaulted
 };
 
 CutterSetup cutterSetup(const ir::Node &tool, const cutting::CuttingData &data);

@@ -287,17 +287,8 @@ public:
 
 private:
   geom::Box rawBox() const {
-    geom::Box box;
-    const Node *raw = workpiece_ ? workpiece_->child("rawpiece") : nullptr;
-    if (!raw || raw->text("shape") != "block" || !raw->has("size"))
-      return box;
-    FrameResult fr = planeFrame(*raw);
-    if (!fr.frame)
-      return box;
-    const ir::Vec3 size = *raw->vec("size");
-    for (const Vec2 &c : {Vec2(0, 0), Vec2(size.x(), 0), Vec2(size.x(), size.y()), Vec2(0, size.y())})
-      box.add(fr.frame->map(c));
-    return box;
+    const std::optional<RawBlock> raw = rawBlock(workpiece_);
+    return raw ? raw->box : geom::Box{};
   }
 
   const ir::Module &module_;
@@ -341,6 +332,21 @@ double pointLength(const ir::Node &tool) {
   if (!(half > 0 && half < 90))
     return 0;
   return tool.number("diameter").value_or(0) / 2 * std::tan(half * std::numbers::pi / 180);
+}
+
+std::optional<RawBlock> rawBlock(const ir::Node *workpiece) {
+  const Node *raw = workpiece ? workpiece->child("rawpiece") : nullptr;
+  if (!raw || raw->text("shape") != "block" || !raw->has("size"))
+    return std::nullopt;
+  FrameResult fr = planeFrame(*raw);
+  if (!fr.frame)
+    return std::nullopt;
+  const ir::Vec3 size = *raw->vec("size");
+  RawBlock block;
+  for (const Vec2 &c : {Vec2(0, 0), Vec2(size.x(), 0), Vec2(size.x(), size.y()), Vec2(0, size.y())})
+    block.box.add(fr.frame->map(c));
+  block.top = fr.frame->z + size.z();
+  return block;
 }
 
 const ir::Node *findFeature(const ir::Module &module, std::string_view symbol) {

@@ -85,6 +85,14 @@ ShapeResult featureShape(const ir::Module &module, const ir::Node &feature);
 /// 14649-111: 0 for a flat end mill; a 140 deg carbide drill has 20 deg).
 double pointLength(const ir::Node &tool);
 
+/// A workpiece's block raw piece in its coordinates: its extent in the plane
+/// and the height of its top; nullopt when it has none or another shape.
+struct RawBlock {
+  geom::Box box;
+  double top = 0;
+};
+std::optional<RawBlock> rawBlock(const ir::Node *workpiece);
+
 /// The feature node a symbol names, or null.
 const ir::Node *findFeature(const ir::Module &module, std::string_view symbol);
 

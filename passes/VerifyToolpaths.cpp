@@ -770,16 +770,7 @@ private:
       add("gouge " + formatFixed(*f.gouge, 3) + " mm2");
     add("path " + formatFixed(f.path, 1) + " mm");
     add(std::to_string(f.moves) + " moves");
-    std::string kept;
-    std::string_view rest = movesNode.comment;
-    while (!rest.empty()) {
-      const size_t end = rest.find("; ");
-      const std::string_view part = rest.substr(0, end);
-      if (!part.starts_with("swept ") && !part.starts_with("path "))
-        kept += std::string(part) + "; ";
-      rest = end == std::string_view::npos ? std::string_view() : rest.substr(end + 2);
-    }
-    movesNode.comment = kept + text;
+    ir::replaceCommentPart(movesNode, {"swept ", "path "}, text);
     changed_ = true;
   }
 

@@ -72,8 +72,11 @@ int runSim(const SimCommandOptions &opts) {
       hasMotion |= e->child("motion") != nullptr;
     }
     std::string pipeline;
-    if (!hasMoves)
-      pipeline = toolpathPipeline({machineName}) + ",";
+    if (!hasMoves) {
+      ToolpathPipelineOptions toolpath;
+      toolpath.machine = machineName;
+      pipeline = toolpathPipeline(toolpath) + ",";
+    }
     if (!hasMotion || opts.tolerance)
       pipeline += planMotionPipeline(machineName, opts.tolerance);
     else if (!pipeline.empty())
