@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <optional>
 
 namespace stepnc::runtime {
 
@@ -31,32 +30,84 @@ constexpr double kToleranceShare = 0.9;
 /// Segments whose caps differ by more than this factor are not one run.
 constexpr double kRunCapSpread = 0.8;
 
+/// A programmed move with any length, as the planner keeps it: its line or
+/// arc without the fields a Segment has for blends (control points, arc-length
+/// table) and without its ends, which are the programmed points
+/// (`segment()` makes the same Segment again), so that the planner's working
+/// copy of a long program stays small.
 struct Piece {
-  Segment seg;
+  double length = 0;  ///< mm
+  double centerX = 0, centerY = 0, radius = 0, startAngle = 0, sweep = 0;  ///< arcs, as in Segment
   double feed = 0;  ///< mm/s; 0 for rapids
-  uint32_t move = 0;
-  bool stopBefore = false;
   double cutStart = 0, cutEnd = 0;  ///< mm taken by blends at either end
   /// A line wholly taken by the blends at its ends, inside a chain of short
   /// lines: the curvature the two blends share at its middle (see
-  /// smoothChains).
-  std::optional<Vec3> midCurvature;
+  /// smoothChains), when hasMidCurvature.
+  Vec3 midCurvature = Vec3::Zero();
+  uint32_t move = 0;
+  SegmentKind kind = SegmentKind::Line;
+  bool ccw = true;
+  bool stopBefore = false;
+  bool hasMidCurvature = false;
+  /// How it meets the piece before it (join): through a blend, or at rest
+  /// for `stopReason`; neither when tangent and curvature already agree.
+  bool blendBefore = false;
+  StopReason stopReason = StopReason::None;
+
+  Piece(const Segment &s, uint32_t moveIndex)
+      : length(s.length), centerX(s.center.x()), centerY(s.center.y()), radius(s.radius), startAngle(s.startAngle),
+        sweep(s.sweep), move(moveIndex), kind(s.kind), ccw(s.ccw) {}
+
+  /// Where the move starts: where the one before it ends (moves of no
+  /// length, which make no piece, included).
+  const Vec3 &from(const PathInput &input) const { return move == 0 ? input.start : input.moves[move - 1].to; }
+  const Vec3 &to(const PathInput &input) const { return input.moves[move].to; }
+
+  /// The move's segment, as Segment::line or Segment::arcTurns made it.
+  Segment segment(const PathInput &input) const {
+    Segment s;
+    s.kind = kind;
+    s.start = from(input);
+    s.end = to(input);
+    s.length = length;
+    s.center = Vec3(centerX, centerY, 0);
+    s.radius = radius;
+    s.startAngle = startAngle;
+    s.sweep = sweep;
+    s.ccw = ccw;
+    return s;
+  }
 };
 
-/// The part [s0, s1] of a line or arc, ready for many distance queries.
-/// Distances to helices are an upper bound (a point of the helix at the
-/// query's angle).
+/// The points at which blendDeviation samples a blend: u = i / 24 for
+/// i = 1..23, and the last again (an even count, for the compiler's pairs).
+constexpr int kDeviationSamples = 24;
+struct DeviationPoints {
+  static constexpr size_t kCount = kDeviationSamples;
+  std::array<double, kCount> x, y, z;
+};
+
+/// The part [s0, s1] of a line or arc, for the squared distances of many
+/// points from it. Squared, so that only the largest of them needs a square
+/// root (which is monotone and correctly rounded: the same bits as taking the
+/// root of each). Distances to plane arcs are exact and need no trigonometry
+/// per point: the nearest point of the circle is in p's direction from the
+/// axis, and whether that direction lies within the part's angles follows
+/// from two cross products with the directions of its ends. Distances to
+/// helices are an upper bound (a point of the helix at the point's angle).
 class PartDistance {
 public:
+  using Squares = std::array<double, DeviationPoints::kCount>;
+
   PartDistance(const Segment &seg, double s0, double s1) {
     first_ = seg.at(s0).p;
     last_ = seg.at(s1).p;
-    line_ = seg.kind == SegmentKind::Line;
-    if (line_) {
+    if (seg.kind == SegmentKind::Line) {
       dir_ = seg.length > 0 ? Vec3((seg.end - seg.start) / seg.length) : Vec3::Zero();
       span_ = s1 - s0;
       return;
     }
+    kind_ = Kind::Helix;
     const double rise = seg.sweep > 0 ? (seg.end.z() - seg.start.z()) / seg.sweep : 0;
     const double k = std::sqrt(seg.radius * seg.radius + rise * rise);
     sigma_ = seg.ccw ? 1 : -1;
@@ -67,29 +118,74 @@ public:
     startAngle_ = seg.startAngle;
     z0_ = seg.start.z();
     rise_ = rise;
+    if (rise == 0) {
+      kind_ = Kind::PlaneArc;
+      const double a0 = startAngle_ + sigma_ * t0_, a1 = startAngle_ + sigma_ * t1_;
+      e0_ = Eigen::Vector2d(std::cos(a0), std::sin(a0));
+      e1_ = Eigen::Vector2d(std::cos(a1), std::sin(a1));
+      whole_ = t1_ - t0_ >= 2 * kPi;
+      wide_ = t1_ - t0_ > kPi;
+    }
   }
 
-  double operator()(const Vec3 &p) const {
-    if (line_) {
-      const double s = std::clamp((p - first_).dot(dir_), 0.0, span_);
-      return (first_ + dir_ * s - p).norm();
+  /// The squared distance of each point.
+  void squares(const DeviationPoints &pts, Squares &out) const {
+    constexpr size_t n = DeviationPoints::kCount;
+    switch (kind_) {
+    case Kind::Line:
+      for (size_t i = 0; i < n; ++i) {
+        const double px = pts.x[i], py = pts.y[i], pz = pts.z[i];
+        const double along = (px - first_.x()) * dir_.x() + (py - first_.y()) * dir_.y() + (pz - first_.z()) * dir_.z();
+        const double s = std::clamp(along, 0.0, span_);
+        const double ex = first_.x() + dir_.x() * s - px, ey = first_.y() + dir_.y() * s - py,
+                     ez = first_.z() + dir_.z() * s - pz;
+        out[i] = ex * ex + ey * ey + ez * ez;
+      }
+      return;
+    case Kind::PlaneArc:
+      for (size_t i = 0; i < n; ++i) {
+        const Vec3 p(pts.x[i], pts.y[i], pts.z[i]);
+        double best = std::min((first_ - p).squaredNorm(), (last_ - p).squaredNorm());
+        const double wx = p.x() - centre_.x(), wy = p.y() - centre_.y();
+        // Turning the part's way, the angle from its start to w is at most
+        // pi where fromStart >= 0, and from w to its end where toEnd >= 0;
+        // the part holds the angles within both (up to a half turn) or
+        // within either (more).
+        const double fromStart = sigma_ * (e0_.x() * wy - e0_.y() * wx);
+        const double toEnd = sigma_ * (wx * e1_.y() - wy * e1_.x());
+        if (whole_ || (wide_ ? fromStart >= 0 || toEnd >= 0 : fromStart >= 0 && toEnd >= 0)) {
+          const double radial = std::sqrt(wx * wx + wy * wy) - radius_, dz = p.z() - z0_;
+          best = std::min(best, radial * radial + dz * dz);
+        }
+        out[i] = best;
+      }
+      return;
+    case Kind::Helix:
+      for (size_t i = 0; i < n; ++i) {
+        const Vec3 p(pts.x[i], pts.y[i], pts.z[i]);
+        double best = std::min((first_ - p).squaredNorm(), (last_ - p).squaredNorm());
+        constexpr double kTurn = 2 * kPi;
+        // The angle of p about the axis, from the part's start, taken into [0, 2 pi).
+        double theta = sigma_ * (std::atan2(p.y() - centre_.y(), p.x() - centre_.x()) - startAngle_) - t0_;
+        theta -= kTurn * std::floor(theta / kTurn);
+        for (double t = t0_ + theta; t <= t1_; t += kTurn) {
+          const double phi = startAngle_ + sigma_ * t;
+          const Vec3 q(centre_.x() + radius_ * std::cos(phi), centre_.y() + radius_ * std::sin(phi), z0_ + rise_ * t);
+          best = std::min(best, (q - p).squaredNorm());
+        }
+        out[i] = best;
+      }
+      return;
     }
-    constexpr double kTurn = 2 * 3.14159265358979323846;
-    double best = std::min((first_ - p).norm(), (last_ - p).norm());
-    // The angle of p about the axis, from the part's start, taken into [0, 2 pi).
-    double theta = sigma_ * (std::atan2(p.y() - centre_.y(), p.x() - centre_.x()) - startAngle_) - t0_;
-    theta -= kTurn * std::floor(theta / kTurn);
-    for (double t = t0_ + theta; t <= t1_; t += kTurn) {
-      const double phi = startAngle_ + sigma_ * t;
-      const Vec3 q(centre_.x() + radius_ * std::cos(phi), centre_.y() + radius_ * std::sin(phi), z0_ + rise_ * t);
-      best = std::min(best, (q - p).norm());
-    }
-    return best;
   }
 
 private:
+  static constexpr double kPi = 3.14159265358979323846;
+  enum class Kind : uint8_t { Line, PlaneArc, Helix };
   Vec3 first_, last_, dir_ = Vec3::Zero(), centre_ = Vec3::Zero();
-  bool line_ = true;
+  Eigen::Vector2d e0_ = Eigen::Vector2d::Zero(), e1_ = Eigen::Vector2d::Zero();  ///< plane arcs: directions of the ends
+  Kind kind_ = Kind::Line;
+  bool whole_ = false, wide_ = false;  ///< plane arcs: a whole turn or more; more than half a turn
   double span_ = 0, sigma_ = 1, t0_ = 0, t1_ = 0, radius_ = 0, startAngle_ = 0, z0_ = 0, rise_ = 0;
 };
 
@@ -115,76 +211,74 @@ std::array<Vec3, 6> blendPoints(const Segment &a, double la, const Segment &b, d
 /// How far a blend strays from the two pieces it replaces (sampled along
 /// its parameter: no arc-length inversion needed to find the worst point).
 double blendDeviation(const std::array<Vec3, 6> &ctrl, const Segment &a, double la, const Segment &b, double lb) {
-  constexpr int kSamples = 24;
   const QuinticCurve curve(ctrl);
-  const PartDistance toA(a, a.length - la, a.length), toB(b, 0, lb);
-  double worst = 0;
-  for (int i = 1; i < kSamples; ++i) {
-    const Vec3 p = curve.point(double(i) / kSamples);
-    worst = std::max(worst, std::min(toA(p), toB(p)));
+  DeviationPoints pts;
+  for (size_t i = 0; i < DeviationPoints::kCount; ++i) {
+    const double u = double(std::min<size_t>(i + 1, kDeviationSamples - 1)) / kDeviationSamples;
+    const Vec3 p = curve.point(u);
+    pts.x[i] = p.x();
+    pts.y[i] = p.y();
+    pts.z[i] = p.z();
   }
-  return worst;
+  PartDistance::Squares toA, toB;
+  PartDistance(a, a.length - la, a.length).squares(pts, toA);
+  PartDistance(b, 0, lb).squares(pts, toB);
+  double worst = 0;
+  for (size_t i = 0; i < DeviationPoints::kCount; ++i)
+    worst = std::max(worst, std::min(toA[i], toB[i]));
+  return std::sqrt(worst);
 }
 
-struct Junction {
-  bool stop = false;
-  StopReason reason = StopReason::None;
-  bool blended = false;
-  Segment blend;
-};
-
-/// Decides how pieces a and b meet: smoothly, through a blend, or at rest.
-Junction join(Piece &a, Piece &b, double tolerance) {
-  Junction j;
+/// Decides how pieces a and b (whose segments are sa and sb) meet: smoothly,
+/// through a blend (b.blendBefore, with a.cutEnd and b.cutStart), or at rest
+/// (b.stopReason).
+void join(Piece &a, const Segment &sa, Piece &b, const Segment &sb, double tolerance) {
   if (b.stopBefore) {
-    j.stop = true;
-    j.reason = StopReason::Program;
-    return j;
+    b.stopReason = StopReason::Program;
+    return;
   }
-  const PathPoint ea = a.seg.at(a.seg.length), sb = b.seg.at(0);
-  const double cosTurn = std::clamp(ea.r1.dot(sb.r1), -1.0, 1.0);
+  const PathPoint ea = sa.at(sa.length), bs = sb.at(0);
+  const double cosTurn = std::clamp(ea.r1.dot(bs.r1), -1.0, 1.0);
   const double turn = std::acos(cosTurn);
-  const double scale = 1 / std::max(1e-3, std::max(ea.r2.norm(), sb.r2.norm()));  // a length of the curves
-  if (turn < 1e-9 && (ea.r2 - sb.r2).norm() * scale < 1e-9)
-    return j;  // tangent and curvature already agree
+  const double scale = 1 / std::max(1e-3, std::max(ea.r2.norm(), bs.r2.norm()));  // a length of the curves
+  if (turn < 1e-9 && (ea.r2 - bs.r2).norm() * scale < 1e-9)
+    return;  // tangent and curvature already agree
   if (turn > kReversal) {
-    j.stop = true;
-    j.reason = StopReason::Reversal;
-    return j;
+    b.stopReason = StopReason::Reversal;
+    return;
   }
   // Cut back as far as the tolerance allows, at most half of each piece
   // (the other half belongs to the blend at its other end).
   const double target = tolerance * kToleranceShare;
-  double l = std::min(a.seg.length / 2, b.seg.length / 2);
-  const bool linear = a.seg.kind == SegmentKind::Line && b.seg.kind == SegmentKind::Line;
+  double l = std::min(sa.length / 2, sb.length / 2);
+  auto blendHere = [&] {
+    b.blendBefore = true;
+    a.cutEnd = l;
+    b.cutStart = l;
+  };
+  const bool linear = sa.kind == SegmentKind::Line && sb.kind == SegmentKind::Line;
   if (linear) {
     // Between two lines the blend is symmetric about the corner's bisector
     // and the same shape at every size: its deviation is its middle's
     // distance from the lines, proportional to l.
-    const QuinticCurve curve(blendPoints(a.seg, l, b.seg, l));
-    const Vec3 mid = curve.point(0.5), dir = a.seg.at(0).r1;
-    const Vec3 off = mid - a.seg.end;
+    const QuinticCurve curve(blendPoints(sa, l, sb, l));
+    const Vec3 mid = curve.point(0.5), dir = sa.at(0).r1;
+    const Vec3 off = mid - sa.end;
     const double dev = (off - dir * off.dot(dir)).norm();
     if (dev > target)
       l *= target / dev;
     if (l >= kTinyBlend) {
-      j.blended = true;
-      j.blend = Segment::blend(blendPoints(a.seg, l, b.seg, l));
-      a.cutEnd = l;
-      b.cutStart = l;
-      return j;
+      blendHere();
+      return;
     }
   }
   double lastL = 0, lastDev = 0;
   for (int it = 0; it < 40 && l >= kTinyBlend; ++it) {
-    const std::array<Vec3, 6> ctrl = blendPoints(a.seg, l, b.seg, l);
-    const double dev = blendDeviation(ctrl, a.seg, l, b.seg, l);
+    const std::array<Vec3, 6> ctrl = blendPoints(sa, l, sb, l);
+    const double dev = blendDeviation(ctrl, sa, l, sb, l);
     if (dev <= target) {
-      j.blended = true;
-      j.blend = Segment::blend(ctrl);
-      a.cutEnd = l;
-      b.cutStart = l;
-      return j;
+      blendHere();
+      return;
     }
     // The deviation grows like l^p near the junction, p between 1 (a
     // corner) and 3 (a curvature step): estimated from the last two tries,
@@ -196,9 +290,7 @@ Junction join(Piece &a, Piece &b, double tolerance) {
     lastDev = dev;
     l *= std::clamp(std::pow(0.97 * target / dev, 1 / p), 0.02, 0.95);
   }
-  j.stop = true;
-  j.reason = StopReason::Tiny;
-  return j;
+  b.stopReason = StopReason::Tiny;
 }
 
 /// The speed cap and the path acceleration and jerk for one segment.
@@ -248,16 +340,32 @@ void limitsFor(const Segment &seg, double feed, const Machine &machine, SegmentI
 
 /// The curvature vector of the circle through the vertex between lines a and
 /// b and the vertices before and after it; zero when either is not a line.
-Vec3 vertexCurvature(const Piece &a, const Piece &b) {
-  if (a.seg.kind != SegmentKind::Line || b.seg.kind != SegmentKind::Line)
+Vec3 vertexCurvature(const PathInput &input, const Piece &a, const Piece &b) {
+  if (a.kind != SegmentKind::Line || b.kind != SegmentKind::Line)
     return Vec3::Zero();
-  const Vec3 ta = (a.seg.end - a.seg.start) / a.seg.length, tb = (b.seg.end - b.seg.start) / b.seg.length;
+  const Vec3 &a0 = a.from(input), &a1 = a.to(input), &b0 = b.from(input), &b1 = b.to(input);
+  const Vec3 ta = (a1 - a0) / a.length, tb = (b1 - b0) / b.length;
   const Vec3 turn = tb - ta;
-  const double chord = (a.seg.end - a.seg.start + b.seg.end - b.seg.start).norm();
+  const double chord = (a1 - a0 + b1 - b0).norm();
   const double sinTurn = ta.cross(tb).norm();
   if (turn.norm() <= 0 || chord <= 0)
     return Vec3::Zero();
   return turn.normalized() * (2 * sinTurn / chord);
+}
+
+/// The end of a blend at arc length s of piece p (its segment): the piece's
+/// own point, with the shared curvature at a smoothed middle.
+PathPoint blendEnd(const Piece &p, const Segment &seg, double s) {
+  PathPoint pt = seg.at(s);
+  if (p.hasMidCurvature)
+    pt.r2 = p.midCurvature;
+  return pt;
+}
+
+/// The control points of the blend before piece b (b.blendBefore), from its
+/// pieces' cuts and curvatures as join and smoothChains leave them.
+std::array<Vec3, 6> blendBetween(const Piece &a, const Segment &sa, const Piece &b, const Segment &sb) {
+  return blendPoints(blendEnd(a, sa, sa.length - a.cutEnd), blendEnd(b, sb, b.cutStart));
 }
 
 /// Dense polylines (CAM output, a curve as many short lines) would become
@@ -269,34 +377,28 @@ Vec3 vertexCurvature(const Piece &a, const Piece &b) {
 /// through the neighbouring vertices). A remade blend that leaves the
 /// tolerance is given back its zero-curvature ends, and so is its neighbour
 /// across each such middle, until every blend is within tolerance and every
-/// middle's two blends agree.
-void smoothChains(std::vector<Piece> &pieces, std::vector<Junction> &joins, double tolerance) {
+/// middle's two blends agree. (The blends themselves are made from the
+/// pieces when the segments are written: blendBetween.)
+void smoothChains(const PathInput &input, std::vector<Piece> &pieces, double tolerance) {
   const size_t n = pieces.size();
   auto consumed = [&](size_t i) {
     const Piece &p = pieces[i];
-    return p.seg.kind == SegmentKind::Line && i > 0 && i + 1 < n && joins[i].blended && joins[i + 1].blended &&
-           p.seg.length - p.cutStart - p.cutEnd <= 1e-9;  // what is left is dropped (plan, step 3)
+    return p.kind == SegmentKind::Line && i > 0 && i + 1 < n && p.blendBefore && pieces[i + 1].blendBefore &&
+           p.length - p.cutStart - p.cutEnd <= 1e-9;  // what is left is dropped (plan, step 3)
   };
   for (size_t i = 0; i < n; ++i) {
     if (!consumed(i))
       continue;
-    const Vec3 t = (pieces[i].seg.end - pieces[i].seg.start) / pieces[i].seg.length;
-    Vec3 k = (vertexCurvature(pieces[i - 1], pieces[i]) + vertexCurvature(pieces[i], pieces[i + 1])) / 2;
+    const Vec3 t = (pieces[i].to(input) - pieces[i].from(input)) / pieces[i].length;
+    Vec3 k = (vertexCurvature(input, pieces[i - 1], pieces[i]) + vertexCurvature(input, pieces[i], pieces[i + 1])) / 2;
     k -= t * k.dot(t);  // normal to the line, as curvature is
     pieces[i].midCurvature = k;
+    pieces[i].hasMidCurvature = true;
   }
-  // The end of a blend: the piece's own point, with the shared curvature at
-  // a smoothed middle.
-  auto endPoint = [&](const Piece &p, double s) {
-    PathPoint pt = p.seg.at(s);
-    if (p.midCurvature)
-      pt.r2 = *p.midCurvature;
-    return pt;
-  };
   const double target = tolerance * kToleranceShare;
   std::vector<char> pending(n, 0);
   for (size_t j = 1; j < n; ++j)
-    pending[j] = joins[j].blended && (pieces[j - 1].midCurvature || pieces[j].midCurvature);
+    pending[j] = pieces[j].blendBefore && (pieces[j - 1].hasMidCurvature || pieces[j].hasMidCurvature);
   for (bool again = true; again;) {
     again = false;
     for (size_t j = 1; j < n; ++j) {
@@ -304,23 +406,17 @@ void smoothChains(std::vector<Piece> &pieces, std::vector<Junction> &joins, doub
         continue;
       pending[j] = 0;
       Piece &a = pieces[j - 1], &b = pieces[j];
-      if (!a.midCurvature && !b.midCurvature) {
-        // Zero-curvature ends again: the blend join() made and checked.
-        joins[j].blend = Segment::blend(blendPoints(a.seg, a.cutEnd, b.seg, b.cutStart));
+      if (!a.hasMidCurvature && !b.hasMidCurvature)
+        continue;  // zero-curvature ends again: the blend join() made and checked
+      const Segment sa = a.segment(input), sb = b.segment(input);
+      if (blendDeviation(blendBetween(a, sa, b, sb), sa, a.cutEnd, sb, b.cutStart) <= target)
         continue;
-      }
-      const double la = a.cutEnd, lb = b.cutStart;
-      const std::array<Vec3, 6> ctrl = blendPoints(endPoint(a, a.seg.length - la), endPoint(b, lb));
-      if (blendDeviation(ctrl, a.seg, la, b.seg, lb) <= target) {
-        joins[j].blend = Segment::blend(ctrl);
-        continue;
-      }
       // Back to zero curvature at both ends; the blends across those
       // middles are made again to match.
       for (size_t side : {j - 1, j}) {
-        if (!pieces[side].midCurvature)
+        if (!pieces[side].hasMidCurvature)
           continue;
-        pieces[side].midCurvature.reset();
+        pieces[side].hasMidCurvature = false;
         pending[side] = 1;          // the blend at the piece's start
         if (side + 1 < n)
           pending[side + 1] = 1;    // and at its end
@@ -348,64 +444,74 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   for (size_t i = 0; i < input.moves.size(); ++i) {
     const PathMove &m = input.moves[i];
     pendingStop = pendingStop || m.stopBefore;
-    Piece p;
-    p.seg = m.kind == PathMove::Kind::Line ? Segment::line(at, m.to)
-                                           : Segment::arcTurns(at, m.to, m.center, m.ccw, m.turns);
-    if (!(p.seg.length > 1e-9)) {
-      at = m.to;
+    const Segment seg = m.kind == PathMove::Kind::Line ? Segment::line(at, m.to)
+                                                       : Segment::arcTurns(at, m.to, m.center, m.ccw, m.turns);
+    at = m.to;
+    if (!(seg.length > 1e-9))
       continue;
-    }
+    Piece &p = pieces.emplace_back(seg, uint32_t(i));
     p.feed = m.feed > 0 ? m.feed / 60 : 0;
-    p.move = uint32_t(i);
     p.stopBefore = pendingStop;
     pendingStop = false;
-    pieces.push_back(std::move(p));
-    at = m.to;
   }
 
   // 2. Junctions: blends or stops.
-  std::vector<Junction> joins(pieces.size());
-  for (size_t i = 1; i < pieces.size(); ++i)
-    joins[i] = join(pieces[i - 1], pieces[i], tolerance);
-  smoothChains(pieces, joins, tolerance);
+  {
+    Segment before, here;
+    for (size_t i = 0; i < pieces.size(); ++i) {
+      before = here;
+      here = pieces[i].segment(input);
+      if (i > 0)
+        join(pieces[i - 1], before, pieces[i], here, tolerance);
+    }
+  }
+  smoothChains(input, pieces, tolerance);
 
   // 3. Segments with their caps.
-  auto push = [&](Segment seg, double feed, uint32_t move, uint32_t next, StopReason stop) {
-    SegmentInfo info;
+  size_t count = 0;
+  for (const Piece &p : pieces)
+    count += size_t(p.blendBefore) + size_t(p.length - p.cutEnd - p.cutStart > 1e-9);
+  out.segments.reserve(count);
+  out.info.reserve(count);
+  auto push = [&](double feed, uint32_t move, uint32_t next, StopReason stop) {
+    SegmentInfo &info = out.info.emplace_back();
     info.feed = feed;
     info.move = move;
     info.nextMove = next;
     info.stop = stop;
-    limitsFor(seg, feed, machine, info);
-    out.segments.push_back(std::move(seg));
-    out.info.push_back(info);
+    limitsFor(out.segments.back(), feed, machine, info);
   };
-  out.segments.reserve(pieces.size() * 2);
-  out.info.reserve(pieces.size() * 2);
   StopReason stop = StopReason::Start;
-  for (size_t i = 0; i < pieces.size(); ++i) {
-    const Piece &p = pieces[i];
-    if (i > 0) {
-      const Junction &jn = joins[i];
-      if (jn.stop)
-        stop = jn.reason;
-      if (jn.blended) {
-        const Piece &prev = pieces[i - 1];
-        double feed = 0;  // the slower of the two; a rapid takes the feed of the other
-        if (prev.feed > 0 && p.feed > 0)
-          feed = std::min(prev.feed, p.feed);
-        else
-          feed = std::max(prev.feed, p.feed);
-        push(jn.blend, feed, prev.move, p.move, stop);
+  {
+    Segment before, here;
+    for (size_t i = 0; i < pieces.size(); ++i) {
+      const Piece &p = pieces[i];
+      before = here;
+      here = p.segment(input);
+      if (i > 0) {
+        if (p.stopReason != StopReason::None)
+          stop = p.stopReason;
+        if (p.blendBefore) {
+          const Piece &prev = pieces[i - 1];
+          double feed = 0;  // the slower of the two; a rapid takes the feed of the other
+          if (prev.feed > 0 && p.feed > 0)
+            feed = std::min(prev.feed, p.feed);
+          else
+            feed = std::max(prev.feed, p.feed);
+          out.segments.push_back(Segment::blend(blendBetween(prev, before, p, here)));
+          push(feed, prev.move, p.move, stop);
+          stop = StopReason::None;
+        }
+      }
+      const double s0 = p.cutStart, s1 = here.length - p.cutEnd;
+      if (s1 - s0 > 1e-9) {
+        out.segments.push_back(here.part(s0, s1));
+        push(p.feed, p.move, p.move, stop);
         stop = StopReason::None;
       }
     }
-    const double s0 = p.cutStart, s1 = p.seg.length - p.cutEnd;
-    if (s1 - s0 > 1e-9) {
-      push(p.seg.part(s0, s1), p.feed, p.move, p.move, stop);
-      stop = StopReason::None;
-    }
   }
+  std::vector<Piece>().swap(pieces);  // not needed any more: its memory serves the steps below
 
   // 4. Runs: consecutive segments too short to reach their caps on their
   // own, none starting at rest, with caps within kRunCapSpread of each other,
@@ -415,7 +521,7 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   // starting and ending with zero acceleration.
   const size_t n = out.segments.size();
   struct Run {
-    size_t first = 0, last = 0;
+    uint32_t first = 0, last = 0;  ///< segments (a trajectory's segment count fits, as its moves' do)
     double length = 0;
     PathLimits limits;
   };
@@ -424,9 +530,10 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
     return out.segments[k].length < rampDistance(0, l.v, l.a, l.j);
   };
   std::vector<Run> runs;
+  runs.reserve(n);
   for (size_t k = 0; k < n;) {
     Run r;
-    r.first = r.last = k;
+    r.first = r.last = uint32_t(k);
     r.length = out.segments[k].length;
     r.limits = out.info[k].limits;
     double highest = r.limits.v;

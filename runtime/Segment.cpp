@@ -47,6 +47,116 @@ PathPoint fromParameter(const Vec3 &p, const Vec3 &d1, const Vec3 &d2, const Vec
 
 } // namespace
 
+namespace {
+
+/// Whether the curve keeps its z (every power coefficient but the first has
+/// z = 0): its derivatives then have z = 0 exactly, and the work on z can be
+/// left out without changing a bit of the results.
+bool inPlaneZ(const QuinticCurve &q) {
+  return q.c[1].z() == 0 && q.c[2].z() == 0 && q.c[3].z() == 0 && q.c[4].z() == 0 && q.c[5].z() == 0;
+}
+
+/// The arc-length table of a blend: five-point Gauss-Legendre on each of the
+/// kBlendTable intervals, as QuinticCurve::length computes it (same points,
+/// same operations in the same order, so the same bits), all 40 speeds in
+/// one loop that the compiler can evaluate two at a time. D = 2 leaves out z
+/// when it is zero.
+template <int D>
+void blendArcTable(const QuinticCurve &q, std::array<double, Segment::kBlendTable + 1> &table) {
+  constexpr size_t kIntervals = Segment::kBlendTable, kNodes = kGaussX.size(), kPoints = kNodes * kIntervals;
+  // u of node i in interval j at i * kIntervals + j, computed as
+  // QuinticCurve::length computes it.
+  static const std::array<double, kPoints> u = [] {
+    std::array<double, kPoints> out{};
+    for (size_t i = 0; i < kNodes; ++i)
+      for (size_t j = 0; j < kIntervals; ++j) {
+        const double u0 = double(j) / kIntervals, u1 = double(j + 1) / kIntervals;
+        out[i * kIntervals + j] = (u0 + u1) / 2 + (u1 - u0) / 2 * kGaussX[i];
+      }
+    return out;
+  }();
+  double a[D][5];
+  for (int k = 0; k < D; ++k) {
+    a[k][0] = q.c[1][k], a[k][1] = 2 * q.c[2][k], a[k][2] = 3 * q.c[3][k], a[k][3] = 4 * q.c[4][k];
+    a[k][4] = 5 * q.c[5][k];
+  }
+  std::array<double, kPoints> speed;
+  for (size_t p = 0; p < kPoints; ++p) {
+    const double t = u[p];
+    double squared = 0;
+    for (int k = 0; k < D; ++k) {
+      const double d1 = (((a[k][4] * t + a[k][3]) * t + a[k][2]) * t + a[k][1]) * t + a[k][0];
+      squared = k == 0 ? d1 * d1 : squared + d1 * d1;
+    }
+    speed[p] = squared;
+  }
+  // Eigen's square root takes two at a time; a plain loop would not (errno).
+  Eigen::Map<Eigen::Array<double, kPoints, 1>> roots(speed.data());
+  roots = roots.sqrt();
+  table[0] = 0;
+  for (size_t j = 0; j < kIntervals; ++j) {
+    double sum = 0;
+    for (size_t i = 0; i < kNodes; ++i)
+      sum += kGaussW[i] * speed[i * kIntervals + j];
+    table[j + 1] = table[j] + sum * (0.5 / kIntervals);
+  }
+}
+
+/// The blend's largest |r1|, |r2|, |r3| per axis over the samples u = i / 32,
+/// i = 0..32 (fromParameter's formulas, with one division per sample instead
+/// of many; the results agree to rounding). Two samples at a time in one
+/// Eigen::Array2d (one vector register where there are any; the last pair
+/// takes u = 1 twice). D = 2 leaves out z when it is zero.
+template <int D>
+void sampleBlendDemand(const QuinticCurve &q, AxisDemand &d) {
+  using Pair = Eigen::Array2d;
+  constexpr int kSamples = 32;
+  // Derivatives' coefficients in u.
+  double a1[D][5], a2[D][4], a3[D][3];
+  for (int k = 0; k < D; ++k) {
+    a1[k][0] = q.c[1][k], a1[k][1] = 2 * q.c[2][k], a1[k][2] = 3 * q.c[3][k], a1[k][3] = 4 * q.c[4][k];
+    a1[k][4] = 5 * q.c[5][k];
+    a2[k][0] = 2 * q.c[2][k], a2[k][1] = 6 * q.c[3][k], a2[k][2] = 12 * q.c[4][k], a2[k][3] = 20 * q.c[5][k];
+    a3[k][0] = 6 * q.c[3][k], a3[k][1] = 24 * q.c[4][k], a3[k][2] = 60 * q.c[5][k];
+  }
+  Pair m1[D], m2[D], m3[D];
+  for (int k = 0; k < D; ++k)
+    m1[k] = m2[k] = m3[k] = Pair::Zero();
+  for (int i = 0; i <= kSamples; i += 2) {
+    const Pair t(double(i) / kSamples, double(std::min(i + 1, kSamples)) / kSamples);
+    Pair d1[D], d2[D], d3[D];
+    Pair q2 = Pair::Zero(), d12 = Pair::Zero(), d22 = Pair::Zero(), d13 = Pair::Zero();
+    for (int k = 0; k < D; ++k) {
+      d1[k] = (((a1[k][4] * t + a1[k][3]) * t + a1[k][2]) * t + a1[k][1]) * t + a1[k][0];
+      d2[k] = ((a2[k][3] * t + a2[k][2]) * t + a2[k][1]) * t + a2[k][0];
+      d3[k] = (a3[k][2] * t + a3[k][1]) * t + a3[k][0];
+      q2 += d1[k] * d1[k];
+      d12 += d1[k] * d2[k];
+      d22 += d2[k] * d2[k];
+      d13 += d1[k] * d3[k];
+    }
+    // With q = |d1|: r1 = d1 / q, r2 = (d2 - d1 d12 / q^2) / q^2 and
+    // r3 = d3 / q^3 - d2 3 d12 / q^5 - d1 ((d22 + d13) / q^5 - 4 d12^2 / q^7);
+    // where q = 0 fromParameter gives zeros, and so do these with 1/q := 0.
+    const Pair iq = (q2 > 0).select(q2.sqrt().inverse(), Pair::Zero());
+    const Pair iq2 = iq * iq, iq5 = iq2 * iq2 * iq;
+    const Pair b2 = d12 * iq2;
+    const Pair e3 = iq2 * iq, f3 = 3 * d12 * iq5, g3 = (d22 + d13) * iq5 - 4 * d12 * d12 * iq5 * iq2;
+    for (int k = 0; k < D; ++k) {
+      m1[k] = m1[k].max((d1[k] * iq).abs());
+      m2[k] = m2[k].max(((d2[k] - d1[k] * b2) * iq2).abs());
+      m3[k] = m3[k].max((e3 * d3[k] - f3 * d2[k] - g3 * d1[k]).abs());
+    }
+  }
+  for (int k = 0; k < D; ++k) {
+    d.r1[k] = m1[k].maxCoeff();
+    d.r2[k] = m2[k].maxCoeff();
+    d.r3[k] = m3[k].maxCoeff();
+  }
+}
+
+} // namespace
+
 Segment Segment::line(const Vec3 &from, const Vec3 &to) {
   Segment s;
   s.kind = SegmentKind::Line;
@@ -123,9 +233,10 @@ Segment Segment::blend(const std::array<Vec3, 6> &ctrl) {
   s.start = ctrl[0];
   s.end = ctrl[5];
   const QuinticCurve q(ctrl);
-  s.arcTable[0] = 0;
-  for (int i = 0; i < kBlendTable; ++i)
-    s.arcTable[i + 1] = s.arcTable[i] + q.length(double(i) / kBlendTable, double(i + 1) / kBlendTable);
+  if (inPlaneZ(q))
+    blendArcTable<2>(q, s.arcTable);
+  else
+    blendArcTable<3>(q, s.arcTable);
   s.length = s.arcTable[kBlendTable];
   return s;
 }
@@ -203,14 +314,10 @@ AxisDemand Segment::demand() const {
     // Sampled densely in u; a quintic's derivatives vary smoothly, and the
     // margin covers what lies between samples.
     const QuinticCurve q(ctrl);
-    constexpr int kSamples = 32;
-    for (int i = 0; i <= kSamples; ++i) {
-      const double u = double(i) / kSamples;
-      const PathPoint pt = fromParameter(Vec3::Zero(), q.d1(u), q.d2(u), q.d3(u));
-      d.r1 = d.r1.cwiseMax(pt.r1.cwiseAbs());
-      d.r2 = d.r2.cwiseMax(pt.r2.cwiseAbs());
-      d.r3 = d.r3.cwiseMax(pt.r3.cwiseAbs());
-    }
+    if (inPlaneZ(q))
+      sampleBlendDemand<2>(q, d);
+    else
+      sampleBlendDemand<3>(q, d);
     constexpr double kMargin = 1.1;
     d.r1 = (d.r1 * kMargin).cwiseMin(Vec3::Ones());
     d.r2 *= kMargin;
