@@ -21,12 +21,20 @@ double moment(double a, double x, double s0, double s1) {
 double deflection(const ToolBeam &beam, double force, double loadFromTip, double pointFromTip) {
   const double length = beam.overhang;
   const double a = std::clamp(length - loadFromTip, 0.0, length); // from the clamp
-  const double x = std::clamp(length - std::min(pointFromTip, loadFromTip), a, length);
-  const double step = std::clamp(length - beam.fluteLength, 0.0,
-                                 length); // where the flutes begin
-  const double shank = moment(a, x, 0, std::min(a, step)) / inertia(beam.diameter);
-  const double fluted = a > step ? moment(a, x, step, a) / inertia(beam.fluteDiameter) : 0;
+  const double x = std::clamp(length - pointFromTip, 0.0, length);
+  const double end = std::min(a, x);                                           // the unit moments overlap up to here
+  const double step = std::clamp(length - beam.fluteLength, 0.0, length); // where the flutes begin
+  const double shank = moment(a, x, 0, std::min(end, step)) / inertia(beam.diameter);
+  const double fluted = end > step ? moment(a, x, step, end) / inertia(beam.fluteDiameter) : 0;
   return force / beam.modulus * (shank + fluted);
+}
+
+double deflectionUnderSpreadLoad(const ToolBeam &beam, double force, double height, double pointFromTip) {
+  constexpr int kSlices = 16;
+  double sum = 0;
+  for (int i = 0; i < kSlices; ++i)
+    sum += deflection(beam, force / kSlices, (i + 0.5) * height / kSlices, pointFromTip);
+  return sum;
 }
 
 double forceForClampStress(const ToolBeam &beam, double stress, double loadFromTip) {

@@ -6,8 +6,9 @@
 //
 //   delta(x) = F / E * integral_0^a (a - s)(x - s) / I(s) ds,  I = pi d^4 / 64
 //
-// integrated exactly piece by piece (I is constant on each section). For a
-// uniform tool loaded at its tip this is F L^3 / (3 E I).
+// and at a point between the clamp and the load (x < a) the integral runs to
+// x only; both are integrated exactly piece by piece (I is constant on each
+// section). For a uniform tool loaded at its tip this is F L^3 / (3 E I).
 #pragma once
 
 namespace stepnc::cutting {
@@ -21,8 +22,13 @@ struct ToolBeam {
 };
 
 /// Deflection (mm) at `pointFromTip` mm above the tip under a force F (N)
-/// applied `loadFromTip` mm above the tip (the point at or below the load).
+/// applied `loadFromTip` mm above the tip.
 double deflection(const ToolBeam &beam, double force, double loadFromTip, double pointFromTip);
+
+/// Deflection (mm) at `pointFromTip` under a force F (N) spread evenly over
+/// the lowest `height` mm of the tool: what straight flutes engaged over an
+/// axial depth of cut take (the sum of kSlices equal loads, midpoint rule).
+double deflectionUnderSpreadLoad(const ToolBeam &beam, double force, double height, double pointFromTip);
 
 /// The force (N) that bends the shank at the clamp to `stress` (N/mm^2)
 /// when applied `loadFromTip` above the tip: M = F (L - load), sigma = M (D/2)

@@ -291,15 +291,19 @@ std::vector<KindSpec> makeTable() {
        "move"});
   const char *roles = "position approach plunge cut link retract";
   add({"rapid", "move", Sigil::None, false, {{"to", T::Point, true}, {"role", T::Word, false, roles}}, {}});
+  // `nominal`: where a move compensated for tool deflection is predicted to
+  // take the bent tool (docs/deflection-compensation.md).
   add({"linear", "move", Sigil::None, false,
-       {{"to", T::Point, true}, {"feed", T::Feed, true}, {"role", T::Word, false, roles}}, {}});
+       {{"to", T::Point, true}, {"feed", T::Feed, true}, {"role", T::Word, false, roles}, {"nominal", T::Point}},
+       {}});
   add({"arc", "move", Sigil::None, false,
        {{"to", T::Point, true},
         {"center", T::Point, true},
         {"dir", T::Word, true, "cw ccw"},
         {"turns", T::Count},
         {"feed", T::Feed, true},
-        {"role", T::Word, false, roles}},
+        {"role", T::Word, false, roles},
+        {"nominal", T::Point}},
        {}});
 
   // Motion IR: what plan-motion makes of the moves (docs/motion.md). `motion`

@@ -25,16 +25,16 @@
 #include <cmath>
 #include <limits>
 #include <map>
-#include <numbers>
 
 namespace stepnc::passes {
 
 namespace {
 
-using geom::Vec2;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 /// Samples whose feeds differ by less than this ratio share a piece.
 constexpr double kPieceRatio = 0.92;
+/// Rounds of capping feeds at what the machine reaches (each plans the program).
+constexpr int kCapRounds = 8;
 
 enum class Limit { Chip, Force, Spindle, Programmed, Air };
 constexpr Limit kLimits[] = {Limit::Chip, Limit::Force, Limit::Spindle, Limit::Programmed, Limit::Air};
@@ -59,21 +59,6 @@ struct Piece {
   double fz = 0;
   Limit limit = Limit::Programmed;
 };
-
-/// The point at distance s along a horizontal line or arc move.
-ir::Vec3 pointAt(const Move &m, double s) {
-  const ir::Vec3 a = *m.from;
-  if (m.kind == MoveKind::Linear) {
-    const double len = m.length();
-    return len > 0 ? ir::Vec3(a + (m.to - a) * (s / len)) : m.to;
-  }
-  const Vec2 c = m.center.head<2>(), u = a.head<2>() - c;
-  const double r = u.norm();
-  const double angle = (m.ccw ? 1 : -1) * s / r;
-  const Vec2 p =
-      c + Vec2(u.x() * std::cos(angle) - u.y() * std::sin(angle), u.x() * std::sin(angle) + u.y() * std::cos(angle));
-  return {p.x(), p.y(), a.z()};
-}
 
 /// Per workingstep: what the report shows.
 struct StepFigures {
@@ -163,7 +148,7 @@ public:
           raised += feed > cm->move.feed;
           piece.set("feed", ir::Value::feed(feed));
           if (i + 1 < ps.size())
-            piece.set("to", ir::Value::point(pointAt(cm->move, ps[i].to)));
+            piece.set("to", ir::Value::point(cm->move.pointAt(ps[i].to)));
           children.push_back(std::move(piece));
         }
       }
@@ -171,9 +156,15 @@ public:
     }
 
     // What the machine reaches with these feeds bounds them.
+    // Lower feeds change the plan (blends, look-ahead), and so what the
+    // machine reaches: cap again until the plan reaches every feed left.
     long long dynamics = 0;
-    if (machine)
-      dynamics = capByDynamics(module, *machine);
+    for (int round = 0; machine && round < kCapRounds; ++round) {
+      const long long capped = capByDynamics(module, *machine);
+      dynamics += capped;
+      if (capped == 0)
+        break;
+    }
 
     const CutAnalysis after = analyseCuts(module, options);
     const std::map<const ir::Node *, double> timeAfter = stepTimes(module, machine);
@@ -308,8 +299,9 @@ private:
       const std::optional<double> feed = node->kind == "rapid" ? std::nullopt : node->number("feed");
       if (!feed || *feed <= 0 || *feed <= peak[k])
         continue;
+      // Feeds are whole mm/min: one within a unit of the peak is reached.
       const double reached = std::max(1.0, std::floor(peak[k]));
-      if (reached >= *feed)
+      if (*feed - peak[k] <= 1)
         continue;
       node->set("feed", ir::Value::feed(reached));
       ++capped;

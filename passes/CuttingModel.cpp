@@ -210,6 +210,7 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
       step.tool = &t->second;
     const double spindle = p.moves->number("spindle").value_or(0);
     step.spindle = std::abs(spindle);
+    step.setup = p.setup;
     for (const Move &m : walkMoves(*p.moves, position)) {
       CutMove cm;
       cm.move = m;
@@ -330,7 +331,26 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
     }
     out.steps.push_back(std::move(step));
   }
+  for (auto &[setup, map] : stocks)
+    out.finished.emplace(setup, std::move(map));
   return out;
+}
+
+bool finishesWalls(const CutStep &step) {
+  return step.operation == "side_finish_milling" || step.operation == "bottom_and_side_finish_milling";
+}
+
+bool engagesPartWall(const CutAnalysis &analysis, const CutStep &step, const CutSample &sample, double z) {
+  if (sample.side == 0 || !(sample.chipFactor > 0) || !step.tool)
+    return false;
+  const auto it = analysis.finished.find(step.setup);
+  if (it == analysis.finished.end())
+    return false;
+  const cutting::HeightMap &part = it->second;
+  // Just past the tool's edge, into the material.
+  const Vec2 into = sample.side * Vec2(-sample.dir.y(), sample.dir.x());
+  const Vec2 probe = sample.at + (step.tool->cutter.radius + 1.5 * part.cell()) * into;
+  return part.at(probe) > z + 0.05 * part.cell();
 }
 
 } // namespace stepnc::passes

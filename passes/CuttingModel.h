@@ -56,6 +56,7 @@ struct CutMove {
 struct CutStep {
   const ir::Node *executable = nullptr;
   const ir::Node *movesNode = nullptr;
+  std::string setup;
   const CutterSetup *tool = nullptr; ///< null when the tool is unknown
   const cutting::Material *material = nullptr;
   double spindle = 0; ///< rev/min, unsigned
@@ -74,7 +75,18 @@ struct CutAnalysis {
   std::map<std::string, CutterSetup, std::less<>> tools;
   double cell = 0;                ///< mm, the stock's grid
   std::vector<std::string> notes; ///< assumptions about materials and raw pieces
+  /// Per setup, the stock the whole program leaves: the finished part.
+  std::map<std::string, cutting::HeightMap, std::less<>> finished;
 };
+
+/// Whether the step finishes walls: a side or bottom-and-side finish (a
+/// plane finish finishes a floor; its side engagement leaves no wall).
+bool finishesWalls(const CutStep &step);
+
+/// Whether the material a sample's move engages on its side stays in the
+/// finished part: a wall of the part, not stock a later move removes (the
+/// inner rings of a floor finish).
+bool engagesPartWall(const CutAnalysis &analysis, const CutStep &step, const CutSample &sample, double z);
 
 /// The material of the workpiece a setup holds, and how it was chosen.
 struct MaterialChoice {

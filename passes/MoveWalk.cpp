@@ -45,11 +45,12 @@ double arcAngle(const Move &m) {
 /// True for an arc whose start lies on its centre: it has no radius to turn on.
 bool degenerateArc(const Move &m) { return (xy(*m.from) - xy(m.center)).norm() <= geom::kEps; }
 
-Move readMove(const ir::Node &n) {
+Move readMove(const ir::Node &n, PathKind path) {
   Move m;
   m.node = &n;
   m.kind = n.kind == "rapid" ? MoveKind::Rapid : n.kind == "linear" ? MoveKind::Linear : MoveKind::Arc;
-  m.to = n.vec("to").value_or(ir::Vec3::Zero());
+  std::optional<ir::Vec3> to = path == PathKind::Predicted ? n.vec("nominal") : std::nullopt;
+  m.to = to ? *to : n.vec("to").value_or(ir::Vec3::Zero());
   m.center = n.vec("center").value_or(ir::Vec3::Zero());
   m.ccw = n.text("dir") == "ccw";
   m.turns = n.count("turns").value_or(0);
@@ -98,6 +99,19 @@ std::vector<geom::Seg> Move::planar() const {
   return segs;
 }
 
+ir::Vec3 Move::pointAt(double s) const {
+  const ir::Vec3 a = from.value_or(to);
+  if (kind != MoveKind::Arc || degenerateArc(*this)) {
+    const double len = length();
+    return len > 0 ? ir::Vec3(a + (to - a) * (s / len)) : to;
+  }
+  const geom::Vec2 c = xy(center), u = xy(a) - c;
+  const double angle = (ccw ? 1 : -1) * s / u.norm();
+  const geom::Vec2 p =
+      c + geom::Vec2(u.x() * std::cos(angle) - u.y() * std::sin(angle), u.x() * std::sin(angle) + u.y() * std::cos(angle));
+  return {p.x(), p.y(), a.z()};
+}
+
 namespace {
 
 void collectExecutables(const ir::Node &plan, std::vector<const ir::Node *> &out) {
@@ -120,13 +134,13 @@ std::vector<const ir::Node *> programOrder(const ir::Module &module) {
   return out;
 }
 
-std::vector<Move> walkMoves(const ir::Node &moves, std::optional<ir::Vec3> start) {
+std::vector<Move> walkMoves(const ir::Node &moves, std::optional<ir::Vec3> start, PathKind path) {
   std::vector<Move> out;
   std::optional<ir::Vec3> at = start;
   for (const ir::Node &n : moves.children) {
     if (n.kind != "rapid" && n.kind != "linear" && n.kind != "arc")
       continue;
-    Move m = readMove(n);
+    Move m = readMove(n, path);
     m.from = at;
     at = m.to;
     out.push_back(std::move(m));

@@ -36,11 +36,22 @@ struct Move {
   /// The move seen from +z: its segments in the plane (a helix's full turns as
   /// half arcs, then the last partial arc). Empty for a purely axial move.
   std::vector<geom::Seg> planar() const;
+  /// The point `s` mm along a line, or along an arc at constant height, from
+  /// its start (which must be known).
+  ir::Vec3 pointAt(double s) const;
 };
+
+/// Which end point a move is read with. Compensated moves (docs/deflection-
+/// compensation.md) are programmed off the part by the deflection the cut is
+/// predicted to cause, and record where the bent tool is predicted to go as
+/// `nominal`: the backends run the programmed path, verification checks the
+/// predicted one.
+enum class PathKind : uint8_t { Programmed, Predicted };
 
 /// The moves of `moves` in order, each knowing where it starts (`start` is
 /// where the tool is before the first one, when known).
-std::vector<Move> walkMoves(const ir::Node &moves, std::optional<ir::Vec3> start = std::nullopt);
+std::vector<Move> walkMoves(const ir::Node &moves, std::optional<ir::Vec3> start = std::nullopt,
+                            PathKind path = PathKind::Programmed);
 
 /// The executables the machine runs, in program order: every workingstep,
 /// rapid movement, program stop, optional stop and display message of the

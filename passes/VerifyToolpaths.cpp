@@ -19,6 +19,8 @@
 //           (the opening of the allowed area with the tool radius);
 // then, per feature, the floors of roughing and finishing together cover what
 // the smallest tool can reach. Figures go into the `moves` node's comment.
+// Moves are read on the path the tool is predicted to follow: a move
+// compensated for tool deflection is checked at its `nominal` end.
 #include "passes/Pass.h"
 
 #include "geom/Boolean.h"
@@ -345,7 +347,9 @@ private:
       s.allowanceSide = s.op->number("allowance_side").value_or(0.0);
       s.allowanceBottom = s.op->number("allowance_bottom").value_or(0.0);
     }
-    s.moves = walkMoves(movesNode);
+    // Where the tool is predicted to go: moves compensated for its deflection
+    // are programmed off the part and reach their `nominal` ends.
+    s.moves = walkMoves(movesNode, std::nullopt, PathKind::Predicted);
     s.figures.moves = s.moves.size();
     for (const Move &m : s.moves)
       s.figures.path += m.length();

@@ -43,6 +43,7 @@ struct CompileOptions {
   bool listTargets = false;
   std::string machine;  ///< for motion-ir and the native target; bounds adapt-feed
   bool noAdaptFeed = false;
+  bool noCompensateDeflection = false;
   std::string cuttingData;
   bool allowFeedIncrease = false;
   // opt only
@@ -140,6 +141,7 @@ int runCompile(const CompileOptions &opts) {
   ToolpathPipelineOptions toolpath;
   toolpath.machine = opts.machine;
   toolpath.adaptFeed = !opts.noAdaptFeed;
+  toolpath.compensateDeflection = !opts.noCompensateDeflection;
   toolpath.cuttingData = opts.cuttingData;
   toolpath.allowFeedIncrease = opts.allowFeedIncrease;
   std::string pipelineText = emit != "feature-ir" && opts.passes.empty() ? toolpathPipeline(toolpath) : opts.passes;
@@ -275,6 +277,9 @@ std::string toolpathPipeline(const ToolpathPipelineOptions &options) {
       add("allow-increase=true");
     text += "adapt-feed" + adapt + (adapt.empty() ? "" : ">") + ",";
   }
+  if (options.compensateDeflection)
+    text += options.cuttingData.empty() ? "compensate-deflection,"
+                                        : "compensate-deflection<data=" + options.cuttingData + ">,";
   return text + "verify-toolpaths";
 }
 
@@ -357,6 +362,9 @@ void registerCompile(CLI::App &app, std::function<void(int)> setResult) {
                   "feed adaptation also keeps feeds within its dynamics and spindle");
   cmd->add_flag("--no-adapt-feed", opts->noAdaptFeed,
                 "Keep the programmed feeds: leave out the adapt-feed pass (docs/feed-adaptation.md)");
+  cmd->add_flag("--no-compensate-deflection", opts->noCompensateDeflection,
+                "Keep finishing walls on the nominal path: leave out the compensate-deflection pass\n"
+                "(docs/deflection-compensation.md)");
   cmd->add_option("--cutting-data", opts->cuttingData,
                   "Cutting data (materials, tool overhangs) on top of the shipped data (docs/cutting-data.md)");
   cmd->add_flag("--allow-feed-increase", opts->allowFeedIncrease,

@@ -19,12 +19,13 @@ namespace stepnc::tool {
 struct ToolpathPipelineOptions {
   std::string machine;
   bool adaptFeed = true;
+  bool compensateDeflection = true;
   std::string cuttingData;  ///< a user cutting-data file, or empty
   bool allowFeedIncrease = false;
 };
 
 /// What `compile --emit=toolpath-ir` runs: resolve-feeds, expand-strategies,
-/// adapt-feed (unless turned off), verify-toolpaths.
+/// adapt-feed and compensate-deflection (unless turned off), verify-toolpaths.
 std::string toolpathPipeline(const ToolpathPipelineOptions &options);
 
 /// The plan-motion pass for a machine (file or shipped name) and tolerance.

@@ -28,6 +28,15 @@ TEST_CASE("cantilever: the test vector of the references and the stepped tool", 
   ToolBeam solid{40, 0, 10, 8, 600000};
   CHECK(deflection(stepped, 200, 0, 0) < deflection(uniform, 200, 0, 0));
   CHECK(deflection(stepped, 200, 0, 0) > deflection(solid, 200, 0, 0));
+  // Above the load: the tip loaded, the point x from the clamp moves
+  // F x^2 (3L - x) / (6 E I); and by reciprocity a load at one height moves a
+  // second height as much as a load there moves the first, stepped or not.
+  CHECK(deflection(uniform, 200, 0, 15) == Approx(200 * 25 * 25 * (3 * 40 - 25) / (6 * 600000 * i)));
+  CHECK(deflection(stepped, 200, 5, 25) == Approx(deflection(stepped, 200, 25, 5)));
+  // A load spread evenly over the whole length: w L^4 / (8 E I) at the tip,
+  // w = F / L; the midpoint rule over 16 slices is within 0.2 %.
+  CHECK(deflectionUnderSpreadLoad(uniform, 200, 40, 0) ==
+        Approx(200 * std::pow(40, 3) / (8 * 600000 * i)).epsilon(0.002));
   // Bending stress at the clamp: sigma = F L (D/2) / I.
   CHECK(forceForClampStress(solid, 800, 0) * 40 * 5 / (std::numbers::pi * std::pow(10, 4) / 64) == Approx(800));
 }

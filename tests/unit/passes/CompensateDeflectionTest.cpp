@@ -1,0 +1,262 @@
+// The compensate-deflection pass: a wall taken at constant radial depth,
+// against the fixed point of the model worked out here; the independent
+// residual check (DeflectionCheck.h); zero force leaves the program as it
+// is; a tight offset limit lowers the feed; a finished pocket passes
+// verification on its predicted path and fails it on its programmed one.
+#include "passes/CuttingModel.h"
+#include "passes/PassManager.h"
+
+#include "tests/unit/TestSupport.h"
+#include "tests/unit/ir/SampleModule.h"
+#include "tests/unit/passes/DeflectionCheck.h"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+using namespace stepnc;
+using namespace stepnc::passes;
+using ir::Node;
+using ir::Value;
+using ir::Vec3;
+
+namespace {
+
+// A 100 x 50 x 20 block of SAE 1020 (steel_1020), its top at z = 0; a D10
+// four-flute end mill with 20 mm of flutes; a side finish of the pocket.
+constexpr const char *kModule = R"(project "DEFLECT"
+  workpiece %wp "WP" material="id" material_standard="SAE 1020" global_tolerance=0.0100mm
+    rawpiece shape=block size=(100.0000,50.0000,20.0000)mm at=(0.0000,0.0000,-20.0000)mm axis=(0.000000,0.000000,1.000000) ref=(1.000000,0.000000,0.000000)
+    closed_pocket %pocket "POCKET" at=(50.0000,25.0000,0.0000)mm axis=(0.000000,0.000000,1.000000) ref=(1.000000,0.000000,0.000000) depth=10.0000mm bottom=planar orthogonal_radius=6.0000mm
+      rectangular_profile width=30.0000mm length=40.0000mm
+  tool %mill10 "MILL 10" type=endmill diameter=10.0000mm cutting_edge_length=20.0000mm flutes=4
+  setup %s1 "S1" at=(0.0000,0.0000,0.0000)mm axis=(0.000000,0.000000,1.000000) ref=(1.000000,0.000000,0.000000) secplane=20.0000mm
+    workpiece_setup workpiece=%wp at=(0.0000,0.0000,0.0000)mm axis=(0.000000,0.000000,1.000000) ref=(1.000000,0.000000,0.000000)
+  workplan @plan "PLAN" setup=%s1
+    workingstep @ws "WS" feature=%pocket secplane=20.0000mm
+      side_finish_milling "OP" tool=%mill10
+)";
+
+ir::test::Parsed parsed() {
+  ir::test::Parsed p = ir::test::parse(kModule);
+  for (const std::string &e : p.errors)
+    FAIL(e);
+  REQUIRE(p.module);
+  return p;
+}
+
+/// Moves under the workingstep: down outside the block at `from`, a line
+/// along the block to `to`, up and away.
+void straightCut(ir::Module &m, const Vec3 &from, const Vec3 &to, double feed) {
+  Node &ws = ir::test::find(m.root, "@ws");
+  Node moves("moves");
+  moves.set("tool", Value::ref("%mill10"))
+      .set("spindle", Value::spindle(-3000))
+      .set("coolant", Value::word("flood"))
+      .set("setup", Value::ref("%s1"))
+      .set("secplane", Value::length(20));
+  auto add = [&](const char *kind, const Vec3 &p, double f) {
+    Node &n = moves.add(Node(kind));
+    n.set("to", Value::point(p));
+    if (f > 0)
+      n.set("feed", Value::feed(f));
+  };
+  add("rapid", Vec3(from.x(), from.y(), 20), 0);
+  add("linear", from, feed);
+  add("linear", to, feed);
+  add("rapid", Vec3(to.x(), to.y(), 20), 0);
+  ws.add(std::move(moves));
+}
+
+bool runPasses(ir::Module &m, const std::string &pipeline, std::vector<std::string> *errors = nullptr) {
+  std::string error;
+  auto entries = parsePipeline(pipeline, error);
+  INFO(error);
+  REQUIRE(entries);
+  DiagnosticCollector c;
+  DiagnosticEngine diags(c);
+  PassManager pm({});
+  pm.add(*entries);
+  const bool ok = pm.run(m, diags);
+  for (const Diagnostic &d : c.diags)
+    if (d.severity == Severity::Error && errors)
+      errors->push_back(d.message);
+  return ok;
+}
+
+const cutting::CuttingData &shipped() {
+  static const cutting::CuttingData data = cutting::shippedCuttingData();
+  return data;
+}
+
+/// The fixed point c = bend(ae + c) of a straight wall on the right of a
+/// line along +x, worked out on the model with the exact ae.
+double wallOffset(double ae, double ap, double fz) {
+  ir::test::Parsed p = parsed();
+  const CutterSetup tool = cutterSetup(ir::test::find(p.module->root, "%mill10"), shipped());
+  const cutting::Material &steel = shipped().materials.at("steel_1020");
+  const cutting::CuttingCoefficients k{steel.ktc, steel.krc, steel.kte, steel.kre};
+  CutSample s;
+  s.dir = geom::Vec2(1, 0);
+  s.side = -1;
+  s.ae = ae;
+  s.ap = ap;
+  double c = 0;
+  for (int i = 0; i < 100; ++i)
+    c = test::midHeightBend(s, tool.cutter, k, tool.beam, c, fz);
+  return c;
+}
+
+} // namespace
+
+TEST_CASE("compensate-deflection: a wall at constant radial depth is offset by the model's fixed point",
+          "[compensate-deflection]") {
+  ir::test::Parsed p = parsed();
+  // Along the block's side y = 50, 0.5 mm into it, 8 deep, fz = 0.1 mm: the
+  // material is on the right of the feed.
+  const double y = 50 + 5 - 0.5;
+  straightCut(*p.module, Vec3(-10, y, -8), Vec3(110, y, -8), 1200);
+  const ir::Module before = *p.module;
+  REQUIRE(runPasses(*p.module, "compensate-deflection"));
+
+  const double expected = wallOffset(0.5, 8, 0.1);
+  INFO("expected offset " << expected << " mm");
+  REQUIRE(expected > 0.005); // a wall worth compensating
+  // The piece along the middle of the wall: moved towards the material (-y)
+  // by the fixed point, within what a cell of the stock does to ae; its
+  // predicted end on the nominal line.
+  const Node &moves = *ir::test::find(p.module->root, "@ws").child("moves");
+  const Node *middle = nullptr;
+  for (const Move &m : walkMoves(moves))
+    if (m.isFeed() && m.from && !m.changesHeight() && m.from->x() < 50 && m.to.x() > 50)
+      middle = m.node;
+  REQUIRE(middle);
+  const Vec3 to = *middle->vec("to");
+  REQUIRE(middle->vec("nominal"));
+  CHECK(middle->vec("nominal")->y() == Approx(y).margin(1e-9));
+  CHECK(y - to.y() == Approx(expected).epsilon(0.1));
+  CHECK(*middle->number("feed") == 1200);
+
+  const test::DeflectionCheck check = test::checkDeflection(before, *p.module, shipped());
+  for (const std::string &f : check.failures)
+    FAIL_CHECK(f);
+  CHECK(check.walls >= 90); // a sample a millimetre along the 100 mm wall
+  CHECK(check.offsetWalls > 0.9 * check.walls);
+  CHECK(check.worstBefore > 0.005);
+  CHECK(check.worstResidual <= 0.002);
+}
+
+TEST_CASE("compensate-deflection: the residual check sees an uncompensated wall", "[compensate-deflection]") {
+  // The check must be able to fail: on the nominal program the residual is
+  // the whole bend.
+  ir::test::Parsed p = parsed();
+  straightCut(*p.module, Vec3(-10, 54.5, -8), Vec3(110, 54.5, -8), 1200);
+  const test::DeflectionCheck check = test::checkDeflection(*p.module, *p.module, shipped());
+  CHECK(check.failures.empty());
+  CHECK(check.worstResidual == Approx(check.worstBefore));
+  CHECK(check.worstResidual > 0.005);
+}
+
+TEST_CASE("compensate-deflection: zero force leaves the path unchanged", "[compensate-deflection]") {
+  // Three passes along the wall: the first takes 0.5 mm; the second, a
+  // spring pass on the same line, meets no material; the third runs 1 mm
+  // clear of it. Neither of the last two has a force to compensate.
+  ir::test::Parsed p = parsed();
+  for (const double y : {54.5, 54.5, 56.0})
+    straightCut(*p.module, Vec3(-10, y, -8), Vec3(110, y, -8), 1200);
+  Node &ws = ir::test::find(p.module->root, "@ws");
+  // One moves node: the passes one after the other.
+  for (size_t i = 1; i < ws.childrenOf("moves").size(); ++i)
+    for (const Node &n : ws.childrenOf("moves")[i]->children)
+      const_cast<Node *>(ws.childrenOf("moves")[0])->add(n);
+  while (ws.childrenOf("moves").size() > 1)
+    ws.children.pop_back();
+  const ir::Module before = *p.module;
+  REQUIRE(runPasses(*p.module, "compensate-deflection"));
+  const Node &a = *ir::test::find(p.module->root, "@ws").child("moves");
+  const Node &b = *ir::test::find(const_cast<Node &>(before.root), "@ws").child("moves");
+  // The first pass is compensated (and so split or joined by connectors);
+  // the other two end exactly as programmed, their moves unchanged.
+  REQUIRE(a.children.size() > b.children.size());
+  const size_t tail = 8; // rapid, plunge, line, rapid; twice
+  for (size_t i = 1; i <= tail; ++i)
+    CHECK(ir::equal(a.children[a.children.size() - i], b.children[b.children.size() - i]));
+  const test::DeflectionCheck check = test::checkDeflection(before, *p.module, shipped());
+  CHECK(check.failures.empty());
+  CHECK(check.worstResidual <= 0.002);
+}
+
+TEST_CASE("compensate-deflection: an offset above the limit lowers the feed", "[compensate-deflection]") {
+  ir::test::Parsed p = parsed();
+  straightCut(*p.module, Vec3(-10, 54.5, -8), Vec3(110, 54.5, -8), 1200);
+  const double full = wallOffset(0.5, 8, 0.1);
+  const double limit = std::round(full / 2 * 1e4) / 1e4;
+  const ir::Module before = *p.module;
+  REQUIRE(runPasses(*p.module, "compensate-deflection<max-offset=" + std::to_string(limit) + ">"));
+  double lowest = 1e9;
+  for (const Move &m : walkMoves(*ir::test::find(p.module->root, "@ws").child("moves")))
+    if (m.isFeed())
+      lowest = std::min(lowest, m.feed);
+  INFO("limit " << limit << " mm, full offset " << full << " mm");
+  // Half the offset: roughly half the force beyond the edge forces, so a
+  // feed well below the programmed one.
+  CHECK(lowest < 0.7 * 1200);
+  const test::DeflectionCheck check = test::checkDeflection(before, *p.module, shipped());
+  for (const std::string &f : check.failures)
+    FAIL_CHECK(f);
+  CHECK(check.largestOffset <= limit + 0.001);
+  CHECK(check.worstResidual <= 0.002);
+}
+
+TEST_CASE("compensate-deflection: a finished pocket verifies on its predicted path", "[compensate-deflection]") {
+  // The pocket roughed to 0.5 mm from its walls, then its walls finished in
+  // one pass 10 deep.
+  std::string text = kModule;
+  const std::string from = "    workingstep @ws";
+  text = text.substr(0, text.find(from)) +
+         "    workingstep @rough \"ROUGH\" feature=%pocket secplane=20.0000mm\n"
+         "      bottom_and_side_rough_milling \"ROUGH\" tool=%mill10 axial_depth=5.0000mm radial_depth=4.0000mm "
+         "allowance_side=0.5000mm\n"
+         "        technology feed=1200.0mm/min spindle=-3000.0rev/min\n"
+         "        strategy type=contour_parallel\n"
+         "    workingstep @ws \"WS\" feature=%pocket secplane=20.0000mm\n"
+         "      side_finish_milling \"OP\" tool=%mill10 axial_depth=10.0000mm radial_depth=0.5000mm\n"
+         "        technology feed=1200.0mm/min spindle=-3000.0rev/min\n";
+  ir::test::Parsed p = ir::test::parse(text);
+  for (const std::string &e : p.errors)
+    FAIL(e);
+  REQUIRE(p.module);
+  std::vector<std::string> errors;
+  REQUIRE(runPasses(*p.module, "expand-strategies", &errors));
+  const ir::Module before = *p.module;
+  const bool ok = runPasses(*p.module, "compensate-deflection,verify-toolpaths", &errors);
+  for (const std::string &e : errors)
+    FAIL_CHECK(e);
+  REQUIRE(ok);
+  const test::DeflectionCheck check = test::checkDeflection(before, *p.module, shipped());
+  for (const std::string &f : check.failures)
+    FAIL_CHECK(f);
+  INFO("walls " << check.walls << ", offset " << check.offsetWalls << ", largest offset " << check.largestOffset);
+  CHECK(check.offsetWalls > 0.5 * check.walls);
+  CHECK(check.largestOffset > 0.01);
+  CHECK(check.worstResidual <= 0.002);
+  // Without `nominal` the verifier checks the programmed path, which is
+  // offset into the walls by more than the tolerance.
+  Node &ws = ir::test::find(p.module->root, "@ws");
+  for (Node &n : ws.children.back().children)
+    std::erase_if(n.attrs, [](const ir::Attr &a) { return a.name == "nominal"; });
+  errors.clear();
+  CHECK_FALSE(runPasses(*p.module, "verify-toolpaths", &errors));
+  REQUIRE_FALSE(errors.empty());
+  CHECK(errors[0].find("gouge") != std::string::npos);
+}
+
+TEST_CASE("compensate-deflection: options are checked", "[compensate-deflection]") {
+  ir::test::Parsed p = parsed();
+  std::vector<std::string> errors;
+  CHECK_FALSE(runPasses(*p.module, "compensate-deflection<max-offset=far>", &errors));
+  REQUIRE(errors.size() == 1);
+  CHECK(errors[0] ==
+        "compensate-deflection: max-offset='far' is not a length: expected a positive number of mm, such as "
+        "max-offset=0.05");
+}

@@ -1,0 +1,156 @@
+// The invariants of adapt-feed and compensate-deflection on every corpus file
+// that reaches the toolpath IR: no adapted feed above the programmed one nor
+// above the machine's speed cap on its move, no chip above the material's
+// target, and after compensation every finishing wall within 2 um of its
+// nominal position on the model (DeflectionCheck.h), with the verifier
+// passing.
+#include "passes/CuttingModel.h"
+#include "passes/MotionIR.h"
+#include "passes/PassManager.h"
+
+#include "tests/unit/TestSupport.h"
+#include "tests/unit/passes/DeflectionCheck.h"
+#include "tools/stepnc/Compile.h"
+#include "tools/stepnc/SchemaSelection.h"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+
+using namespace stepnc;
+using namespace stepnc::passes;
+
+namespace {
+
+const char *const kFiles[] = {
+    "jucsr__sanssouci/OnePocket",
+    "jucsr__sanssouci/RanhuraPerfilRoundedU.p21",
+    "jucsr__sanssouci/RanhuraPerfilUQuadrado.p21",
+    "jucsr__sanssouci/STEP-NC_Slot1 File.p21",
+    "jucsr__sanssouci/oneHoleOneSlotOneStepOnePoket.p21",
+    "unseenlaser__iso-14649-toolkit/ex1.stp",
+    "unseenlaser__iso-14649-toolkit/ex1E.stp",
+};
+
+struct Loaded {
+  std::unique_ptr<SourceFile> source;
+  std::unique_ptr<ir::Module> module;
+};
+
+Loaded load(const std::string &path) {
+  Loaded l;
+  std::string error;
+  l.source = SourceFile::open(path, error);
+  INFO(error);
+  REQUIRE(l.source);
+  DiagnosticCollector c;
+  DiagnosticEngine diags(c);
+  const tool::SchemaOptions options;
+  tool::SchemaSelection schemas(options);
+  bool usage = false;
+  REQUIRE(schemas.load(diags, usage));
+  l.module = tool::loadModule(*l.source, schemas, diags, usage);
+  REQUIRE(l.module);
+  return l;
+}
+
+bool run(ir::Module &m, const std::string &pipeline, std::vector<std::string> &errors) {
+  std::string error;
+  auto entries = parsePipeline(pipeline, error);
+  INFO(error);
+  REQUIRE(entries);
+  DiagnosticCollector c;
+  DiagnosticEngine diags(c);
+  PassManager pm({});
+  pm.add(*entries);
+  const bool ok = pm.run(m, diags);
+  for (const Diagnostic &d : c.diags)
+    if (d.severity == Severity::Error)
+      errors.push_back(d.message);
+  return ok;
+}
+
+} // namespace
+
+TEST_CASE("adapt-feed and compensate-deflection: invariants on the corpus",
+          "[adapt-feed][compensate-deflection][corpus]") {
+  const std::string corpus = test::corpusDir();
+  if (corpus.empty()) {
+    WARN("corpus not found (set STEPNC_CORPUS): skipped");
+    return;
+  }
+  const cutting::CuttingData data = cutting::shippedCuttingData();
+  std::unique_ptr<SourceFile> machineFile;
+  DiagnosticCollector collector;
+  DiagnosticEngine machineDiags(collector);
+  const std::optional<runtime::Machine> machine = runtime::loadMachine("hsc-3axis", machineFile, machineDiags);
+  REQUIRE(machine);
+  for (const char *name : kFiles) {
+    const std::string path = corpus + "/" + name;
+    if (!std::filesystem::exists(path)) {
+      WARN(path << " not found: skipped");
+      continue;
+    }
+    INFO(name);
+    Loaded l = load(path);
+    std::vector<std::string> errors;
+    REQUIRE(run(*l.module, "resolve-feeds,expand-strategies", errors));
+    const ir::Module programmed = *l.module;
+    REQUIRE(run(*l.module, "adapt-feed<machine=hsc-3axis>", errors));
+    const ir::Module adapted = *l.module;
+
+    // Feeds: every piece of a move at or below its programmed feed, and at
+    // most 1 mm/min (feeds are whole mm/min) above the highest speed the
+    // machine reaches on it.
+    const ProgramPath before = programPath(programmed), after = programPath(adapted);
+    const runtime::Trajectory plan = runtime::plan(after.path, *machine);
+    std::vector<double> cap(after.path.moves.size(), 0);
+    for (size_t k = 0; k < plan.segments.size(); ++k)
+      cap[plan.info[k].move] = std::max(cap[plan.info[k].move], plan.profiles[k].peak() * 60);
+    size_t j = 0, raised = 0, overCap = 0;
+    for (size_t i = 0; i < before.nodes.size(); ++i) {
+      const double feed = before.nodes[i]->number("feed").value_or(0);
+      const ir::Vec3 end = *before.nodes[i]->vec("to");
+      for (; j < after.nodes.size(); ++j) {
+        const double f = after.nodes[j]->number("feed").value_or(0);
+        raised += f > feed;
+        overCap += after.nodes[j]->kind != "rapid" && f > cap[j] + 1;
+        if ((*after.nodes[j]->vec("to") - end).norm() < 1e-9 && after.nodes[j]->kind == before.nodes[i]->kind)
+          break;
+      }
+      ++j;
+    }
+    CHECK(j == after.nodes.size());
+    CHECK(raised == 0);
+    CHECK(overCap == 0);
+
+    // Chips: at every sample of the adapted program, at most the target
+    // (2 % for where the samples of the analysis after fall between those
+    // the feeds were chosen on).
+    const CutAnalysis cuts = analyseCuts(adapted, {&data, &*machine});
+    size_t samples = 0, overChip = 0;
+    for (const CutStep &step : cuts.steps)
+      for (const CutMove &cm : step.moves)
+        for (const CutSample &s : cm.samples) {
+          if (!(s.chipFactor > 0))
+            continue;
+          ++samples;
+          overChip += cm.fz * s.chipFactor > 1.02 * step.material->chipThickness;
+        }
+    INFO(samples << " samples, " << overChip << " over the chip target");
+    CHECK(overChip == 0);
+
+    // Deflection: every finishing wall within 2 um of its nominal position,
+    // and the verifier passes on the predicted path.
+    REQUIRE(run(*l.module, "compensate-deflection,verify-toolpaths", errors));
+    for (const std::string &e : errors)
+      FAIL_CHECK(e);
+    const test::DeflectionCheck check = test::checkDeflection(adapted, *l.module, data);
+    for (const std::string &f : check.failures)
+      FAIL_CHECK(f);
+    INFO(check.walls << " wall samples, " << check.offsetWalls << " offset, before " << check.worstBefore * 1000
+                     << " um");
+    CHECK(check.worstResidual <= 0.002);
+  }
+}
