@@ -6,6 +6,7 @@
 // values key by key and may describe tools. docs/cutting-data.md.
 #pragma once
 
+#include "cutting/Mechanics.h"
 #include "support/Diagnostics.h"
 #include "support/SourceFile.h"
 
@@ -26,6 +27,8 @@ struct Material {
   double kte = 0, kre = 0;    ///< N/mm
   double chipThickness = 0.1; ///< mm, the target maximum chip thickness h*
   std::string source;
+
+  CuttingCoefficients coefficients() const { return {ktc, krc, kte, kre}; }
 };
 
 struct ToolMaterial {

@@ -16,8 +16,8 @@
 // comments and the
 // `--stats` report.
 #include "passes/CuttingModel.h"
+#include "passes/CuttingPass.h"
 #include "passes/MotionIR.h"
-#include "passes/Pass.h"
 
 #include "support/Format.h"
 
@@ -70,22 +70,16 @@ struct StepFigures {
   int split = 0;
 };
 
-class AdaptFeedPass final : public Pass {
+class AdaptFeedPass final : public CuttingPass {
 public:
   AdaptFeedPass(std::string machine, std::string data, bool allowIncrease, std::string error)
-      : machineSpec_(std::move(machine)), dataPath_(std::move(data)), allowIncrease_(allowIncrease),
-        error_(std::move(error)) {}
+      : CuttingPass(std::move(data), std::move(error)), machineSpec_(std::move(machine)),
+        allowIncrease_(allowIncrease) {}
 
   std::string_view name() const override { return "adapt-feed"; }
-  std::vector<std::string> report() const override { return report_; }
 
   PassResult run(ir::Module &module, DiagnosticEngine &diags, PassStats &stats) override {
-    report_.clear();
-    if (!error_.empty()) {
-      diags.error({}, error_);
-      return {false, false};
-    }
-    const auto data = cutting::loadCuttingData(dataPath_, dataFile_, diags);
+    const auto data = start(diags);
     if (!data)
       return {false, false};
     std::optional<runtime::Machine> machine;
@@ -121,19 +115,14 @@ public:
       auto *movesNode = const_cast<ir::Node *>(step.movesNode);
       std::vector<ir::Node> children;
       children.reserve(movesNode->children.size());
-      size_t k = 0;
+      size_t cursor = 0;
       for (ir::Node &child : movesNode->children) {
-        const CutMove *cm = nullptr;
-        while (k < step.moves.size() && step.moves[k].move.node != &child)
-          ++k;
-        if (k < step.moves.size())
-          cm = &step.moves[k];
+        const CutMove *cm = step.moveOf(child, cursor);
         auto it = cm ? pieces.find(cm->move.node) : pieces.end();
         if (it == pieces.end()) {
           children.push_back(std::move(child));
           continue;
         }
-        const double flutesRpm = cm->move.feed / cm->fz;
         const std::vector<Piece> &ps = it->second;
         split += (long long)ps.size() - 1;
         f.split += int(ps.size()) - 1;
@@ -141,7 +130,7 @@ public:
           ir::Node piece = child;
           double feed = ps[i].limit == Limit::Programmed || ps[i].limit == Limit::Air
                             ? cm->move.feed
-                            : std::max(1.0, std::floor(ps[i].fz * flutesRpm));
+                            : cm->feedFor(ps[i].fz);
           if (!allowIncrease_)
             feed = std::min(feed, cm->move.feed);
           lowered += feed < cm->move.feed;
@@ -225,7 +214,6 @@ private:
     // A move with whole turns (a circle at depth) is one piece.
     const bool splittable = cm.move.turns == 0;
     std::vector<Piece> out;
-    const double length = cm.move.length();
     size_t i = 0;
     while (i < wants.size()) {
       double lo = wants[i].fz, hi = wants[i].fz;
@@ -242,7 +230,7 @@ private:
       }
       Piece p;
       p.from = out.empty() ? 0 : out.back().to;
-      p.to = j < wants.size() ? (cm.samples[j - 1].s + cm.samples[j].s) / 2 : length;
+      p.to = cm.pieceEnd(j);
       // The piece reaches halfway to the samples on either side, where the
       // engagement is not known: it must suit them too.
       if (i > 0 && wants[i - 1].fz < lo) {
@@ -361,11 +349,9 @@ private:
     }
   }
 
-  std::string machineSpec_, dataPath_;
+  std::string machineSpec_;
   bool allowIncrease_ = false;
-  std::string error_;
-  std::unique_ptr<SourceFile> dataFile_, machineFile_;
-  std::vector<std::string> report_;
+  std::unique_ptr<SourceFile> machineFile_;
 };
 
 } // namespace

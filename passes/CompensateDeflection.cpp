@@ -16,7 +16,7 @@
 // short connecting lines join offset and nominal positions. Offsets are
 // whole micrometres; each sample's residual error stays within 1.5 um.
 #include "passes/CuttingModel.h"
-#include "passes/Pass.h"
+#include "passes/CuttingPass.h"
 
 #include "support/Format.h"
 
@@ -48,56 +48,24 @@ constexpr int kMaxIterations = 200;
 constexpr double kPieceRatio = 0.92;
 constexpr double kSamePoint = 1e-6; ///< mm: closer positions need no connector
 
-Vec2 leftNormal(const Vec2 &d) { return {-d.y(), d.x()}; }
-
-/// How far the tool bends away from a wall (mm) at the tip, the middle and
-/// the top of the engaged height.
-struct Bend {
-  double tip = 0, mid = 0, top = 0;
-  double taper() const { return tip - top; }
-};
-
-/// The wall one sample cuts, as the model sees it.
-struct Wall {
-  const cutting::Cutter *cutter = nullptr;
-  const cutting::CuttingCoefficients *k = nullptr;
-  const cutting::ToolBeam *beam = nullptr;
-  Vec2 dir = Vec2::UnitX();
-  int side = 0; ///< +1 material on the left of the feed, -1 right
-  double ae = 0, ap = 0;
-
-  /// The bend with the path `offset` mm further into the wall, at fz.
-  Bend bend(double offset, double fz) const {
-    const cutting::Engagement e = cutting::wallEngagement(dir, side, ae + offset, ap, *cutter);
-    const Vec2 normal = side * leftNormal(dir); // into the wall
-    const double push = cutting::ForceModel(e, *cutter, *k).peakPush(normal, fz);
-    if (!(push > 0))
-      return {};
-    const double h = std::min(ap, cutter->fluteLength);
-    return {cutting::deflectionUnderSpreadLoad(*beam, push, h, 0),
-            cutting::deflectionUnderSpreadLoad(*beam, push, h, h / 2),
-            cutting::deflectionUnderSpreadLoad(*beam, push, h, h)};
-  }
-};
-
 struct Solution {
   double offset = 0; ///< mm into the wall
-  Bend bend;         ///< at that offset
+  WallBend bend;     ///< at that offset
   bool converged = true;
 };
 
 /// The offset that cancels the bend it causes at mid-height, c = bend(c), by
 /// fixed-point iteration from the nominal path (c = 0).
-Solution solve(const Wall &w, double fz) {
+Solution solve(const CutStep &step, const CutSample &sample, double fz) {
   Solution s;
-  s.bend = w.bend(0, fz);
+  s.bend = wallBend(step, sample, 0, fz);
   for (int i = 0; i < kMaxIterations; ++i) {
     if (std::abs(s.bend.mid - s.offset) <= kConverged)
       return s;
     s.offset = s.bend.mid;
     if (s.offset > kDiverged)
       break;
-    s.bend = w.bend(s.offset, fz);
+    s.bend = wallBend(step, sample, s.offset, fz);
   }
   s.converged = false;
   return s;
@@ -105,11 +73,14 @@ Solution solve(const Wall &w, double fz) {
 
 /// One sample's plan.
 struct SamplePlan {
-  bool wall = false;
-  Wall w;
-  double fz = 0;       ///< mm per tooth: the move's, or lowered to keep the offset within the limit
-  Solution sol;        ///< at fz
-  bool beyond = false; ///< even the lowest feed cannot keep the offset within the limit
+  const CutSample *wall = nullptr; ///< the sample, when it cuts a wall of the part
+  double fz = 0;                   ///< mm per tooth: the move's, or lowered to keep the offset within the limit
+  Solution sol;                    ///< at fz
+  bool beyond = false;             ///< even the lowest feed cannot keep the offset within the limit
+
+  double offset() const { return wall ? sol.offset : 0.0; }
+  /// The side of the wall the sample is offset towards; 0 below kMinOffset.
+  int side() const { return wall && sol.offset >= kMinOffset ? wall->side : 0; }
 };
 
 struct Piece {
@@ -130,7 +101,8 @@ ir::Vec3 offsetPoint(const Move &m, const ir::Vec3 &p, int side, double offset) 
     const Vec2 u = (p.head<2>() - m.center.head<2>()).normalized();
     n = m.ccw ? -u : u; // the left of a counter-clockwise arc is its centre
   } else {
-    n = leftNormal((m.to - *m.from).head<2>().normalized());
+    const Vec2 d = (m.to - *m.from).head<2>().normalized();
+    n = Vec2(-d.y(), d.x());
   }
   const Vec2 q = p.head<2>() + side * offset * n;
   return {q.x(), q.y(), p.z()};
@@ -145,21 +117,15 @@ struct StepFigures {
   int beyond = 0; ///< samples whose offset stays above the limit at any feed
 };
 
-class CompensateDeflectionPass final : public Pass {
+class CompensateDeflectionPass final : public CuttingPass {
 public:
   CompensateDeflectionPass(std::string data, double maxOffset, std::string error)
-      : dataPath_(std::move(data)), maxOffset_(maxOffset), error_(std::move(error)) {}
+      : CuttingPass(std::move(data), std::move(error)), maxOffset_(maxOffset) {}
 
   std::string_view name() const override { return "compensate-deflection"; }
-  std::vector<std::string> report() const override { return report_; }
 
   PassResult run(ir::Module &module, DiagnosticEngine &diags, PassStats &stats) override {
-    report_.clear();
-    if (!error_.empty()) {
-      diags.error({}, error_);
-      return {false, false};
-    }
-    const auto data = cutting::loadCuttingData(dataPath_, dataFile_, diags);
+    const auto data = start(diags);
     if (!data)
       return {false, false};
     const CutAnalysis analysis = analyseCuts(module, {&*data, nullptr});
@@ -170,16 +136,12 @@ public:
       if (!finishesWalls(step) || !step.tool || !step.tool->mill || !step.material)
         continue;
       StepFigures f;
-      const cutting::CuttingCoefficients k{step.material->ktc, step.material->krc, step.material->kte,
-                                           step.material->kre};
-      cutting::Cutter cutter = step.tool->cutter;
-      cutter.clockwise = step.movesNode->number("spindle").value_or(0) <= 0;
       std::map<const ir::Node *, std::vector<Piece>> pieces;
       for (const CutMove &cm : step.moves) {
         if (!cm.measured || cm.samples.empty())
           continue;
-        std::vector<SamplePlan> plans = planSamples(analysis, step, cm, cutter, k, f);
-        std::vector<Piece> ps = group(cm, plans, f);
+        std::vector<SamplePlan> plans = planSamples(analysis, step, cm, f);
+        std::vector<Piece> ps = group(step, cm, plans, f);
         const bool changes =
             std::any_of(ps.begin(), ps.end(), [&](const Piece &p) { return p.offset != 0 || p.fz < cm.fz; });
         if (changes)
@@ -201,35 +163,33 @@ public:
 
 private:
   /// Every sample of a measured finishing move: its wall (one-sided
-  /// engagement of material the part keeps), the feed that keeps its offset within the limit, and the
-  /// offset at that feed.
+  /// engagement of material the part keeps), the feed that keeps its offset
+  /// within the limit, and the offset at that feed.
   std::vector<SamplePlan> planSamples(const CutAnalysis &analysis, const CutStep &step, const CutMove &cm,
-                                      const cutting::Cutter &cutter, const cutting::CuttingCoefficients &k,
                                       StepFigures &f) const {
-    const cutting::ToolBeam &beam = step.tool->beam;
     std::vector<SamplePlan> plans;
     const double spacing = cm.samples.size() > 1 ? cm.move.length() / double(cm.samples.size()) : cm.move.length();
     for (const CutSample &s : cm.samples) {
       SamplePlan p;
       p.fz = cm.fz;
       if (engagesPartWall(analysis, step, s, cm.move.to.z())) {
-        p.wall = true;
-        p.w = {&cutter, &k, &beam, s.dir, s.side, s.ae, s.ap};
-        p.sol = solve(p.w, cm.fz);
-        f.errorBefore = std::max(f.errorBefore, p.w.bend(0, cm.fz).mid);
-        f.taperBefore = std::max(f.taperBefore, p.w.bend(0, cm.fz).taper());
+        p.wall = &s;
+        p.sol = solve(step, s, cm.fz);
+        const WallBend nominal = wallBend(step, s, 0, cm.fz);
+        f.errorBefore = std::max(f.errorBefore, nominal.mid);
+        f.taperBefore = std::max(f.taperBefore, nominal.taper());
         f.wallLength += spacing;
         if (!p.sol.converged || p.sol.offset > maxOffset_) {
           // The feed at which the offset meets the limit: offsets grow with fz.
           double lo = 0, hi = cm.fz;
           for (int i = 0; i < 40; ++i) {
             const double mid = (lo + hi) / 2;
-            const Solution t = solve(p.w, mid);
+            const Solution t = solve(step, s, mid);
             (t.converged && t.offset <= maxOffset_ ? lo : hi) = mid;
           }
           if (lo > 0) {
             p.fz = lo;
-            p.sol = solve(p.w, lo);
+            p.sol = solve(step, s, lo);
             f.loweredLength += spacing;
           } else {
             p.beyond = true; // edge forces alone bend the tool further: keep the feed, offset by the limit
@@ -244,44 +204,34 @@ private:
   }
 
   /// Pieces of a move: consecutive samples on the same side whose offsets
-  /// are within kPieceSpread and feeds within kPieceRatio; each piece takes
-  /// the lowest feed of its samples and the middle of their offsets at it.
-  std::vector<Piece> group(const CutMove &cm, std::vector<SamplePlan> &plans, StepFigures &f) const {
+  /// are within kPieceSpread and feeds within kPieceRatio (a move with whole
+  /// turns is one piece); each piece takes the lowest feed of its samples and
+  /// the middle of their offsets at it.
+  std::vector<Piece> group(const CutStep &step, const CutMove &cm, std::vector<SamplePlan> &plans,
+                           StepFigures &f) const {
     std::vector<Piece> out;
     const bool splittable = cm.move.turns == 0;
-    auto offsetOf = [](const SamplePlan &p) { return p.wall ? p.sol.offset : 0.0; };
     size_t i = 0;
     while (i < plans.size()) {
-      double lo = offsetOf(plans[i]), hi = lo, fzLo = plans[i].fz, fzHi = fzLo;
-      int side = plans[i].wall && offsetOf(plans[i]) >= kMinOffset ? plans[i].w.side : 0;
-      size_t j = i + 1;
-      for (; j < plans.size() && splittable; ++j) {
-        const double o = offsetOf(plans[j]);
-        const int s = plans[j].wall && o >= kMinOffset ? plans[j].w.side : 0;
-        if (s != 0 && side != 0 && s != side)
+      double lo = plans[i].offset(), hi = lo, fzLo = plans[i].fz, fzHi = fzLo;
+      int side = plans[i].side();
+      size_t end = i + 1;
+      for (; end < plans.size(); ++end) {
+        const SamplePlan &p = plans[end];
+        const bool apart = (p.side() != 0 && side != 0 && p.side() != side) ||
+                           std::max(hi, p.offset()) - std::min(lo, p.offset()) > kPieceSpread ||
+                           std::min(fzLo, p.fz) < kPieceRatio * std::max(fzHi, p.fz);
+        if (splittable && apart)
           break;
-        if (std::max(hi, o) - std::min(lo, o) > kPieceSpread)
-          break;
-        if (std::min(fzLo, plans[j].fz) < kPieceRatio * std::max(fzHi, plans[j].fz))
-          break;
-        lo = std::min(lo, o);
-        hi = std::max(hi, o);
-        fzLo = std::min(fzLo, plans[j].fz);
-        fzHi = std::max(fzHi, plans[j].fz);
-        side = side ? side : s;
+        lo = std::min(lo, p.offset());
+        hi = std::max(hi, p.offset());
+        fzLo = std::min(fzLo, p.fz);
+        fzHi = std::max(fzHi, p.fz);
+        side = side ? side : p.side();
       }
-      if (!splittable)
-        for (const SamplePlan &p : plans) {
-          lo = std::min(lo, offsetOf(p));
-          hi = std::max(hi, offsetOf(p));
-          fzLo = std::min(fzLo, p.fz);
-          if (side == 0 && p.wall && offsetOf(p) >= kMinOffset)
-            side = p.w.side;
-        }
-      const size_t end = splittable ? j : plans.size();
       Piece piece;
       piece.from = out.empty() ? 0 : out.back().to;
-      piece.to = end < plans.size() ? (cm.samples[end - 1].s + cm.samples[end].s) / 2 : cm.move.length();
+      piece.to = cm.pieceEnd(end);
       piece.fz = fzLo;
       piece.side = side;
       // The samples at the piece's feed; its offset in the middle of theirs.
@@ -290,7 +240,7 @@ private:
         hi = 0;
         for (size_t q = i; q < end; ++q)
           if (plans[q].wall && !plans[q].beyond) {
-            plans[q].sol = solve(plans[q].w, fzLo);
+            plans[q].sol = solve(step, *plans[q].wall, fzLo);
             lo = std::min(lo, plans[q].sol.offset);
             hi = std::max(hi, plans[q].sol.offset);
           }
@@ -300,14 +250,12 @@ private:
       const double middle = (lo + hi) / 2;
       piece.offset =
           side != 0 && middle >= kMinOffset ? std::min(std::round(middle / kOffsetGrid) * kOffsetGrid, maxOffset_) : 0;
-      for (size_t q = i; q < end; ++q) {
-        const SamplePlan &p = plans[q];
-        if (!p.wall)
-          continue;
-        const Bend b = p.w.bend(piece.offset, piece.fz);
-        f.errorAfter = std::max(f.errorAfter, std::abs(b.mid - piece.offset));
-        f.taperAfter = std::max(f.taperAfter, b.taper());
-      }
+      for (size_t q = i; q < end; ++q)
+        if (plans[q].wall) {
+          const WallBend b = wallBend(step, *plans[q].wall, piece.offset, piece.fz);
+          f.errorAfter = std::max(f.errorAfter, std::abs(b.mid - piece.offset));
+          f.taperAfter = std::max(f.taperAfter, b.taper());
+        }
       f.offsetMax = std::max(f.offsetMax, piece.offset);
       if (!out.empty() && out.back().offset == piece.offset && out.back().fz == piece.fz &&
           out.back().side == piece.side)
@@ -328,7 +276,7 @@ private:
     std::vector<ir::Node> children;
     children.reserve(movesNode->children.size());
     std::optional<ir::Vec3> programmed; // where the new program leaves the tool
-    size_t k = 0;
+    size_t cursor = 0;
     auto connect = [&](const ir::Vec3 &to, const ir::Vec3 &nominal, double feed, const ir::Node &next) {
       if (!programmed || (*programmed - to).norm() <= kSamePoint)
         return;
@@ -342,9 +290,7 @@ private:
       ++connectors;
     };
     for (ir::Node &child : movesNode->children) {
-      while (k < step.moves.size() && step.moves[k].move.node != &child)
-        ++k;
-      const CutMove *cm = k < step.moves.size() ? &step.moves[k] : nullptr;
+      const CutMove *cm = step.moveOf(child, cursor);
       if (!cm) {
         children.push_back(std::move(child));
         continue;
@@ -359,10 +305,9 @@ private:
         children.push_back(std::move(child));
         continue;
       }
-      const double flutesRpm = m.feed / cm->fz;
       ++compensated;
       for (const Piece &p : it->second) {
-        const double feed = p.fz < cm->fz ? std::max(1.0, std::floor(p.fz * flutesRpm)) : m.feed;
+        const double feed = p.fz < cm->fz ? cm->feedFor(p.fz) : m.feed;
         lowered += feed < m.feed;
         const ir::Vec3 nominalFrom = p.from == 0 ? *m.from : m.pointAt(p.from);
         const ir::Vec3 nominalTo = p.to >= m.length() ? m.to : m.pointAt(p.to);
@@ -409,11 +354,7 @@ private:
     }
   }
 
-  std::string dataPath_;
   double maxOffset_ = kDefaultMaxOffset;
-  std::string error_;
-  std::unique_ptr<SourceFile> dataFile_;
-  std::vector<std::string> report_;
 };
 
 } // namespace

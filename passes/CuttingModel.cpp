@@ -205,7 +205,6 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
     step.executable = p.exec;
     step.movesNode = p.moves;
     step.operation = operationKind(*p.exec);
-    step.finishing = step.operation.find("finish") != std::string::npos;
     if (auto t = out.tools.find(p.moves->text("tool").value_or("")); t != out.tools.end())
       step.tool = &t->second;
     const double spindle = p.moves->number("spindle").value_or(0);
@@ -273,8 +272,10 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
 
     const CutterSetup *tool = step.tool;
     const double radius = tool ? tool->cutter.radius : 0;
-    cutting::Cutter cutter = tool ? tool->cutter : cutting::Cutter{};
-    cutter.clockwise = spindle <= 0;
+    if (tool)
+      step.cutter = tool->cutter;
+    step.cutter.clockwise = spindle <= 0;
+    const cutting::Cutter &cutter = step.cutter;
     const cutting::Material *material = step.material;
     const bool model = tool && tool->mill && radius > 0 && material && step.spindle > 0;
     const double torqueLimit = options.machine ? spindleTorqueLimit(*options.machine, step.spindle) : kInf;
@@ -289,7 +290,7 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
       if (model && !m.changesHeight() && !segs.empty()) {
         cm.measured = true;
         cm.fz = m.feed / (cutter.flutes * step.spindle);
-        const cutting::CuttingCoefficients k{material->ktc, material->krc, material->kte, material->kre};
+        const cutting::CuttingCoefficients k = material->coefficients();
         const double z = m.to.z();
         for (const PathPoint &pp : samplePath(segs, sampleStep)) {
           const cutting::Engagement e = cutting::measureEngagement(map, pp.at, z, pp.dir, cutter);
@@ -348,9 +349,21 @@ bool engagesPartWall(const CutAnalysis &analysis, const CutStep &step, const Cut
     return false;
   const cutting::HeightMap &part = it->second;
   // Just past the tool's edge, into the material.
-  const Vec2 into = sample.side * Vec2(-sample.dir.y(), sample.dir.x());
-  const Vec2 probe = sample.at + (step.tool->cutter.radius + 1.5 * part.cell()) * into;
+  const Vec2 probe = sample.at + (step.cutter.radius + 1.5 * part.cell()) * sample.intoWall();
   return part.at(probe) > z + 0.05 * part.cell();
+}
+
+WallBend wallBend(const CutStep &step, const CutSample &sample, double offset, double fz) {
+  const cutting::Engagement e = cutting::wallEngagement(sample.dir, sample.side, sample.ae + offset, sample.ap,
+                                                        step.cutter);
+  const double push =
+      cutting::ForceModel(e, step.cutter, step.material->coefficients()).peakPush(sample.intoWall(), fz);
+  if (!(push > 0))
+    return {};
+  const cutting::ToolBeam &beam = step.tool->beam;
+  const double h = std::min(sample.ap, step.cutter.fluteLength);
+  return {cutting::deflectionUnderSpreadLoad(beam, push, h, 0), cutting::deflectionUnderSpreadLoad(beam, push, h, h / 2),
+          cutting::deflectionUnderSpreadLoad(beam, push, h, h)};
 }
 
 } // namespace stepnc::passes

@@ -16,6 +16,8 @@
 #include "passes/MoveWalk.h"
 #include "runtime/Machine.h"
 
+#include <algorithm>
+#include <cmath>
 #include <map>
 #include <string>
 #include <vector>
@@ -44,6 +46,9 @@ struct CutSample {
   double fzTorque = 0;   ///< largest fz within the spindle's torque and power (mm; inf without a machine)
   double force = 0;      ///< N, peak at the move's feed
   double torque = 0;     ///< N m, mean at the move's feed
+
+  /// Unit normal from the path towards the material on `side`.
+  geom::Vec2 intoWall() const { return side * geom::Vec2(-dir.y(), dir.x()); }
 };
 
 struct CutMove {
@@ -51,6 +56,15 @@ struct CutMove {
   bool measured = false; ///< a horizontal feed move of a milling cutter
   double fz = 0;         ///< mm per tooth at the move's feed
   std::vector<CutSample> samples;
+
+  /// Where a piece ending before sample j ends, mm along the move: halfway
+  /// to the sample before it; the move's end when j is past the last sample.
+  double pieceEnd(size_t j) const {
+    return j < samples.size() ? (samples[j - 1].s + samples[j].s) / 2 : move.length();
+  }
+  /// The feed (mm/min) that gives `perTooth` on this move, in whole mm/min
+  /// rounded down, at least 1.
+  double feedFor(double perTooth) const { return std::max(1.0, std::floor(perTooth * move.feed / fz)); }
 };
 
 struct CutStep {
@@ -58,11 +72,19 @@ struct CutStep {
   const ir::Node *movesNode = nullptr;
   std::string setup;
   const CutterSetup *tool = nullptr; ///< null when the tool is unknown
+  cutting::Cutter cutter;            ///< the tool's, turning the way the step's spindle does
   const cutting::Material *material = nullptr;
   double spindle = 0; ///< rev/min, unsigned
   std::string operation;
-  bool finishing = false; ///< a finishing operation (side or bottom-and-side finish)
   std::vector<CutMove> moves;
+
+  /// The move of `moves` whose node is `node`, searching on from `cursor`
+  /// (moves are met in the order of their nodes); null for other children.
+  const CutMove *moveOf(const ir::Node &node, size_t &cursor) const {
+    while (cursor < moves.size() && moves[cursor].move.node != &node)
+      ++cursor;
+    return cursor < moves.size() ? &moves[cursor] : nullptr;
+  }
 };
 
 struct CutOptions {
@@ -78,6 +100,19 @@ struct CutAnalysis {
   /// Per setup, the stock the whole program leaves: the finished part.
   std::map<std::string, cutting::HeightMap, std::less<>> finished;
 };
+
+/// How far a tool bends away from a wall (mm) at the tip, at mid-height and
+/// at the top of the engaged height.
+struct WallBend {
+  double tip = 0, mid = 0, top = 0;
+  double taper() const { return tip - top; }
+};
+
+/// The bend of the step's tool cutting the wall of `sample` as a straight
+/// wall taken to its equivalent radial depth plus `offset` mm, at feed per
+/// tooth fz: the peak push off the wall over a revolution, spread over the
+/// engaged height of the stepped cantilever.
+WallBend wallBend(const CutStep &step, const CutSample &sample, double offset, double fz);
 
 /// Whether the step finishes walls: a side or bottom-and-side finish (a
 /// plane finish finishes a floor; its side engagement leaves no wall).

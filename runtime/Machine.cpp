@@ -1,6 +1,7 @@
 #include "runtime/Machine.h"
 
 #include "runtime/TomlReader.h"
+#include "support/Format.h"
 
 namespace stepnc::runtime {
 
@@ -41,8 +42,8 @@ std::optional<Machine> readMachine(const SourceFile &file, DiagnosticEngine &dia
     m.spindlePower = r.number(*s, "power", "spindle", "kW", 0.01, 1e4, true).value_or(0);
     m.spindleTorque = r.number(*s, "torque", "spindle", "N m", 0.01, 1e6, false);
     if (r.ok() && m.spindleMin >= m.spindleMax)
-      r.error(s->get("min_speed")->source(), "spindle.min_speed " + plainNumber(m.spindleMin) +
-                                                 " rev/min is not below max_speed " + plainNumber(m.spindleMax));
+      r.error(s->get("min_speed")->source(), "spindle.min_speed " + formatTrimmed(m.spindleMin, 6) +
+                                                 " rev/min is not below max_speed " + formatTrimmed(m.spindleMax, 6));
   }
   if (const toml::table *axes = r.table(root, "axes", "axes")) {
     r.onlyKnown(*axes, {"x", "y", "z"}, "[axes]");

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 
 namespace stepnc::runtime {
 
@@ -22,7 +23,9 @@ constexpr double kCurveJerk = 0.6;
 constexpr double kCouplingJerk = 0.2;
 
 /// Turning more than this (radians) is a reversal: the tool stops.
-constexpr double kReversal = 179.0 * 3.14159265358979323846 / 180.0;
+constexpr double kReversal = 179.0 * std::numbers::pi / 180.0;
+/// What is left of a piece between its blends makes a segment when longer than this (mm).
+constexpr double kKeptMiddle = 1e-9;
 /// Blends shorter than this (mm on each side) are not made; the tool stops.
 constexpr double kTinyBlend = 1e-6;
 /// Share of the tolerance blends use; sampled deviations may miss a little.
@@ -40,6 +43,9 @@ struct Piece {
   double centerX = 0, centerY = 0, radius = 0, startAngle = 0, sweep = 0;  ///< arcs, as in Segment
   double feed = 0;  ///< mm/s; 0 for rapids
   double cutStart = 0, cutEnd = 0;  ///< mm taken by blends at either end
+  /// Whether something is left between the blends: a segment of its own
+  /// (the test step 3 writes segments by).
+  bool keepsMiddle() const { return (length - cutEnd) - cutStart > kKeptMiddle; }
   /// A line wholly taken by the blends at its ends, inside a chain of short
   /// lines: the curvature the two blends share at its middle (see
   /// smoothChains), when hasMidCurvature.
@@ -83,8 +89,7 @@ struct Piece {
 /// i = 1..23, and the last again (an even count, for the compiler's pairs).
 constexpr int kDeviationSamples = 24;
 struct DeviationPoints {
-  static constexpr size_t kCount = kDeviationSamples;
-  std::array<double, kCount> x, y, z;
+  std::array<double, kDeviationSamples> x, y, z;
 };
 
 /// The part [s0, s1] of a line or arc, for the squared distances of many
@@ -97,7 +102,7 @@ struct DeviationPoints {
 /// helices are an upper bound (a point of the helix at the point's angle).
 class PartDistance {
 public:
-  using Squares = std::array<double, DeviationPoints::kCount>;
+  using Squares = std::array<double, kDeviationSamples>;
 
   PartDistance(const Segment &seg, double s0, double s1) {
     first_ = seg.at(s0).p;
@@ -123,14 +128,14 @@ public:
       const double a0 = startAngle_ + sigma_ * t0_, a1 = startAngle_ + sigma_ * t1_;
       e0_ = Eigen::Vector2d(std::cos(a0), std::sin(a0));
       e1_ = Eigen::Vector2d(std::cos(a1), std::sin(a1));
-      whole_ = t1_ - t0_ >= 2 * kPi;
-      wide_ = t1_ - t0_ > kPi;
+      whole_ = t1_ - t0_ >= 2 * std::numbers::pi;
+      wide_ = t1_ - t0_ > std::numbers::pi;
     }
   }
 
   /// The squared distance of each point.
   void squares(const DeviationPoints &pts, Squares &out) const {
-    constexpr size_t n = DeviationPoints::kCount;
+    constexpr size_t n = kDeviationSamples;
     switch (kind_) {
     case Kind::Line:
       for (size_t i = 0; i < n; ++i) {
@@ -164,7 +169,7 @@ public:
       for (size_t i = 0; i < n; ++i) {
         const Vec3 p(pts.x[i], pts.y[i], pts.z[i]);
         double best = std::min((first_ - p).squaredNorm(), (last_ - p).squaredNorm());
-        constexpr double kTurn = 2 * kPi;
+        constexpr double kTurn = 2 * std::numbers::pi;
         // The angle of p about the axis, from the part's start, taken into [0, 2 pi).
         double theta = sigma_ * (std::atan2(p.y() - centre_.y(), p.x() - centre_.x()) - startAngle_) - t0_;
         theta -= kTurn * std::floor(theta / kTurn);
@@ -180,7 +185,6 @@ public:
   }
 
 private:
-  static constexpr double kPi = 3.14159265358979323846;
   enum class Kind : uint8_t { Line, PlaneArc, Helix };
   Vec3 first_, last_, dir_ = Vec3::Zero(), centre_ = Vec3::Zero();
   Eigen::Vector2d e0_ = Eigen::Vector2d::Zero(), e1_ = Eigen::Vector2d::Zero();  ///< plane arcs: directions of the ends
@@ -213,7 +217,7 @@ std::array<Vec3, 6> blendPoints(const Segment &a, double la, const Segment &b, d
 double blendDeviation(const std::array<Vec3, 6> &ctrl, const Segment &a, double la, const Segment &b, double lb) {
   const QuinticCurve curve(ctrl);
   DeviationPoints pts;
-  for (size_t i = 0; i < DeviationPoints::kCount; ++i) {
+  for (size_t i = 0; i < kDeviationSamples; ++i) {
     const double u = double(std::min<size_t>(i + 1, kDeviationSamples - 1)) / kDeviationSamples;
     const Vec3 p = curve.point(u);
     pts.x[i] = p.x();
@@ -224,7 +228,7 @@ double blendDeviation(const std::array<Vec3, 6> &ctrl, const Segment &a, double 
   PartDistance(a, a.length - la, a.length).squares(pts, toA);
   PartDistance(b, 0, lb).squares(pts, toB);
   double worst = 0;
-  for (size_t i = 0; i < DeviationPoints::kCount; ++i)
+  for (size_t i = 0; i < kDeviationSamples; ++i)
     worst = std::max(worst, std::min(toA[i], toB[i]));
   return std::sqrt(worst);
 }
@@ -384,7 +388,7 @@ void smoothChains(const PathInput &input, std::vector<Piece> &pieces, double tol
   auto consumed = [&](size_t i) {
     const Piece &p = pieces[i];
     return p.kind == SegmentKind::Line && i > 0 && i + 1 < n && p.blendBefore && pieces[i + 1].blendBefore &&
-           p.length - p.cutStart - p.cutEnd <= 1e-9;  // what is left is dropped (plan, step 3)
+           !p.keepsMiddle();  // what is left is dropped (plan, step 3)
   };
   for (size_t i = 0; i < n; ++i) {
     if (!consumed(i))
@@ -470,7 +474,7 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   // 3. Segments with their caps.
   size_t count = 0;
   for (const Piece &p : pieces)
-    count += size_t(p.blendBefore) + size_t(p.length - p.cutEnd - p.cutStart > 1e-9);
+    count += size_t(p.blendBefore) + size_t(p.keepsMiddle());
   out.segments.reserve(count);
   out.info.reserve(count);
   auto push = [&](double feed, uint32_t move, uint32_t next, StopReason stop) {
@@ -503,9 +507,8 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
           stop = StopReason::None;
         }
       }
-      const double s0 = p.cutStart, s1 = here.length - p.cutEnd;
-      if (s1 - s0 > 1e-9) {
-        out.segments.push_back(here.part(s0, s1));
+      if (p.keepsMiddle()) {
+        out.segments.push_back(here.part(p.cutStart, here.length - p.cutEnd));
         push(p.feed, p.move, p.move, stop);
         stop = StopReason::None;
       }

@@ -440,16 +440,6 @@ std::string seconds(double t) { return formatFixed(t, 3) + " s"; }
 std::string perMinute(double mmPerS) { return formatFixed(mmPerS * 60, 1) + " mm/min"; }
 std::string percent(double fraction) { return formatFixed(fraction * 100, 1) + " %"; }
 
-/// "95", "97.5": a setting as people write it.
-std::string plain(double v) {
-  std::string s = formatFixed(v, 3);
-  while (s.back() == '0')
-    s.pop_back();
-  if (s.back() == '.')
-    s.pop_back();
-  return s;
-}
-
 std::string axisName(const Machine &machine, int axis) {
   if (axis >= 0 && static_cast<size_t>(axis) < machine.axes.size())
     return machine.axes[static_cast<size_t>(axis)].name;
@@ -490,7 +480,7 @@ std::string formatReport(const SimReport &report, const Trajectory &trajectory, 
            " programmed (" + percent(report.meanProgrammedFeed > 0 ? report.meanFeed / report.meanProgrammedFeed : 0) +
            "), lowest " + percent(report.minFeedRatio) + " between stops\n";
     const double slow = report.slowTime[0] + report.slowTime[1] + report.slowTime[2];
-    out += "below " + plain(report.slowFraction * 100) + " % of the programmed feed: " + seconds(slow) + "\n";
+    out += "below " + formatTrimmed(report.slowFraction * 100, 3) + " % of the programmed feed: " + seconds(slow) + "\n";
     if (report.slowTime[static_cast<size_t>(SlowReason::Ramp)] > 0)
       out += "  speeding up or slowing down: " + seconds(report.slowTime[static_cast<size_t>(SlowReason::Ramp)]) +
              "\n";

@@ -6,15 +6,6 @@
 
 namespace stepnc::runtime {
 
-std::string plainNumber(double v) {
-  std::string s = formatFixed(v, 6);
-  while (s.back() == '0')
-    s.pop_back();
-  if (s.back() == '.')
-    s.pop_back();
-  return s;
-}
-
 namespace {
 
 std::string join(std::initializer_list<std::string_view> names) {
@@ -58,8 +49,8 @@ std::optional<double> TomlReader::number(const toml::table &table, std::string_v
   }
   std::optional<double> v = n->value<double>();
   if (!v || !(*v >= lo && *v <= hi)) {
-    error(n->source(), where + "." + std::string(key) + " must be a number of " + unit + " from " + plainNumber(lo) +
-                           " to " + plainNumber(hi));
+    error(n->source(), where + "." + std::string(key) + " must be a number of " + unit + " from " + formatTrimmed(lo, 6) +
+                           " to " + formatTrimmed(hi, 6));
     return std::nullopt;
   }
   return v;

@@ -19,9 +19,6 @@
 
 namespace stepnc::runtime {
 
-/// A limit as people write it: "1000000", "0.00001", never an exponent.
-std::string plainNumber(double v);
-
 class TomlReader {
 public:
   /// `what` names the file in messages: "the machine file".
@@ -29,7 +26,6 @@ public:
       : file_(file), diags_(diags), what_(std::move(what)) {}
 
   bool ok() const { return ok_; }
-  const std::string &what() const { return what_; }
 
   /// The file's root table; nullopt (after an error) when it is not TOML.
   std::optional<toml::table> parse();
@@ -55,9 +51,9 @@ public:
   const toml::table *table(const toml::table &parent, std::string_view key, const std::string &where,
                            bool required = true);
 
+private:
   SourceLoc locate(const toml::source_position &p) const;
 
-private:
   const SourceFile &file_;
   DiagnosticEngine &diags_;
   std::string what_;

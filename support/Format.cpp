@@ -30,6 +30,17 @@ std::string formatFixed(double value, int decimals) {
   return s;
 }
 
+std::string formatTrimmed(double value, int decimals) {
+  std::string s = formatFixed(value, decimals);
+  if (s.find('.') == std::string::npos)
+    return s;
+  while (s.back() == '0')
+    s.pop_back();
+  if (s.back() == '.')
+    s.pop_back();
+  return s;
+}
+
 std::string formatTuple(std::initializer_list<double> values, int decimals) {
   std::string s = "(";
   for (double v : values) {

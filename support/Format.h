@@ -21,6 +21,10 @@ std::string formatExact(double value);
 /// as "0.000". Non-finite values print as "nan"/"inf" (callers reject them first).
 std::string formatFixed(double value, int decimals);
 
+/// Fixed-point with at most `decimals` digits after the point, trailing zeros
+/// and a bare point dropped: "95", "97.5". A setting as people write it.
+std::string formatTrimmed(double value, int decimals);
+
 /// "(1.0000, -2.5000, 0.0000)": numbers in fixed point, for messages.
 std::string formatTuple(std::initializer_list<double> values, int decimals);
 

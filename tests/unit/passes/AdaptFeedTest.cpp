@@ -4,10 +4,10 @@
 // toolpath IR.
 #include "passes/CuttingModel.h"
 #include "passes/MotionIR.h"
-#include "passes/PassManager.h"
 
 #include "tests/unit/TestSupport.h"
 #include "tests/unit/ir/SampleModule.h"
+#include "tests/unit/passes/PassTestSupport.h"
 #include "tools/stepnc/Compile.h"
 
 #include <catch2/catch.hpp>
@@ -47,44 +47,6 @@ ir::test::Parsed parsed() {
   return p;
 }
 
-/// Moves under the workingstep: rapid above `from`, down to z at feed, then a
-/// line to `to` at `feed`, up and away.
-void straightCut(ir::Module &m, const Vec3 &from, const Vec3 &to, double feed, double spindle = -3000) {
-  Node &ws = ir::test::find(m.root, "@ws");
-  Node moves("moves");
-  moves.set("tool", Value::ref("%mill10"))
-      .set("spindle", Value::spindle(spindle))
-      .set("coolant", Value::word("flood"))
-      .set("setup", Value::ref("%s1"))
-      .set("secplane", Value::length(20));
-  auto add = [&](const char *kind, const Vec3 &p, double f) {
-    Node &n = moves.add(Node(kind));
-    n.set("to", Value::point(p));
-    if (f > 0)
-      n.set("feed", Value::feed(f));
-  };
-  add("rapid", Vec3(from.x(), from.y(), 20), 0);
-  add("linear", from, feed);
-  add("linear", to, feed);
-  add("rapid", Vec3(to.x(), to.y(), 20), 0);
-  ws.add(std::move(moves));
-}
-
-bool runPasses(ir::Module &m, const std::string &pipeline, std::vector<std::string> *errors = nullptr) {
-  std::string error;
-  auto entries = parsePipeline(pipeline, error);
-  INFO(error);
-  REQUIRE(entries);
-  DiagnosticCollector c;
-  DiagnosticEngine diags(c);
-  PassManager pm({});
-  pm.add(*entries);
-  const bool ok = pm.run(m, diags);
-  for (const Diagnostic &d : c.diags)
-    if (d.severity == Severity::Error && errors)
-      errors->push_back(d.message);
-  return ok;
-}
 
 /// Feeds of the feed moves of a moves node, in order.
 std::vector<double> feeds(const Node &moves) {
@@ -100,8 +62,8 @@ std::vector<double> feeds(const Node &moves) {
 TEST_CASE("adapt-feed: a straight slot gets fz = h*", "[adapt-feed]") {
   ir::test::Parsed p = parsed();
   // Programmed 0.2 mm per tooth: 0.2 x 4 x 3000 = 2400 mm/min. Slotting 5 deep.
-  straightCut(*p.module, Vec3(-10, 25, -5), Vec3(110, 25, -5), 2400);
-  REQUIRE(runPasses(*p.module, "adapt-feed"));
+  test::addStraightCut(*p.module, Vec3(-10, 25, -5), Vec3(110, 25, -5), 2400);
+  REQUIRE(test::runPipeline(*p.module, "adapt-feed"));
   const std::vector<double> f = feeds(*ir::test::find(p.module->root, "@ws").child("moves"));
   // The plunge outside the block is kept; the slot in full engagement gets
   // h* x flutes x rev/min = 0.10 x 4 x 3000 = 1200 mm/min; where the tool
@@ -123,8 +85,8 @@ TEST_CASE("adapt-feed: a wall at constant radial depth gets the chip-thinning fe
     // Along the block's side y = 50, the tool's edge 1 mm into it, 5 deep, well
     // over the chip target (1 mm per tooth programmed).
     const double y = 50 + 5 - ae;
-    straightCut(*p.module, Vec3(-10, y, -5), Vec3(110, y, -5), 12000);
-    REQUIRE(runPasses(*p.module, "adapt-feed"));
+    test::addStraightCut(*p.module, Vec3(-10, y, -5), Vec3(110, y, -5), 12000);
+    REQUIRE(test::runPipeline(*p.module, "adapt-feed"));
     const std::vector<double> f = feeds(*ir::test::find(p.module->root, "@ws").child("moves"));
     // fz = h* / sin(phi_e), phi_e = acos(1 - ae / R) (REFERENCES: chip thinning).
     const double expected = 0.10 / std::sin(std::acos(1 - ae / 5)) * 4 * 3000;
@@ -150,7 +112,7 @@ TEST_CASE("adapt-feed: pocket corners get lower feeds than the walls", "[adapt-f
   tech.set("feed", Value::feed(12000)).set("spindle", Value::spindle(-3000));
   op.add(Node("strategy")).set("type", Value::word("contour_parallel"));
   std::vector<std::string> errors;
-  REQUIRE(runPasses(*p.module, "expand-strategies,adapt-feed,verify-toolpaths", &errors));
+  REQUIRE(test::runPipeline(*p.module, "expand-strategies,adapt-feed,verify-toolpaths", &errors));
   const Node &moves = *ir::test::find(p.module->root, "@ws").child("moves");
   // The outermost ring at the floor: the tool centre runs round [35, 65] x
   // [15, 35]. Along the middles of its sides the tool takes the 3 mm left by
@@ -186,7 +148,7 @@ TEST_CASE("adapt-feed: pocket corners get lower feeds than the walls", "[adapt-f
 TEST_CASE("adapt-feed: options are checked", "[adapt-feed]") {
   ir::test::Parsed p = parsed();
   std::vector<std::string> errors;
-  CHECK_FALSE(runPasses(*p.module, "adapt-feed<allow-increase=maybe>", &errors));
+  CHECK_FALSE(test::runPipeline(*p.module, "adapt-feed<allow-increase=maybe>", &errors));
   REQUIRE(errors.size() == 1);
   CHECK(errors[0] == "adapt-feed: allow-increase='maybe' must be true or false");
 }

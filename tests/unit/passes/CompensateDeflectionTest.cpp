@@ -4,11 +4,11 @@
 // is; a tight offset limit lowers the feed; a finished pocket passes
 // verification on its predicted path and fails it on its programmed one.
 #include "passes/CuttingModel.h"
-#include "passes/PassManager.h"
 
 #include "tests/unit/TestSupport.h"
 #include "tests/unit/ir/SampleModule.h"
 #include "tests/unit/passes/DeflectionCheck.h"
+#include "tests/unit/passes/PassTestSupport.h"
 
 #include <catch2/catch.hpp>
 
@@ -45,45 +45,6 @@ ir::test::Parsed parsed() {
   return p;
 }
 
-/// Moves under the workingstep: down outside the block at `from`, a line
-/// along the block to `to`, up and away.
-void straightCut(ir::Module &m, const Vec3 &from, const Vec3 &to, double feed) {
-  Node &ws = ir::test::find(m.root, "@ws");
-  Node moves("moves");
-  moves.set("tool", Value::ref("%mill10"))
-      .set("spindle", Value::spindle(-3000))
-      .set("coolant", Value::word("flood"))
-      .set("setup", Value::ref("%s1"))
-      .set("secplane", Value::length(20));
-  auto add = [&](const char *kind, const Vec3 &p, double f) {
-    Node &n = moves.add(Node(kind));
-    n.set("to", Value::point(p));
-    if (f > 0)
-      n.set("feed", Value::feed(f));
-  };
-  add("rapid", Vec3(from.x(), from.y(), 20), 0);
-  add("linear", from, feed);
-  add("linear", to, feed);
-  add("rapid", Vec3(to.x(), to.y(), 20), 0);
-  ws.add(std::move(moves));
-}
-
-bool runPasses(ir::Module &m, const std::string &pipeline, std::vector<std::string> *errors = nullptr) {
-  std::string error;
-  auto entries = parsePipeline(pipeline, error);
-  INFO(error);
-  REQUIRE(entries);
-  DiagnosticCollector c;
-  DiagnosticEngine diags(c);
-  PassManager pm({});
-  pm.add(*entries);
-  const bool ok = pm.run(m, diags);
-  for (const Diagnostic &d : c.diags)
-    if (d.severity == Severity::Error && errors)
-      errors->push_back(d.message);
-  return ok;
-}
-
 const cutting::CuttingData &shipped() {
   static const cutting::CuttingData data = cutting::shippedCuttingData();
   return data;
@@ -94,8 +55,10 @@ const cutting::CuttingData &shipped() {
 double wallOffset(double ae, double ap, double fz) {
   ir::test::Parsed p = parsed();
   const CutterSetup tool = cutterSetup(ir::test::find(p.module->root, "%mill10"), shipped());
-  const cutting::Material &steel = shipped().materials.at("steel_1020");
-  const cutting::CuttingCoefficients k{steel.ktc, steel.krc, steel.kte, steel.kre};
+  CutStep step;
+  step.tool = &tool;
+  step.cutter = tool.cutter; // clockwise, as the moves' spindle -3000 turns
+  step.material = &shipped().materials.at("steel_1020");
   CutSample s;
   s.dir = geom::Vec2(1, 0);
   s.side = -1;
@@ -103,7 +66,7 @@ double wallOffset(double ae, double ap, double fz) {
   s.ap = ap;
   double c = 0;
   for (int i = 0; i < 100; ++i)
-    c = test::midHeightBend(s, tool.cutter, k, tool.beam, c, fz);
+    c = wallBend(step, s, c, fz).mid;
   return c;
 }
 
@@ -115,9 +78,9 @@ TEST_CASE("compensate-deflection: a wall at constant radial depth is offset by t
   // Along the block's side y = 50, 0.5 mm into it, 8 deep, fz = 0.1 mm: the
   // material is on the right of the feed.
   const double y = 50 + 5 - 0.5;
-  straightCut(*p.module, Vec3(-10, y, -8), Vec3(110, y, -8), 1200);
+  test::addStraightCut(*p.module, Vec3(-10, y, -8), Vec3(110, y, -8), 1200);
   const ir::Module before = *p.module;
-  REQUIRE(runPasses(*p.module, "compensate-deflection"));
+  REQUIRE(test::runPipeline(*p.module, "compensate-deflection"));
 
   const double expected = wallOffset(0.5, 8, 0.1);
   INFO("expected offset " << expected << " mm");
@@ -150,7 +113,7 @@ TEST_CASE("compensate-deflection: the residual check sees an uncompensated wall"
   // The check must be able to fail: on the nominal program the residual is
   // the whole bend.
   ir::test::Parsed p = parsed();
-  straightCut(*p.module, Vec3(-10, 54.5, -8), Vec3(110, 54.5, -8), 1200);
+  test::addStraightCut(*p.module, Vec3(-10, 54.5, -8), Vec3(110, 54.5, -8), 1200);
   const test::DeflectionCheck check = test::checkDeflection(*p.module, *p.module, shipped());
   CHECK(check.failures.empty());
   CHECK(check.worstResidual == Approx(check.worstBefore));
@@ -163,7 +126,7 @@ TEST_CASE("compensate-deflection: zero force leaves the path unchanged", "[compe
   // clear of it. Neither of the last two has a force to compensate.
   ir::test::Parsed p = parsed();
   for (const double y : {54.5, 54.5, 56.0})
-    straightCut(*p.module, Vec3(-10, y, -8), Vec3(110, y, -8), 1200);
+    test::addStraightCut(*p.module, Vec3(-10, y, -8), Vec3(110, y, -8), 1200);
   Node &ws = ir::test::find(p.module->root, "@ws");
   // One moves node: the passes one after the other.
   for (size_t i = 1; i < ws.childrenOf("moves").size(); ++i)
@@ -172,7 +135,7 @@ TEST_CASE("compensate-deflection: zero force leaves the path unchanged", "[compe
   while (ws.childrenOf("moves").size() > 1)
     ws.children.pop_back();
   const ir::Module before = *p.module;
-  REQUIRE(runPasses(*p.module, "compensate-deflection"));
+  REQUIRE(test::runPipeline(*p.module, "compensate-deflection"));
   const Node &a = *ir::test::find(p.module->root, "@ws").child("moves");
   const Node &b = *ir::test::find(const_cast<Node &>(before.root), "@ws").child("moves");
   // The first pass is compensated (and so split or joined by connectors);
@@ -188,11 +151,11 @@ TEST_CASE("compensate-deflection: zero force leaves the path unchanged", "[compe
 
 TEST_CASE("compensate-deflection: an offset above the limit lowers the feed", "[compensate-deflection]") {
   ir::test::Parsed p = parsed();
-  straightCut(*p.module, Vec3(-10, 54.5, -8), Vec3(110, 54.5, -8), 1200);
+  test::addStraightCut(*p.module, Vec3(-10, 54.5, -8), Vec3(110, 54.5, -8), 1200);
   const double full = wallOffset(0.5, 8, 0.1);
   const double limit = std::round(full / 2 * 1e4) / 1e4;
   const ir::Module before = *p.module;
-  REQUIRE(runPasses(*p.module, "compensate-deflection<max-offset=" + std::to_string(limit) + ">"));
+  REQUIRE(test::runPipeline(*p.module, "compensate-deflection<max-offset=" + std::to_string(limit) + ">"));
   double lowest = 1e9;
   for (const Move &m : walkMoves(*ir::test::find(p.module->root, "@ws").child("moves")))
     if (m.isFeed())
@@ -227,9 +190,9 @@ TEST_CASE("compensate-deflection: a finished pocket verifies on its predicted pa
     FAIL(e);
   REQUIRE(p.module);
   std::vector<std::string> errors;
-  REQUIRE(runPasses(*p.module, "expand-strategies", &errors));
+  REQUIRE(test::runPipeline(*p.module, "expand-strategies", &errors));
   const ir::Module before = *p.module;
-  const bool ok = runPasses(*p.module, "compensate-deflection,verify-toolpaths", &errors);
+  const bool ok = test::runPipeline(*p.module, "compensate-deflection,verify-toolpaths", &errors);
   for (const std::string &e : errors)
     FAIL_CHECK(e);
   REQUIRE(ok);
@@ -246,7 +209,7 @@ TEST_CASE("compensate-deflection: a finished pocket verifies on its predicted pa
   for (Node &n : ws.children.back().children)
     std::erase_if(n.attrs, [](const ir::Attr &a) { return a.name == "nominal"; });
   errors.clear();
-  CHECK_FALSE(runPasses(*p.module, "verify-toolpaths", &errors));
+  CHECK_FALSE(test::runPipeline(*p.module, "verify-toolpaths", &errors));
   REQUIRE_FALSE(errors.empty());
   CHECK(errors[0].find("gouge") != std::string::npos);
 }
@@ -254,7 +217,7 @@ TEST_CASE("compensate-deflection: a finished pocket verifies on its predicted pa
 TEST_CASE("compensate-deflection: options are checked", "[compensate-deflection]") {
   ir::test::Parsed p = parsed();
   std::vector<std::string> errors;
-  CHECK_FALSE(runPasses(*p.module, "compensate-deflection<max-offset=far>", &errors));
+  CHECK_FALSE(test::runPipeline(*p.module, "compensate-deflection<max-offset=far>", &errors));
   REQUIRE(errors.size() == 1);
   CHECK(errors[0] ==
         "compensate-deflection: max-offset='far' is not a length: expected a positive number of mm, such as "

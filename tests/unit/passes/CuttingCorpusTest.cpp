@@ -6,10 +6,10 @@
 // passing.
 #include "passes/CuttingModel.h"
 #include "passes/MotionIR.h"
-#include "passes/PassManager.h"
 
 #include "tests/unit/TestSupport.h"
 #include "tests/unit/passes/DeflectionCheck.h"
+#include "tests/unit/passes/PassTestSupport.h"
 #include "tools/stepnc/Compile.h"
 #include "tools/stepnc/SchemaSelection.h"
 
@@ -55,22 +55,6 @@ Loaded load(const std::string &path) {
   return l;
 }
 
-bool run(ir::Module &m, const std::string &pipeline, std::vector<std::string> &errors) {
-  std::string error;
-  auto entries = parsePipeline(pipeline, error);
-  INFO(error);
-  REQUIRE(entries);
-  DiagnosticCollector c;
-  DiagnosticEngine diags(c);
-  PassManager pm({});
-  pm.add(*entries);
-  const bool ok = pm.run(m, diags);
-  for (const Diagnostic &d : c.diags)
-    if (d.severity == Severity::Error)
-      errors.push_back(d.message);
-  return ok;
-}
-
 } // namespace
 
 TEST_CASE("adapt-feed and compensate-deflection: invariants on the corpus",
@@ -95,9 +79,9 @@ TEST_CASE("adapt-feed and compensate-deflection: invariants on the corpus",
     INFO(name);
     Loaded l = load(path);
     std::vector<std::string> errors;
-    REQUIRE(run(*l.module, "resolve-feeds,expand-strategies", errors));
+    REQUIRE(test::runPipeline(*l.module, "resolve-feeds,expand-strategies", &errors));
     const ir::Module programmed = *l.module;
-    REQUIRE(run(*l.module, "adapt-feed<machine=hsc-3axis>", errors));
+    REQUIRE(test::runPipeline(*l.module, "adapt-feed<machine=hsc-3axis>", &errors));
     const ir::Module adapted = *l.module;
 
     // Feeds: every piece of a move at or below its programmed feed, and at
@@ -143,7 +127,7 @@ TEST_CASE("adapt-feed and compensate-deflection: invariants on the corpus",
 
     // Deflection: every finishing wall within 2 um of its nominal position,
     // and the verifier passes on the predicted path.
-    REQUIRE(run(*l.module, "compensate-deflection,verify-toolpaths", errors));
+    REQUIRE(test::runPipeline(*l.module, "compensate-deflection,verify-toolpaths", &errors));
     for (const std::string &e : errors)
       FAIL_CHECK(e);
     const test::DeflectionCheck check = test::checkDeflection(adapted, *l.module, data);

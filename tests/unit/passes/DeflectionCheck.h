@@ -3,11 +3,10 @@
 // was (one-sided engagement at a sample of the cutting model), find the
 // move of the compensated program whose predicted path (`nominal`) passes
 // there, read its offset from its geometry and its feed, and evaluate the
-// bend of the tool at mid-height of the cut. The residual |bend - offset| is
+// bend of the tool at mid-height of the cut on the model (passes::wallBend). The residual |bend - offset| is
 // the position error the compensated program is predicted to leave.
 #pragma once
 
-#include "cutting/Deflection.h"
 #include "passes/CuttingModel.h"
 
 #include <cmath>
@@ -25,18 +24,6 @@ struct DeflectionCheck {
   double largestOffset = 0; ///< mm
   std::vector<std::string> failures;
 };
-
-/// The bend of the tool (mm, away from the wall) at mid-height of the cut:
-/// the pass's model, rebuilt here from the cutting library.
-inline double midHeightBend(const passes::CutSample &s, const cutting::Cutter &cutter,
-                            const cutting::CuttingCoefficients &k, const cutting::ToolBeam &beam, double offset,
-                            double fz) {
-  const cutting::Engagement e = cutting::wallEngagement(s.dir, s.side, s.ae + offset, s.ap, cutter);
-  const geom::Vec2 into = s.side * geom::Vec2(-s.dir.y(), s.dir.x());
-  const double push = cutting::ForceModel(e, cutter, k).peakPush(into, fz);
-  const double h = std::min(s.ap, cutter.fluteLength);
-  return push > 0 ? cutting::deflectionUnderSpreadLoad(beam, push, h, h / 2) : 0;
-}
 
 inline DeflectionCheck checkDeflection(const ir::Module &before, const ir::Module &after,
                                        const cutting::CuttingData &data) {
@@ -57,11 +44,7 @@ inline DeflectionCheck checkDeflection(const ir::Module &before, const ir::Modul
       continue;
     const std::vector<Move> programmed = walkMoves(*moved[i]);
     const std::vector<Move> predicted = walkMoves(*moved[i], std::nullopt, PathKind::Predicted);
-    cutting::Cutter cutter = step.tool->cutter;
-    cutter.clockwise = step.movesNode->number("spindle").value_or(0) <= 0;
-    const cutting::CuttingCoefficients k{step.material->ktc, step.material->krc, step.material->kte,
-                                         step.material->kre};
-    const double perFz = cutter.flutes * step.spindle; // mm/min per mm of fz
+    const double perFz = step.cutter.flutes * step.spindle; // mm/min per mm of fz
     for (const CutMove &cm : step.moves)
       for (const CutSample &s : cm.samples) {
         if (!engagesPartWall(analysis, step, s, cm.move.to.z()))
@@ -92,17 +75,16 @@ inline DeflectionCheck checkDeflection(const ir::Module &before, const ir::Modul
           shift = ((p.to.head<2>() - c).norm() - (predicted[found].to.head<2>() - c).norm()) * (s.at - c).normalized();
         }
         const double offset = shift.norm();
-        const geom::Vec2 into = s.side * geom::Vec2(-s.dir.y(), s.dir.x());
         if (offset > 0) {
           ++out.offsetWalls;
-          if (shift.dot(into) < 0.99 * offset)
+          if (shift.dot(s.intoWall()) < 0.99 * offset)
             out.failures.push_back(where.str() + ": offset away from the wall");
         }
         if (p.feed > cm.move.feed)
           out.failures.push_back(where.str() + ": feed raised");
-        const double bend = midHeightBend(s, cutter, k, step.tool->beam, offset, p.feed / perFz);
+        const double bend = wallBend(step, s, offset, p.feed / perFz).mid;
         out.worstResidual = std::max(out.worstResidual, std::abs(bend - offset));
-        out.worstBefore = std::max(out.worstBefore, midHeightBend(s, cutter, k, step.tool->beam, 0, cm.fz));
+        out.worstBefore = std::max(out.worstBefore, wallBend(step, s, 0, cm.fz).mid);
         out.largestOffset = std::max(out.largestOffset, offset);
       }
   }
