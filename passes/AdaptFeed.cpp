@@ -31,10 +31,11 @@ namespace stepnc::passes {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
-/// Samples whose feeds differ by less than this ratio share a piece.
-constexpr double kPieceRatio = 0.92;
+/// What a piece costs in adapt-feed's grouping of samples, as mm of cut
+/// at no feed: a piece more is worth it where it gains at least that.
+constexpr double kPieceCost = 0.25;
 /// Rounds of capping feeds at what the machine reaches (each plans the program).
-constexpr int kCapRounds = 8;
+constexpr int kCapRounds = 64;
 
 enum class Limit { Chip, Force, Spindle, Programmed, Air };
 constexpr Limit kLimits[] = {Limit::Chip, Limit::Force, Limit::Spindle, Limit::Programmed, Limit::Air};
@@ -128,9 +129,8 @@ public:
         f.split += int(ps.size()) - 1;
         for (size_t i = 0; i < ps.size(); ++i) {
           ir::Node piece = child;
-          double feed = ps[i].limit == Limit::Programmed || ps[i].limit == Limit::Air
-                            ? cm->move.feed
-                            : cm->feedFor(ps[i].fz);
+          double feed =
+              ps[i].limit == Limit::Programmed || ps[i].limit == Limit::Air ? cm->move.feed : cm->feedFor(ps[i].fz);
           if (!allowIncrease_)
             feed = std::min(feed, cm->move.feed);
           lowered += feed < cm->move.feed;
@@ -143,6 +143,11 @@ public:
       }
       movesNode->children = std::move(children);
     }
+
+    // The pieces measured on their own samples (the engagement between the
+    // samples the feeds were chosen on): any still over a limit is lowered.
+    const long long rechecked = lowerOverLimits(module, options);
+    lowered += rechecked;
 
     // What the machine reaches with these feeds bounds them.
     // Lower feeds change the plan (blends, look-ahead), and so what the
@@ -188,13 +193,70 @@ public:
   }
 
 private:
+  /// The feed per tooth a sample wants, and what sets it.
+  struct Want {
+    double fz;
+    Limit limit;
+  };
+  /// Consecutive samples that share one feed: the lowest they want.
+  struct Group {
+    size_t first, last; ///< samples
+    Want want;
+  };
+
+  /// Splits a move's samples into groups, each at the lowest feed its
+  /// samples want, so that every sample keeps at least kFeedRatio of the
+  /// feed it wants and, within that, the feed given away (each sample's
+  /// share of the length times the fraction of its feed lost) plus
+  /// kPieceCost per group is least. A greedy run would let a slope into a
+  /// corner pull the whole wall before it down to the corner's feed. A move
+  /// with whole turns (a circle at depth) is one group.
+  static std::vector<Group> groupSamples(const CutMove &cm, const std::vector<Want> &wants) {
+    const size_t n = wants.size();
+    if (cm.move.turns != 0)
+      return {Group{0, n - 1, *std::min_element(wants.begin(), wants.end(), [](const Want &a, const Want &b) {
+                      return a.fz < b.fz;
+                    })}};
+    // Each sample stands for the length halfway to its neighbours.
+    std::vector<double> share(n);
+    for (size_t k = 0; k < n; ++k)
+      share[k] = (k + 1 < n ? cm.samples[k + 1].s : cm.move.length()) / 2 - (k > 0 ? cm.samples[k - 1].s : 0) / 2;
+    // best[j]: least cost of samples [0, j); from[j]: where its last group starts.
+    std::vector<double> best(n + 1, kInf);
+    std::vector<size_t> from(n + 1, 0);
+    best[0] = 0;
+    for (size_t j = 1; j <= n; ++j) {
+      double lo = kInf, hi = 0, length = 0, perFeed = 0;
+      for (size_t i = j; i-- > 0;) {
+        lo = std::min(lo, wants[i].fz);
+        hi = std::max(hi, wants[i].fz);
+        if (lo < kFeedRatio * hi)
+          break;
+        length += share[i];
+        perFeed += share[i] / wants[i].fz;
+        // Lost: sum of share x (1 - lo / want).
+        const double cost = best[i] + (length - lo * perFeed) + kPieceCost;
+        if (cost < best[j]) {
+          best[j] = cost;
+          from[j] = i;
+        }
+      }
+    }
+    std::vector<Group> groups;
+    for (size_t j = n; j > 0; j = from[j]) {
+      Group g{from[j], j - 1, wants[j - 1]};
+      for (size_t k = g.first; k <= g.last; ++k)
+        if (wants[k].fz < g.want.fz)
+          g.want = wants[k];
+      groups.push_back(g);
+    }
+    std::reverse(groups.begin(), groups.end());
+    return groups;
+  }
+
   /// Pieces of one measured move with their feed per tooth.
   std::vector<Piece> plan(const CutMove &cm, const CutStep &step) const {
     const double hStar = step.material->chipThickness;
-    struct Want {
-      double fz;
-      Limit limit;
-    };
     std::vector<Want> wants;
     for (const CutSample &s : cm.samples) {
       Want w{kInf, Limit::Chip};
@@ -211,46 +273,52 @@ private:
         w = {cm.fz, Limit::Programmed};
       wants.push_back(w);
     }
-    // A move with whole turns (a circle at depth) is one piece.
-    const bool splittable = cm.move.turns == 0;
+    const std::vector<Group> groups = groupSamples(cm, wants);
+    // Between two groups the engagement is known only at their samples: the
+    // stretch between them goes to the group with the lower feed, which
+    // suits the samples at both its ends. Each piece so keeps its own feed.
     std::vector<Piece> out;
-    size_t i = 0;
-    while (i < wants.size()) {
-      double lo = wants[i].fz, hi = wants[i].fz;
-      Limit limit = wants[i].limit;
-      size_t j = i + 1;
-      for (; j < wants.size(); ++j) {
-        const double l = std::min(lo, wants[j].fz), h = std::max(hi, wants[j].fz);
-        if (splittable && l < kPieceRatio * h)
-          break;
-        if (wants[j].fz < lo)
-          limit = wants[j].limit;
-        lo = l;
-        hi = h;
-      }
+    for (size_t g = 0; g < groups.size(); ++g) {
       Piece p;
-      p.from = out.empty() ? 0 : out.back().to;
-      p.to = cm.pieceEnd(j);
-      // The piece reaches halfway to the samples on either side, where the
-      // engagement is not known: it must suit them too.
-      if (i > 0 && wants[i - 1].fz < lo) {
-        lo = wants[i - 1].fz;
-        limit = wants[i - 1].limit;
-      }
-      if (j < wants.size() && wants[j].fz < lo) {
-        lo = wants[j].fz;
-        limit = wants[j].limit;
-      }
-      p.fz = lo;
-      p.limit = limit;
+      p.from = g == 0 ? 0
+                      : (groups[g - 1].want.fz <= groups[g].want.fz ? cm.samples[groups[g].first].s
+                                                                    : cm.samples[groups[g - 1].last].s);
+      p.to = g + 1 == groups.size() ? cm.move.length()
+                                    : (groups[g].want.fz <= groups[g + 1].want.fz ? cm.samples[groups[g + 1].first].s
+                                                                                  : cm.samples[groups[g].last].s);
+      p.fz = groups[g].want.fz;
+      p.limit = groups[g].want.limit;
+      // A group above both its neighbours that has only one sample gives
+      // its place to them.
+      if (p.to - p.from <= 1e-9)
+        continue;
       // Pieces with the same feed are one.
       if (!out.empty() && out.back().fz == p.fz && out.back().limit == p.limit)
         out.back().to = p.to;
       else
         out.push_back(p);
-      i = j;
     }
     return out;
+  }
+
+  /// Lowers the feed of every measured move whose chip, force or torque is
+  /// over its limit at one of its samples; how many were.
+  static long long lowerOverLimits(ir::Module &module, const CutOptions &options) {
+    long long count = 0;
+    for (const CutStep &step : analyseCuts(module, options).steps)
+      for (const CutMove &cm : step.moves) {
+        if (!cm.measured || !step.material)
+          continue;
+        double want = kInf;
+        for (const CutSample &s : cm.samples)
+          if (s.chipFactor > 0)
+            want = std::min({want, step.material->chipThickness / s.chipFactor, s.fzForce, s.fzTorque});
+        if (want >= cm.fz)
+          continue;
+        const_cast<ir::Node *>(cm.move.node)->set("feed", ir::Value::feed(cm.feedFor(want)));
+        ++count;
+      }
+    return count;
   }
 
   /// Seconds per executable of the program as planned on the machine.
@@ -268,11 +336,11 @@ private:
     return out;
   }
 
-  /// Lowers every feed above the highest speed the machine can hold on its
-  /// move: the planner's speed cap there (axis velocities, acceleration and
-  /// jerk on the path's curvature, the controller's max feed). The speed a
-  /// short move actually reaches is lower still, but that is acceleration,
-  /// not a feed to program: capping there would only slow the plan down.
+  /// Lowers every feed above the highest speed the machine reaches on its
+  /// move in the plan of the program (the runtime's simulated actual feed:
+  /// axis velocities, acceleration and jerk on the path's curvature, the
+  /// controller's max feed, and on a short move what it gets to between
+  /// speeding up and slowing down); how many were.
   static long long capByDynamics(ir::Module &module, const runtime::Machine &machine) {
     const ProgramPath program = programPath(module);
     if (program.path.moves.empty())

@@ -44,8 +44,6 @@ constexpr double kOffsetGrid = 0.001;
 constexpr double kConverged = 1e-7; ///< mm: fixed-point tolerance
 constexpr double kDiverged = 1.0;   ///< mm: an offset this large means the iteration runs away
 constexpr int kMaxIterations = 200;
-/// Samples whose feeds differ by less than this ratio share a piece (as in adapt-feed).
-constexpr double kPieceRatio = 0.92;
 constexpr double kSamePoint = 1e-6; ///< mm: closer positions need no connector
 
 struct Solution {
@@ -204,7 +202,7 @@ private:
   }
 
   /// Pieces of a move: consecutive samples on the same side whose offsets
-  /// are within kPieceSpread and feeds within kPieceRatio (a move with whole
+  /// are within kPieceSpread and feeds within kFeedRatio (a move with whole
   /// turns is one piece); each piece takes the lowest feed of its samples and
   /// the middle of their offsets at it.
   std::vector<Piece> group(const CutStep &step, const CutMove &cm, std::vector<SamplePlan> &plans,
@@ -220,7 +218,7 @@ private:
         const SamplePlan &p = plans[end];
         const bool apart = (p.side() != 0 && side != 0 && p.side() != side) ||
                            std::max(hi, p.offset()) - std::min(lo, p.offset()) > kPieceSpread ||
-                           std::min(fzLo, p.fz) < kPieceRatio * std::max(fzHi, p.fz);
+                           std::min(fzLo, p.fz) < kFeedRatio * std::max(fzHi, p.fz);
         if (splittable && apart)
           break;
         lo = std::min(lo, p.offset());

@@ -97,6 +97,20 @@ std::vector<PathPoint> samplePath(const std::vector<geom::Seg> &segs, double ste
   return out;
 }
 
+/// The sample at `s` mm along a move's plane path.
+PathPoint pathPointAt(const std::vector<geom::Seg> &segs, double s) {
+  double offset = 0;
+  for (size_t i = 0; i < segs.size(); ++i) {
+    const double len = segs[i].length();
+    if (s <= offset + len || i + 1 == segs.size()) {
+      const double t = std::clamp(len > 0 ? (s - offset) / len : 0.0, 0.0, 1.0);
+      return {s, segs[i].at(t), segs[i].tangent(t)};
+    }
+    offset += len;
+  }
+  return {s, Vec2::Zero(), Vec2::UnitX()};
+}
+
 std::string operationKind(const ir::Node &executable) {
   for (const ir::Node &c : executable.children)
     if (const ir::KindSpec *spec = ir::findKind(c.kind); spec && spec->category == "operation")
@@ -292,7 +306,7 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
         cm.fz = m.feed / (cutter.flutes * step.spindle);
         const cutting::CuttingCoefficients k = material->coefficients();
         const double z = m.to.z();
-        for (const PathPoint &pp : samplePath(segs, sampleStep)) {
+        auto measure = [&](const PathPoint &pp) {
           const cutting::Engagement e = cutting::measureEngagement(map, pp.at, z, pp.dir, cutter);
           CutSample s;
           s.s = pp.s;
@@ -311,7 +325,27 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
           } else {
             s.fzForce = s.fzTorque = kInf;
           }
-          cm.samples.push_back(s);
+          return s;
+        };
+        // Where the chip changes by more than kFeedRatio between two
+        // samples (entering and leaving material, corners), samples are
+        // added halfway until they are two cells apart, so that the feeds
+        // can follow the engagement there.
+        const double finest = 2 * map.cell();
+        auto refine = [&](auto &self, const CutSample &a, const CutSample &b) -> void {
+          const double lo = std::min(a.chipFactor, b.chipFactor), hi = std::max(a.chipFactor, b.chipFactor);
+          if (b.s - a.s <= finest || lo >= kFeedRatio * hi)
+            return;
+          const CutSample mid = measure(pathPointAt(segs, (a.s + b.s) / 2));
+          self(self, a, mid);
+          cm.samples.push_back(mid);
+          self(self, mid, b);
+        };
+        for (const PathPoint &pp : samplePath(segs, sampleStep)) {
+          CutSample s = measure(pp);
+          if (!cm.samples.empty())
+            refine(refine, CutSample(cm.samples.back()), s);
+          cm.samples.push_back(std::move(s));
         }
       }
       // Cut the move into the stock.
@@ -354,15 +388,16 @@ bool engagesPartWall(const CutAnalysis &analysis, const CutStep &step, const Cut
 }
 
 WallBend wallBend(const CutStep &step, const CutSample &sample, double offset, double fz) {
-  const cutting::Engagement e = cutting::wallEngagement(sample.dir, sample.side, sample.ae + offset, sample.ap,
-                                                        step.cutter);
+  const cutting::Engagement e =
+      cutting::wallEngagement(sample.dir, sample.side, sample.ae + offset, sample.ap, step.cutter);
   const double push =
       cutting::ForceModel(e, step.cutter, step.material->coefficients()).peakPush(sample.intoWall(), fz);
   if (!(push > 0))
     return {};
   const cutting::ToolBeam &beam = step.tool->beam;
   const double h = std::min(sample.ap, step.cutter.fluteLength);
-  return {cutting::deflectionUnderSpreadLoad(beam, push, h, 0), cutting::deflectionUnderSpreadLoad(beam, push, h, h / 2),
+  return {cutting::deflectionUnderSpreadLoad(beam, push, h, 0),
+          cutting::deflectionUnderSpreadLoad(beam, push, h, h / 2),
           cutting::deflectionUnderSpreadLoad(beam, push, h, h)};
 }
 

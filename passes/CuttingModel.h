@@ -24,6 +24,10 @@
 
 namespace stepnc::passes {
 
+/// Feeds within this ratio are one feed to adapt-feed, and samples whose
+/// chips are within it need no sample between them.
+inline constexpr double kFeedRatio = 0.92;
+
 struct CutterSetup {
   std::string symbol;
   bool mill = false; ///< a milling cutter (the model applies); drills and the like are only cut into the stock
@@ -59,9 +63,7 @@ struct CutMove {
 
   /// Where a piece ending before sample j ends, mm along the move: halfway
   /// to the sample before it; the move's end when j is past the last sample.
-  double pieceEnd(size_t j) const {
-    return j < samples.size() ? (samples[j - 1].s + samples[j].s) / 2 : move.length();
-  }
+  double pieceEnd(size_t j) const { return j < samples.size() ? (samples[j - 1].s + samples[j].s) / 2 : move.length(); }
   /// The feed (mm/min) that gives `perTooth` on this move, in whole mm/min
   /// rounded down, at least 1.
   double feedFor(double perTooth) const { return std::max(1.0, std::floor(perTooth * move.feed / fz)); }

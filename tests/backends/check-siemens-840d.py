@@ -121,17 +121,16 @@ def planned_moves(path):
 
 
 def on_circle(piece, centre, radius, tol):
-    """Whether an arc of the program lies on the planned circle. With I/J its centre is the plan's; a CR=
-    arc's centre moves with the rounding of its end points (far, on a short arc), so it is enough that it
-    has the radius and that its middle lies on the circle."""
+    """Whether an arc of the program lies on the planned circle: about the plan's centre, or through
+    points on the circle at both ends and in the middle. The centre a controller reads moves with the
+    rounding of the end points, far on a short arc: a CR= arc's always, an I/J arc's where stepnc
+    balances it between the printed ends (a 0.2 mm arc moves it by microns off the path's)."""
     if math.dist(piece["centre"], centre) <= tol:
         return True
-    if not piece.get("cr") or abs(piece["radius"] - radius) > tol:
-        return False
     a = math.atan2(piece["start"][1] - piece["centre"][1], piece["start"][0] - piece["centre"][0])
     a += (1 if piece["ccw"] else -1) * piece["sweep"] / 2
     middle = (piece["centre"][0] + piece["radius"] * math.cos(a), piece["centre"][1] + piece["radius"] * math.sin(a))
-    return abs(math.dist(middle, centre) - radius) <= tol
+    return all(abs(math.dist(p, centre) - radius) <= tol for p in (piece["start"][:2], middle, piece["to"][:2]))
 
 
 def arc_text(m):

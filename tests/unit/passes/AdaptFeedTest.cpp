@@ -47,7 +47,6 @@ ir::test::Parsed parsed() {
   return p;
 }
 
-
 /// Feeds of the feed moves of a moves node, in order.
 std::vector<double> feeds(const Node &moves) {
   std::vector<double> out;
@@ -136,13 +135,15 @@ TEST_CASE("adapt-feed: pocket corners get lower feeds than the walls", "[adapt-f
     for (const Vec3 &c : {Vec3(35, 15, 0), Vec3(65, 15, 0), Vec3(65, 35, 0), Vec3(35, 35, 0)})
       midNearest = std::min(midNearest, (mid.head<2>() - c.head<2>()).norm());
     if (nearest < 1e-3)
-      cornerLow = std::min(cornerLow, m.feed);  // the piece that ends in a corner
+      cornerLow = std::min(cornerLow, m.feed); // the piece that ends in a corner
     else if (midNearest > 8)
       wallLow = std::min(wallLow, m.feed);
   }
   REQUIRE(wallLow < 1e9);
   REQUIRE(cornerLow < 1e9);
-  CHECK(cornerLow < 0.9 * wallLow);
+  // At ae 3 of R 5 the chip factor on the walls is sin(acos(1 - 3/5)) =
+  // 0.917; in the corners the tool engages over half a turn, a factor of 1.
+  CHECK(cornerLow < 0.95 * wallLow);
 }
 
 TEST_CASE("adapt-feed: options are checked", "[adapt-feed]") {

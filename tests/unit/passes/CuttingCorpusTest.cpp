@@ -17,6 +17,8 @@
 
 #include <cmath>
 #include <filesystem>
+#include <limits>
+#include <map>
 
 using namespace stepnc;
 using namespace stepnc::passes;
@@ -53,6 +55,59 @@ Loaded load(const std::string &path) {
   l.module = tool::loadModule(*l.source, schemas, diags, usage);
   REQUIRE(l.module);
   return l;
+}
+
+/// How close to the chip target adapt-feed comes where the chip limits the
+/// feed, read on the samples it chose the feeds on: the samples of the
+/// program before it whose chip sets the lowest feed there (below what the
+/// force allows) and whose neighbours want feeds within the pass's feed
+/// ratio (not an entry, exit or corner, where feeds step between samples).
+/// Each such sample's chip at the feed the adapted program has there,
+/// the higher one where two pieces meet on it.
+struct ChipFit {
+  size_t limited = 0, under = 0, over = 0; ///< samples; below 0.9 of the target; above it
+  double lowest = 1;                       ///< lowest chip / target among them
+};
+
+ChipFit chipFit(const ir::Module &programmed, const ir::Module &adapted, const cutting::CuttingData &data) {
+  const CutAnalysis before = analyseCuts(programmed, {&data, nullptr});
+  const CutAnalysis after = analyseCuts(adapted, {&data, nullptr});
+  ChipFit fit;
+  REQUIRE(before.steps.size() == after.steps.size());
+  for (size_t k = 0; k < before.steps.size(); ++k) {
+    const CutStep &step = before.steps[k];
+    const std::vector<CutMove> &pieces = after.steps[k].moves;
+    size_t next = 0;
+    for (const CutMove &cm : step.moves) {
+      // The pieces of this move, with where each ends along it.
+      std::vector<std::pair<double, const CutMove *>> ends;
+      for (double run = 0; next < pieces.size() && run < cm.move.length() - 1e-6; ++next) {
+        run += pieces[next].move.length();
+        ends.push_back({run, &pieces[next]});
+      }
+      if (!cm.measured || cm.move.turns > 0 || !step.material)
+        continue;
+      const double target = step.material->chipThickness;
+      auto want = [&](const CutSample &s) { return s.chipFactor > 0 ? target / s.chipFactor : 0.0; };
+      for (size_t i = 1; i + 1 < cm.samples.size(); ++i) {
+        const CutSample &s = cm.samples[i];
+        const double w = want(s), w0 = want(cm.samples[i - 1]), w1 = want(cm.samples[i + 1]);
+        if (w <= 0 || w > 0.98 * s.fzForce || std::min(w, w0) < kFeedRatio * std::max(w, w0) ||
+            std::min(w, w1) < kFeedRatio * std::max(w, w1))
+          continue;
+        double fz = 0;
+        for (const auto &[end, piece] : ends)
+          if (end >= s.s - 1e-6 && end - piece->move.length() <= s.s + 1e-6)
+            fz = std::max(fz, piece->fz);
+        ++fit.limited;
+        const double ratio = fz * s.chipFactor / target;
+        fit.lowest = std::min(fit.lowest, ratio);
+        fit.under += ratio < 0.9;
+        fit.over += ratio > 1 + 1e-9;
+      }
+    }
+  }
+  return fit;
 }
 
 } // namespace
@@ -124,6 +179,21 @@ TEST_CASE("adapt-feed and compensate-deflection: invariants on the corpus",
         }
     INFO(samples << " samples, " << overChip << " over the chip target");
     CHECK(overChip == 0);
+
+    // Where the chip limits the feed, the chip is within [0.9, 1.0] of the
+    // target. The corpus programs feeds below the chip target, so this is
+    // checked with increases allowed, and with no machine, so that nothing
+    // else caps them.
+    {
+      ir::Module increased = programmed;
+      REQUIRE(test::runPipeline(increased, "adapt-feed<allow-increase=true>", &errors));
+      const ChipFit fit = chipFit(programmed, increased, data);
+      INFO(fit.limited << " samples limited by the chip, " << fit.under << " below 0.9 of the target, lowest "
+                       << fit.lowest << ", " << fit.over << " above it");
+      CHECK(fit.limited > 0);
+      CHECK(fit.under == 0);
+      CHECK(fit.over == 0);
+    }
 
     // Deflection: every finishing wall within 2 um of its nominal position,
     // and the verifier passes on the predicted path.
