@@ -277,15 +277,15 @@ private:
     // Between two groups the engagement is known only at their samples: the
     // stretch between them goes to the group with the lower feed, which
     // suits the samples at both its ends. Each piece so keeps its own feed.
+    auto boundary = [&](size_t g) { // mm along the move, between groups g and g + 1
+      return groups[g].want.fz <= groups[g + 1].want.fz ? cm.samples[groups[g + 1].first].s
+                                                        : cm.samples[groups[g].last].s;
+    };
     std::vector<Piece> out;
     for (size_t g = 0; g < groups.size(); ++g) {
       Piece p;
-      p.from = g == 0 ? 0
-                      : (groups[g - 1].want.fz <= groups[g].want.fz ? cm.samples[groups[g].first].s
-                                                                    : cm.samples[groups[g - 1].last].s);
-      p.to = g + 1 == groups.size() ? cm.move.length()
-                                    : (groups[g].want.fz <= groups[g + 1].want.fz ? cm.samples[groups[g + 1].first].s
-                                                                                  : cm.samples[groups[g].last].s);
+      p.from = g == 0 ? 0 : boundary(g - 1);
+      p.to = g + 1 == groups.size() ? cm.move.length() : boundary(g);
       p.fz = groups[g].want.fz;
       p.limit = groups[g].want.limit;
       // A group above both its neighbours that has only one sample gives

@@ -343,7 +343,7 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
         };
         for (const PathPoint &pp : samplePath(segs, sampleStep)) {
           CutSample s = measure(pp);
-          if (!cm.samples.empty())
+          if (!cm.samples.empty()) // a copy: refining appends to the samples
             refine(refine, CutSample(cm.samples.back()), s);
           cm.samples.push_back(std::move(s));
         }

@@ -24,27 +24,11 @@ using ir::Vec3;
 
 namespace {
 
-// A 100 x 50 x 20 block of SAE 1020 (steel_1020: h* = 0.10 mm), its top at z = 0;
-// a D10 four-flute end mill; moves written by hand under one workingstep.
-constexpr const char *kModule = R"(project "ADAPT"
-  workpiece %wp "WP" material="id" material_standard="SAE 1020" global_tolerance=0.0100mm
-    rawpiece shape=block size=(100.0000,50.0000,20.0000)mm at=(0.0000,0.0000,-20.0000)mm axis=(0.000000,0.000000,1.000000) ref=(1.000000,0.000000,0.000000)
-    closed_pocket %pocket "POCKET" at=(50.0000,25.0000,0.0000)mm axis=(0.000000,0.000000,1.000000) ref=(1.000000,0.000000,0.000000) depth=10.0000mm bottom=planar orthogonal_radius=5.0000mm
-      rectangular_profile width=30.0000mm length=40.0000mm
-  tool %mill10 "MILL 10" type=endmill diameter=10.0000mm cutting_edge_length=20.0000mm flutes=4
-  setup %s1 "S1" at=(0.0000,0.0000,0.0000)mm axis=(0.000000,0.000000,1.000000) ref=(1.000000,0.000000,0.000000) secplane=20.0000mm
-    workpiece_setup workpiece=%wp at=(0.0000,0.0000,0.0000)mm axis=(0.000000,0.000000,1.000000) ref=(1.000000,0.000000,0.000000)
-  workplan @plan "PLAN" setup=%s1
-    workingstep @ws "WS" feature=%pocket secplane=20.0000mm
-      bottom_and_side_rough_milling "OP" tool=%mill10
-)";
-
+// The block of SAE 1020 with its pocket (corner radius 5), rough milled;
+// moves written by hand under its workingstep.
 ir::test::Parsed parsed() {
-  ir::test::Parsed p = ir::test::parse(kModule);
-  for (const std::string &e : p.errors)
-    FAIL(e);
-  REQUIRE(p.module);
-  return p;
+  return test::parseModule(
+      test::blockPocketModule(5, test::oneStep(R"(bottom_and_side_rough_milling "OP" tool=%mill10)")));
 }
 
 /// Feeds of the feed moves of a moves node, in order.

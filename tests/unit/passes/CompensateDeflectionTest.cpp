@@ -22,27 +22,9 @@ using ir::Vec3;
 
 namespace {
 
-// A 100 x 50 x 20 block of SAE 1020 (steel_1020), its top at z = 0; a D10
-// four-flute end mill with 20 mm of flutes; a side finish of the pocket.
-constexpr const char *kModule = R"(project "DEFLECT"
-  workpiece %wp "WP" material="id" material_standard="SAE 1020" global_tolerance=0.0100mm
-    rawpiece shape=block size=(100.0000,50.0000,20.0000)mm at=(0.0000,0.0000,-20.0000)mm axis=(0.000000,0.000000,1.000000) ref=(1.000000,0.000000,0.000000)
-    closed_pocket %pocket "POCKET" at=(50.0000,25.0000,0.0000)mm axis=(0.000000,0.000000,1.000000) ref=(1.000000,0.000000,0.000000) depth=10.0000mm bottom=planar orthogonal_radius=6.0000mm
-      rectangular_profile width=30.0000mm length=40.0000mm
-  tool %mill10 "MILL 10" type=endmill diameter=10.0000mm cutting_edge_length=20.0000mm flutes=4
-  setup %s1 "S1" at=(0.0000,0.0000,0.0000)mm axis=(0.000000,0.000000,1.000000) ref=(1.000000,0.000000,0.000000) secplane=20.0000mm
-    workpiece_setup workpiece=%wp at=(0.0000,0.0000,0.0000)mm axis=(0.000000,0.000000,1.000000) ref=(1.000000,0.000000,0.000000)
-  workplan @plan "PLAN" setup=%s1
-    workingstep @ws "WS" feature=%pocket secplane=20.0000mm
-      side_finish_milling "OP" tool=%mill10
-)";
-
+// The block of SAE 1020 with its pocket (corner radius 6), side finished.
 ir::test::Parsed parsed() {
-  ir::test::Parsed p = ir::test::parse(kModule);
-  for (const std::string &e : p.errors)
-    FAIL(e);
-  REQUIRE(p.module);
-  return p;
+  return test::parseModule(test::blockPocketModule(6, test::oneStep(R"(side_finish_milling "OP" tool=%mill10)")));
 }
 
 const cutting::CuttingData &shipped() {
@@ -174,21 +156,15 @@ TEST_CASE("compensate-deflection: an offset above the limit lowers the feed", "[
 TEST_CASE("compensate-deflection: a finished pocket verifies on its predicted path", "[compensate-deflection]") {
   // The pocket roughed to 0.5 mm from its walls, then its walls finished in
   // one pass 10 deep.
-  std::string text = kModule;
-  const std::string from = "    workingstep @ws";
-  text = text.substr(0, text.find(from)) +
-         "    workingstep @rough \"ROUGH\" feature=%pocket secplane=20.0000mm\n"
+  ir::test::Parsed p = test::parseModule(test::blockPocketModule(
+      6, "    workingstep @rough \"ROUGH\" feature=%pocket secplane=20.0000mm\n"
          "      bottom_and_side_rough_milling \"ROUGH\" tool=%mill10 axial_depth=5.0000mm radial_depth=4.0000mm "
          "allowance_side=0.5000mm\n"
          "        technology feed=1200.0mm/min spindle=-3000.0rev/min\n"
          "        strategy type=contour_parallel\n"
          "    workingstep @ws \"WS\" feature=%pocket secplane=20.0000mm\n"
          "      side_finish_milling \"OP\" tool=%mill10 axial_depth=10.0000mm radial_depth=0.5000mm\n"
-         "        technology feed=1200.0mm/min spindle=-3000.0rev/min\n";
-  ir::test::Parsed p = ir::test::parse(text);
-  for (const std::string &e : p.errors)
-    FAIL(e);
-  REQUIRE(p.module);
+         "        technology feed=1200.0mm/min spindle=-3000.0rev/min\n"));
   std::vector<std::string> errors;
   REQUIRE(test::runPipeline(*p.module, "expand-strategies", &errors));
   const ir::Module before = *p.module;
