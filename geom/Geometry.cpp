@@ -435,6 +435,14 @@ double Chain::length() const {
 
 // --- Distances and intersections ---------------------------------------------
 
+Vec2 nearestEquidistant(const Vec2 &c, const Vec2 &a, const Vec2 &b) {
+  const Vec2 d = b - a;
+  if (d.norm() <= kEps)
+    return c;
+  const Vec2 mid = (a + b) / 2, u = perp(d).normalized();
+  return mid + (c - mid).dot(u) * u;
+}
+
 Vec2 closestPoint(const Seg &s, const Vec2 &p) {
   if (!s.isArc()) {
     const Vec2 d = s.b - s.a;

@@ -109,6 +109,10 @@ struct Chain {
 
 // --- Distances and intersections ---------------------------------------------
 
+/// The point nearest c that is equally far from a and b (c itself when a
+/// and b coincide): the centre of an arc from a to b kept close to c.
+Vec2 nearestEquidistant(const Vec2 &c, const Vec2 &a, const Vec2 &b);
+
 Vec2 closestPoint(const Seg &s, const Vec2 &p);
 double distance(const Seg &s, const Vec2 &p);
 /// Smallest distance between two segments (0 when they meet).

@@ -292,7 +292,9 @@ std::vector<KindSpec> makeTable() {
   const char *roles = "position approach plunge cut link retract";
   add({"rapid", "move", Sigil::None, false, {{"to", T::Point, true}, {"role", T::Word, false, roles}}, {}});
   // `nominal`: where a move compensated for tool deflection is predicted to
-  // take the bent tool (docs/deflection-compensation.md).
+  // take the bent tool (docs/deflection-compensation.md); `nominal_center`:
+  // the centre of the arc it is predicted to follow, where the programmed
+  // arc's is moved (the offset changes along it).
   add({"linear", "move", Sigil::None, false,
        {{"to", T::Point, true}, {"feed", T::Feed, true}, {"role", T::Word, false, roles}, {"nominal", T::Point}},
        {}});
@@ -303,7 +305,8 @@ std::vector<KindSpec> makeTable() {
         {"turns", T::Count},
         {"feed", T::Feed, true},
         {"role", T::Word, false, roles},
-        {"nominal", T::Point}},
+        {"nominal", T::Point},
+        {"nominal_center", T::Point}},
        {}});
 
   // Motion IR: what plan-motion makes of the moves (docs/motion.md). `motion`

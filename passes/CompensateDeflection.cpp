@@ -11,10 +11,20 @@
 // takes ae + c and bends the tool further, so the offset is the fixed point
 // c = delta(ae + c) at mid-height of the cut, iterated from the nominal
 // path. Where c would exceed max-offset, the feed is lowered until it does
-// not. Moves are split where the offset changes by more than 2 um, offset
-// pieces keep the nominal end they are predicted to reach as `nominal`, and
-// short connecting lines join offset and nominal positions. Offsets are
-// whole micrometres; each sample's residual error stays within 1.5 um.
+// not.
+//
+// The offset the program gets is one continuous, piecewise-linear function
+// of the distance along each run of moves that join tangentially (a wall
+// with its rounded corners), within 1 um of every wall sample's fixed point
+// and with as few changes of slope as that allows. The path therefore never
+// steps where the offset changes: it turns by the change of slope, a few
+// micro-radians, which the machine runs at full feed. Lines along which the
+// offset changes stay lines; arcs become arcs about a centre moved a little
+// so that both their ends sit at their offsets. Each move is cut where the
+// slope or the feed changes, and every offset move records the nominal end
+// it is predicted to reach as `nominal`. Where two runs meet at a corner of
+// two lines, both run to where their offset lines cross; elsewhere a short
+// connecting line joins them.
 #include "passes/CuttingModel.h"
 #include "passes/CuttingPass.h"
 
@@ -23,7 +33,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <map>
+#include <optional>
 
 namespace stepnc::passes {
 
@@ -32,19 +42,19 @@ namespace {
 using geom::Vec2;
 
 constexpr double kDefaultMaxOffset = 0.05; ///< mm
-/// mm: the offsets of the samples in one piece differ by at most this, so
-/// that the piece's offset is within 1 um of each one's.
-constexpr double kPieceSpread = 0.002;
-/// mm: pieces offset less than this stay on the nominal path, where the
-/// tool then bends less than this (bend(0) < the fixed point).
-constexpr double kMinOffset = 0.0015;
-/// mm: offsets are whole micrometres, so that pieces either share one or
-/// are joined by a connector a controller's output resolution can hold.
-constexpr double kOffsetGrid = 0.001;
+/// mm: the programmed offset stays this close to every wall sample's fixed
+/// point (the residual error is then within about as much).
+constexpr double kFitTolerance = 0.001;
 constexpr double kConverged = 1e-7; ///< mm: fixed-point tolerance
 constexpr double kDiverged = 1.0;   ///< mm: an offset this large means the iteration runs away
 constexpr int kMaxIterations = 200;
 constexpr double kSamePoint = 1e-6; ///< mm: closer positions need no connector
+/// Two moves meet tangentially (one run) when their directions differ by
+/// less than this (rad); otherwise they make a corner.
+constexpr double kTangentTurn = 0.01;
+/// At a corner the two offset lines run to where they cross when that is
+/// within this many times the step between them (and half of either line).
+constexpr double kCornerReach = 10.0;
 
 struct Solution {
   double offset = 0; ///< mm into the wall
@@ -75,36 +85,149 @@ struct SamplePlan {
   double fz = 0;                   ///< mm per tooth: the move's, or lowered to keep the offset within the limit
   Solution sol;                    ///< at fz
   bool beyond = false;             ///< even the lowest feed cannot keep the offset within the limit
-
-  double offset() const { return wall ? sol.offset : 0.0; }
-  /// The side of the wall the sample is offset towards; 0 below kMinOffset.
-  int side() const { return wall && sol.offset >= kMinOffset ? wall->side : 0; }
 };
 
-struct Piece {
-  double from = 0, to = 0; ///< mm along the move
-  double fz = 0;
-  double offset = 0; ///< mm into the wall on `side`
-  int side = 0;
+/// A stretch [from, to] of a move (mm along it) cut at one feed.
+struct FeedPiece {
+  double from = 0, to = 0;
+  double fz = 0; ///< mm per tooth
 };
 
-/// The point `offset` mm into the wall on `side` from the nominal point p of
-/// a horizontal move: a line is shifted along its normal, an arc's radius
-/// changes about the same centre.
-ir::Vec3 offsetPoint(const Move &m, const ir::Vec3 &p, int side, double offset) {
-  if (offset == 0 || side == 0)
+/// Where the offset must be at a place along a run: within [lo, hi] (mm to
+/// the left of the path; negative to the right), `want` if nothing else
+/// decides.
+struct Band {
+  double s = 0; ///< mm along the run
+  double lo = 0, hi = 0, want = 0;
+};
+
+/// A continuous, piecewise-linear offset along a run: mm to the left of
+/// the path (negative to the right), constant before the first vertex and
+/// after the last; zero everywhere without vertices.
+struct Profile {
+  std::vector<std::pair<double, double>> vertices; ///< (s, offset), s increasing
+
+  double at(double s) const {
+    if (vertices.empty())
+      return 0;
+    if (s <= vertices.front().first)
+      return vertices.front().second;
+    if (s >= vertices.back().first)
+      return vertices.back().second;
+    const auto hi = std::upper_bound(vertices.begin(), vertices.end(), s,
+                                     [](double x, const std::pair<double, double> &v) { return x < v.first; });
+    const auto lo = hi - 1;
+    return lo->second + (hi->second - lo->second) * (s - lo->first) / (hi->first - lo->first);
+  }
+};
+
+/// The profile through `bands` (ordered by s): from the first band's wanted
+/// value, each stretch runs as far as one straight line stays within every
+/// band it passes, with the slope of the stretch before when that fits
+/// (else the nearest that does), so that the slope changes as seldom and as
+/// little as the bands allow.
+Profile fitProfile(std::vector<Band> bands) {
+  // Bands at one place: their common part (the middle when they have none).
+  std::vector<Band> merged;
+  for (const Band &b : bands) {
+    if (!merged.empty() && b.s - merged.back().s <= kSamePoint) {
+      Band &m = merged.back();
+      m.lo = std::max(m.lo, b.lo);
+      m.hi = std::min(m.hi, b.hi);
+      if (m.lo > m.hi)
+        m.lo = m.hi = (m.lo + m.hi) / 2;
+      m.want = std::clamp(m.want, m.lo, m.hi);
+    } else {
+      merged.push_back(b);
+    }
+  }
+  Profile p;
+  if (merged.empty())
     return p;
-  Vec2 n;
+  double s0 = merged[0].s, v0 = std::clamp(merged[0].want, merged[0].lo, merged[0].hi), slope = 0;
+  p.vertices.emplace_back(s0, v0);
+  for (size_t i = 1; i < merged.size();) {
+    double lo = -std::numeric_limits<double>::infinity(), hi = std::numeric_limits<double>::infinity();
+    size_t j = i;
+    for (; j < merged.size(); ++j) {
+      const double ds = merged[j].s - s0;
+      const double nlo = std::max(lo, (merged[j].lo - v0) / ds), nhi = std::min(hi, (merged[j].hi - v0) / ds);
+      if (nlo > nhi)
+        break;
+      lo = nlo;
+      hi = nhi;
+    }
+    slope = std::clamp(slope, lo, hi);
+    const double s1 = merged[j - 1].s;
+    v0 += slope * (s1 - s0);
+    s0 = s1;
+    p.vertices.emplace_back(s0, v0);
+    i = j;
+  }
+  return p;
+}
+
+/// The point `offset` mm to the left (right when negative) of the nominal
+/// point p of a horizontal move: a line is shifted along its normal, an
+/// arc's radius changes about its centre.
+ir::Vec3 offsetPoint(const Move &m, const ir::Vec3 &p, double offset) {
+  if (offset == 0)
+    return p;
+  Vec2 left;
   if (m.kind == MoveKind::Arc) {
     const Vec2 u = (p.head<2>() - m.center.head<2>()).normalized();
-    n = m.ccw ? -u : u; // the left of a counter-clockwise arc is its centre
+    left = m.ccw ? -u : u; // the left of a counter-clockwise arc is its centre
   } else {
     const Vec2 d = (m.to - *m.from).head<2>().normalized();
-    n = Vec2(-d.y(), d.x());
+    left = Vec2(-d.y(), d.x());
   }
-  const Vec2 q = p.head<2>() + side * offset * n;
+  const Vec2 q = p.head<2>() + offset * left;
   return {q.x(), q.y(), p.z()};
 }
+
+/// The unit direction of a horizontal move at its point p.
+Vec2 tangentAt(const Move &m, const ir::Vec3 &p) {
+  if (m.kind == MoveKind::Arc) {
+    const Vec2 u = (p.head<2>() - m.center.head<2>()).normalized();
+    return m.ccw ? Vec2(-u.y(), u.x()) : Vec2(u.y(), -u.x());
+  }
+  return (m.to - *m.from).head<2>().normalized();
+}
+
+/// A horizontal milling move the model measured.
+bool flat(const CutMove &cm) { return cm.measured && cm.move.from && !cm.move.changesHeight(); }
+
+/// Whether b continues a in one run: both flat at one height, b starting
+/// where a ends in the direction a ends in.
+bool continues(const CutMove &a, const CutMove &b) {
+  if (!flat(a) || !flat(b) || (*b.move.from - a.move.to).norm() > kSamePoint)
+    return false;
+  const Vec2 u = tangentAt(a.move, a.move.to), v = tangentAt(b.move, *b.move.from);
+  return std::abs(std::atan2(geom::cross(u, v), u.dot(v))) <= kTangentTurn;
+}
+
+/// What the rewrite changed, for the statistics.
+struct RewriteCounts {
+  long long compensated = 0, connectors = 0, lowered = 0;
+};
+
+/// A move of the rewritten step (or another child, passed through), with
+/// where it is programmed to start and end and the nominal ends it is
+/// predicted to reach.
+struct Placed {
+  explicit Placed(ir::Node n, const Move *m = nullptr) : node(std::move(n)), move(m) {}
+
+  ir::Node node;
+  const Move *move = nullptr; ///< the move it is or is a piece of; null for other children
+  bool changed = false;       ///< its end is to be written
+  ir::Vec3 from = ir::Vec3::Zero(), to = ir::Vec3::Zero();
+  ir::Vec3 nominalFrom = ir::Vec3::Zero(), nominalTo = ir::Vec3::Zero();
+  double feed = 0;
+  std::optional<ir::Node> lead; ///< a connector run before it
+
+  /// A horizontal feed line whose start is known.
+  bool flatLine() const { return move && move->kind == MoveKind::Linear && move->from && !move->changesHeight(); }
+};
 
 /// Per workingstep: what the report shows.
 struct StepFigures {
@@ -113,6 +236,16 @@ struct StepFigures {
   double offsetMax = 0;                   ///< mm
   double wallLength = 0, loweredLength = 0;
   int beyond = 0; ///< samples whose offset stays above the limit at any feed
+};
+
+/// A measured move of a finishing step as planned: its samples, the feeds
+/// of its stretches, and where it starts along its run.
+struct MoveFit {
+  const CutMove *cm = nullptr;
+  std::vector<SamplePlan> samples;
+  std::vector<FeedPiece> feeds;
+  size_t run = 0;   ///< index of its run's profile
+  double start = 0; ///< mm along the run
 };
 
 class CompensateDeflectionPass final : public CuttingPass {
@@ -128,35 +261,70 @@ public:
       return {false, false};
     const CutAnalysis analysis = analyseCuts(module, {&*data, nullptr});
 
-    long long compensated = 0, connectors = 0, lowered = 0;
+    RewriteCounts counts;
     std::vector<std::pair<const CutStep *, StepFigures>> figures;
     for (const CutStep &step : analysis.steps) {
       if (!finishesWalls(step) || !step.tool || !step.tool->mill || !step.material)
         continue;
       StepFigures f;
-      std::map<const ir::Node *, std::vector<Piece>> pieces;
-      for (const CutMove &cm : step.moves) {
-        if (!cm.measured || cm.samples.empty())
+      // The moves' samples and feeds, their runs and each run's profile.
+      std::vector<MoveFit> fits(step.moves.size());
+      std::vector<std::vector<Band>> bands;
+      for (size_t k = 0; k < step.moves.size(); ++k) {
+        const CutMove &cm = step.moves[k];
+        MoveFit &fit = fits[k];
+        fit.cm = &cm;
+        if (!flat(cm) || cm.samples.empty())
           continue;
-        std::vector<SamplePlan> plans = planSamples(analysis, step, cm, f);
-        std::vector<Piece> ps = group(step, cm, plans, f);
-        const bool changes =
-            std::any_of(ps.begin(), ps.end(), [&](const Piece &p) { return p.offset != 0 || p.fz < cm.fz; });
-        if (changes)
-          pieces[cm.move.node] = std::move(ps);
+        fit.samples = planSamples(analysis, step, cm, f);
+        fit.feeds = feedPieces(step, cm, fit.samples);
+        if (k > 0 && fits[k - 1].cm && !fits[k - 1].samples.empty() && cm.move.turns == 0 &&
+            step.moves[k - 1].move.turns == 0 && continues(step.moves[k - 1], cm)) {
+          fit.run = fits[k - 1].run;
+          fit.start = fits[k - 1].start + step.moves[k - 1].move.length();
+        } else {
+          fit.run = bands.size();
+          bands.emplace_back();
+        }
+        for (size_t q = 0; q < cm.samples.size(); ++q)
+          if (const SamplePlan &sp = fit.samples[q]; sp.wall)
+            bands[fit.run].push_back(band(fit.start + cm.samples[q].s, sp));
       }
-      if (!pieces.empty())
-        rewrite(step, pieces, compensated, connectors, lowered);
+      std::vector<Profile> profiles;
+      for (std::vector<Band> &b : bands)
+        profiles.push_back(fitProfile(std::move(b)));
+      // The offsets the samples get, and whether any move changes.
+      bool changes = false;
+      for (const MoveFit &fit : fits) {
+        if (fit.samples.empty())
+          continue;
+        const Profile &profile = profiles[fit.run];
+        for (size_t q = 0; q < fit.samples.size(); ++q) {
+          const double offset = profile.at(fit.start + fit.cm->samples[q].s);
+          f.offsetMax = std::max(f.offsetMax, std::abs(offset));
+          changes = changes || offset != 0;
+          if (const SamplePlan &sp = fit.samples[q]; sp.wall) {
+            const double into = sp.wall->side * offset;
+            const WallBend b = wallBend(step, *sp.wall, into, sp.fz);
+            f.errorAfter = std::max(f.errorAfter, std::abs(b.mid - into));
+            f.taperAfter = std::max(f.taperAfter, b.taper());
+          }
+        }
+        for (const FeedPiece &piece : fit.feeds)
+          changes = changes || piece.fz < fit.cm->fz;
+      }
+      if (changes)
+        rewrite(step, fits, profiles, counts);
       if (f.wallLength > 0) {
         writeComment(*const_cast<ir::Node *>(step.movesNode), f);
         figures.emplace_back(&step, f);
       }
     }
     writeReport(analysis, figures);
-    stats["moves compensated"] = compensated;
-    stats["connectors added"] = connectors;
-    stats["feeds lowered for deflection"] = lowered;
-    return {true, compensated + lowered > 0};
+    stats["moves compensated"] = counts.compensated;
+    stats["connectors added"] = counts.connectors;
+    stats["feeds lowered for deflection"] = counts.lowered;
+    return {true, counts.compensated + counts.lowered > 0};
   }
 
 private:
@@ -201,125 +369,187 @@ private:
     return plans;
   }
 
-  /// Pieces of a move: consecutive samples on the same side whose offsets
-  /// are within kPieceSpread and feeds within kFeedRatio (a move with whole
-  /// turns is one piece); each piece takes the lowest feed of its samples and
-  /// the middle of their offsets at it.
-  std::vector<Piece> group(const CutStep &step, const CutMove &cm, std::vector<SamplePlan> &plans,
-                           StepFigures &f) const {
-    std::vector<Piece> out;
-    const bool splittable = cm.move.turns == 0;
-    size_t i = 0;
-    while (i < plans.size()) {
-      double lo = plans[i].offset(), hi = lo, fzLo = plans[i].fz, fzHi = fzLo;
-      int side = plans[i].side();
+  /// Stretches of a move at one feed: consecutive samples whose feeds are
+  /// within kFeedRatio (a move with whole turns is one), at the lowest of
+  /// them; each wall sample's offset is then solved at its stretch's feed.
+  static std::vector<FeedPiece> feedPieces(const CutStep &step, const CutMove &cm, std::vector<SamplePlan> &plans) {
+    std::vector<FeedPiece> out;
+    for (size_t i = 0; i < plans.size();) {
+      double lo = plans[i].fz, hi = lo;
       size_t end = i + 1;
       for (; end < plans.size(); ++end) {
-        const SamplePlan &p = plans[end];
-        const bool apart = (p.side() != 0 && side != 0 && p.side() != side) ||
-                           std::max(hi, p.offset()) - std::min(lo, p.offset()) > kPieceSpread ||
-                           std::min(fzLo, p.fz) < kFeedRatio * std::max(fzHi, p.fz);
-        if (splittable && apart)
+        const double fz = plans[end].fz;
+        if (cm.move.turns == 0 && std::min(lo, fz) < kFeedRatio * std::max(hi, fz))
           break;
-        lo = std::min(lo, p.offset());
-        hi = std::max(hi, p.offset());
-        fzLo = std::min(fzLo, p.fz);
-        fzHi = std::max(fzHi, p.fz);
-        side = side ? side : p.side();
+        lo = std::min(lo, fz);
+        hi = std::max(hi, fz);
       }
-      Piece piece;
-      piece.from = out.empty() ? 0 : out.back().to;
-      piece.to = cm.pieceEnd(end);
-      piece.fz = fzLo;
-      piece.side = side;
-      // The samples at the piece's feed; its offset in the middle of theirs.
-      if (fzLo < fzHi) {
-        lo = kDiverged;
-        hi = 0;
-        for (size_t q = i; q < end; ++q)
-          if (plans[q].wall && !plans[q].beyond) {
-            plans[q].sol = solve(step, *plans[q].wall, fzLo);
-            lo = std::min(lo, plans[q].sol.offset);
-            hi = std::max(hi, plans[q].sol.offset);
-          }
-        if (hi < lo)
-          lo = hi = 0;
+      for (size_t q = i; q < end; ++q) {
+        SamplePlan &p = plans[q];
+        if (p.wall && p.fz > lo && !p.beyond)
+          p.sol = solve(step, *p.wall, lo);
+        p.fz = lo;
       }
-      const double middle = (lo + hi) / 2;
-      piece.offset =
-          side != 0 && middle >= kMinOffset ? std::min(std::round(middle / kOffsetGrid) * kOffsetGrid, maxOffset_) : 0;
-      for (size_t q = i; q < end; ++q)
-        if (plans[q].wall) {
-          const WallBend b = wallBend(step, *plans[q].wall, piece.offset, piece.fz);
-          f.errorAfter = std::max(f.errorAfter, std::abs(b.mid - piece.offset));
-          f.taperAfter = std::max(f.taperAfter, b.taper());
-        }
-      f.offsetMax = std::max(f.offsetMax, piece.offset);
-      if (!out.empty() && out.back().offset == piece.offset && out.back().fz == piece.fz &&
-          out.back().side == piece.side)
-        out.back().to = piece.to;
+      const double from = out.empty() ? 0 : out.back().to, to = cm.pieceEnd(end);
+      if (!out.empty() && out.back().fz == lo)
+        out.back().to = to;
       else
-        out.push_back(piece);
+        out.push_back({from, to, lo});
       i = end;
     }
     return out;
   }
 
-  /// Rewrites the step's moves: compensated moves as their pieces, with
-  /// connecting lines where the programmed position leaves the nominal one
-  /// or comes back to it.
-  void rewrite(const CutStep &step, const std::map<const ir::Node *, std::vector<Piece>> &pieces,
-               long long &compensated, long long &connectors, long long &lowered) const {
+  /// Where a wall sample `s` mm along its run wants the path: within
+  /// kFitTolerance of its fixed point, into its wall (never away from it)
+  /// by at most max-offset; on the nominal path when that is within.
+  Band band(double s, const SamplePlan &p) const {
+    const double c = p.wall->side * p.sol.offset;
+    Band b{s, c - kFitTolerance, c + kFitTolerance, c};
+    if (p.wall->side > 0)
+      b = {s, std::max(b.lo, 0.0), std::max(b.lo, std::min(b.hi, maxOffset_)), c};
+    else
+      b = {s, std::min(b.hi, std::max(b.lo, -maxOffset_)), std::min(b.hi, 0.0), c};
+    if (b.lo <= 0 && b.hi >= 0)
+      b.want = 0;
+    return b;
+  }
+
+  /// Rewrites the step's moves: each changed move as its stretches between
+  /// the changes of slope of its run's profile and of feed, offset by the
+  /// profile; other moves as they were, joined to what runs before them.
+  void rewrite(const CutStep &step, const std::vector<MoveFit> &fits, const std::vector<Profile> &profiles,
+               RewriteCounts &counts) const {
     auto *movesNode = const_cast<ir::Node *>(step.movesNode);
-    std::vector<ir::Node> children;
-    children.reserve(movesNode->children.size());
-    std::optional<ir::Vec3> programmed; // where the new program leaves the tool
+    std::vector<Placed> placed;
+    placed.reserve(movesNode->children.size());
     size_t cursor = 0;
-    auto connect = [&](const ir::Vec3 &to, const ir::Vec3 &nominal, double feed, const ir::Node &next) {
-      if (!programmed || (*programmed - to).norm() <= kSamePoint)
-        return;
-      ir::Node line("linear");
-      line.set("to", ir::Value::point(to)).set("feed", ir::Value::feed(feed));
-      if (auto role = next.text("role"))
-        line.set("role", ir::Value::word(*role));
-      if ((to - nominal).norm() > kSamePoint)
-        line.set("nominal", ir::Value::point(nominal));
-      children.push_back(std::move(line));
-      ++connectors;
-    };
     for (ir::Node &child : movesNode->children) {
       const CutMove *cm = step.moveOf(child, cursor);
       if (!cm) {
-        children.push_back(std::move(child));
+        placed.emplace_back(std::move(child));
         continue;
       }
       const Move &m = cm->move;
-      const auto it = pieces.find(m.node);
-      if (it == pieces.end()) {
-        // Unchanged: a feed move starts where it did.
-        if (m.isFeed() && m.from)
-          connect(*m.from, *m.from, m.feed, child);
-        programmed = m.to;
-        children.push_back(std::move(child));
+      const MoveFit &fit = fits[size_t(cm - step.moves.data())];
+      std::vector<Placed> pieces;
+      if (!fit.samples.empty())
+        pieces = cut(child, fit, profiles[fit.run]);
+      if (pieces.empty()) {
+        Placed &p = placed.emplace_back(std::move(child), &m);
+        p.from = p.nominalFrom = m.from.value_or(m.to);
+        p.to = p.nominalTo = m.to;
+        p.feed = m.feed;
         continue;
       }
-      ++compensated;
-      for (const Piece &p : it->second) {
-        const double feed = p.fz < cm->fz ? cm->feedFor(p.fz) : m.feed;
-        lowered += feed < m.feed;
-        const ir::Vec3 nominalFrom = p.from == 0 ? *m.from : m.pointAt(p.from);
-        const ir::Vec3 nominalTo = p.to >= m.length() ? m.to : m.pointAt(p.to);
-        connect(offsetPoint(m, nominalFrom, p.side, p.offset), nominalFrom, feed, child);
-        ir::Node piece = child;
-        const ir::Vec3 to = offsetPoint(m, nominalTo, p.side, p.offset);
-        piece.set("to", ir::Value::point(to)).set("feed", ir::Value::feed(feed));
-        if (p.offset != 0)
-          piece.set("nominal", ir::Value::point(nominalTo));
-        children.push_back(std::move(piece));
-        programmed = to;
+      ++counts.compensated;
+      for (Placed &p : pieces) {
+        counts.lowered += p.feed < m.feed;
+        placed.push_back(std::move(p));
       }
     }
-    movesNode->children = std::move(children);
+    // Join each feed move to where the program before it leaves the tool.
+    Placed *last = nullptr;
+    for (Placed &p : placed) {
+      if (!p.move)
+        continue;
+      if (last && p.move->isFeed() && p.move->from)
+        join(*last, p, counts);
+      last = &p;
+    }
+    movesNode->children.clear();
+    for (Placed &p : placed) {
+      if (p.lead)
+        movesNode->children.push_back(std::move(*p.lead));
+      if (p.changed) {
+        p.node.set("to", ir::Value::point(p.to));
+        if (p.move->isFeed())
+          p.node.set("feed", ir::Value::feed(p.feed));
+        if ((p.to - p.nominalTo).norm() > kSamePoint)
+          p.node.set("nominal", ir::Value::point(p.nominalTo));
+      }
+      movesNode->children.push_back(std::move(p.node));
+    }
+  }
+
+  /// The stretches of a move offset by its run's profile: cut where the
+  /// profile's slope or the feed changes (a move with whole turns keeps one
+  /// offset, the profile's at its middle); none when the move stays as it
+  /// is.
+  static std::vector<Placed> cut(const ir::Node &node, const MoveFit &fit, const Profile &profile) {
+    const Move &m = fit.cm->move;
+    const double length = m.length();
+    std::vector<double> at{0, length};
+    if (m.turns == 0) {
+      for (size_t i = 0; i + 1 < fit.feeds.size(); ++i)
+        at.push_back(fit.feeds[i].to);
+      for (const auto &[s, v] : profile.vertices)
+        if (s > fit.start && s < fit.start + length)
+          at.push_back(s - fit.start);
+    }
+    std::sort(at.begin(), at.end());
+    at.erase(std::unique(at.begin(), at.end(), [](double a, double b) { return b - a <= kSamePoint; }), at.end());
+    at.back() = length;
+    const auto offsetAt = [&](double s) { return profile.at(fit.start + (m.turns == 0 ? s : length / 2)); };
+    bool changes = false;
+    for (const double s : at)
+      changes = changes || offsetAt(s) != 0;
+    for (const FeedPiece &piece : fit.feeds)
+      changes = changes || piece.fz < fit.cm->fz;
+    if (!changes)
+      return {};
+    std::vector<Placed> out;
+    for (size_t i = 0; i + 1 < at.size(); ++i) {
+      const double a = at[i], b = at[i + 1], oa = offsetAt(a), ob = offsetAt(b);
+      Placed &p = out.emplace_back(node, &m);
+      p.changed = true;
+      p.nominalFrom = a == 0 ? *m.from : m.pointAt(a);
+      p.nominalTo = b == length ? m.to : m.pointAt(b);
+      p.from = offsetPoint(m, p.nominalFrom, oa);
+      p.to = offsetPoint(m, p.nominalTo, ob);
+      const auto piece =
+          std::find_if(fit.feeds.begin(), fit.feeds.end(), [&](const FeedPiece &f) { return (a + b) / 2 <= f.to; });
+      const double fz = piece == fit.feeds.end() ? fit.feeds.back().fz : piece->fz;
+      p.feed = fz < fit.cm->fz ? fit.cm->feedFor(fz) : m.feed;
+      if (m.kind == MoveKind::Arc && oa != ob) {
+        const Vec2 c = geom::nearestEquidistant(m.center.head<2>(), p.from.head<2>(), p.to.head<2>());
+        p.node.set("center", ir::Value::point({c.x(), c.y(), m.center.z()}))
+            .set("nominal_center", ir::Value::point(m.center));
+      }
+    }
+    return out;
+  }
+
+  /// Joins b to a where b starts off a's programmed end: at a corner of two
+  /// lines both run to where they cross; otherwise a connecting line steps
+  /// across.
+  static void join(Placed &a, Placed &b, RewriteCounts &counts) {
+    const double step = (b.from - a.to).norm();
+    if (step <= kSamePoint)
+      return;
+    if (a.flatLine() && b.flatLine() && std::abs(a.to.z() - b.from.z()) <= kSamePoint &&
+        (a.nominalTo - b.nominalFrom).norm() <= kSamePoint) {
+      const Vec2 da = (a.to - a.from).head<2>(), db = (b.to - b.from).head<2>();
+      const double den = geom::cross(da, db);
+      if (std::abs(den) > geom::kEps * da.norm() * db.norm()) {
+        const double s = geom::cross((b.from - a.from).head<2>(), db) / den;
+        const Vec2 x = a.from.head<2>() + s * da;
+        const double reach = std::min({kCornerReach * step, da.norm() / 2, db.norm() / 2});
+        if ((x - a.to.head<2>()).norm() <= reach && (x - b.from.head<2>()).norm() <= reach) {
+          a.to = b.from = {x.x(), x.y(), a.to.z()};
+          a.changed = true;
+          return;
+        }
+      }
+    }
+    ir::Node line("linear");
+    line.set("to", ir::Value::point(b.from)).set("feed", ir::Value::feed(std::min(a.feed, b.feed)));
+    if (auto role = b.node.text("role"))
+      line.set("role", ir::Value::word(*role));
+    if ((b.from - b.nominalFrom).norm() > kSamePoint)
+      line.set("nominal", ir::Value::point(b.nominalFrom));
+    b.lead = std::move(line);
+    ++counts.connectors;
   }
 
   static std::string um(double mm) { return formatFixed(mm * 1000, 1); }

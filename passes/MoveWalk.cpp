@@ -51,7 +51,8 @@ Move readMove(const ir::Node &n, PathKind path) {
   m.kind = n.kind == "rapid" ? MoveKind::Rapid : n.kind == "linear" ? MoveKind::Linear : MoveKind::Arc;
   std::optional<ir::Vec3> to = path == PathKind::Predicted ? n.vec("nominal") : std::nullopt;
   m.to = to ? *to : n.vec("to").value_or(ir::Vec3::Zero());
-  m.center = n.vec("center").value_or(ir::Vec3::Zero());
+  std::optional<ir::Vec3> center = path == PathKind::Predicted ? n.vec("nominal_center") : std::nullopt;
+  m.center = center ? *center : n.vec("center").value_or(ir::Vec3::Zero());
   m.ccw = n.text("dir") == "ccw";
   m.turns = n.count("turns").value_or(0);
   m.feed = m.isFeed() ? n.number("feed").value_or(0.0) : 0.0;

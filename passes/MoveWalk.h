@@ -45,7 +45,8 @@ struct Move {
 /// compensation.md) are programmed off the part by the deflection the cut is
 /// predicted to cause, and record where the bent tool is predicted to go as
 /// `nominal`: the backends run the programmed path, verification checks the
-/// predicted one.
+/// predicted one (and an arc whose offset changes along it records the
+/// centre of its predicted arc as `nominal_center`).
 enum class PathKind : uint8_t { Programmed, Predicted };
 
 /// The moves of `moves` in order, each knowing where it starts (`start` is

@@ -499,17 +499,10 @@ def normalise(moves, decimals):
             near = math.dist(start, mv["to"]) <= 1.5 * 10.0 ** -decimals
             if near and not (mv["kind"] == "arc" and mv["sweep"] > math.pi):
                 continue
-        prev = out[-1] if out else None
-        if (mv["kind"] == "arc" and prev and prev["kind"] == "arc" and prev["ccw"] == mv["ccw"]
-                and prev.get("feed") == mv.get("feed") and prev["start"] is not None and start is not None
-                and prev["start"][2] == prev["to"][2] == mv["to"][2]
-                and math.dist(prev["centre"], mv["centre"]) <= 2 * PATH_TOL):
+        if out and joinable(out[-1], mv):
             # Arcs about one centre in a row are one arc (a backend may
             # split an arc, e.g. a near-whole circle into halves).
-            merged = dict(prev)
-            merged["to"], merged["sweep"], merged["where"] = mv["to"], prev["sweep"] + mv["sweep"], mv["where"]
-            merged["pieces"] = arc_pieces(prev) + arc_pieces(mv)
-            out[-1] = merged
+            out[-1] = joined(out[-1], mv)
             continue
         if mv["kind"] == "rapid" and out and out[-1]["kind"] == "rapid":
             merged = dict(out[-1])
@@ -519,6 +512,24 @@ def normalise(moves, decimals):
             continue
         out.append(mv)
     return out
+
+
+def joinable(prev, mv):
+    """Whether mv continues the flat arc prev about the same centre (within
+    2 PATH_TOL: printing moves a centre) at the same feed."""
+    return (mv["kind"] == "arc" and prev["kind"] == "arc" and prev["ccw"] == mv["ccw"]
+            and prev.get("feed") == mv.get("feed") and prev["start"] is not None and mv.get("start") is not None
+            and prev["start"][2] == prev["to"][2] == mv["to"][2]
+            and math.dist(prev["centre"], mv["centre"]) <= 2 * PATH_TOL)
+
+
+def joined(prev, mv):
+    """The arcs prev and mv as one."""
+    merged = dict(prev)
+    merged["to"], merged["sweep"], merged["where"] = mv["to"], prev["sweep"] + mv["sweep"], mv["where"]
+    merged["pieces"] = arc_pieces(prev) + arc_pieces(mv)
+    merged["parts"] = prev.get("parts", [prev]) + mv.get("parts", [mv])
+    return merged
 
 
 def program_moves(motions):
@@ -582,6 +593,21 @@ def compare(prog, ir, problems, decimals):
         ends = all(a["to"][k] is None or abs(a["to"][k] - b["to"][k]) <= END_TOL for k in range(3))
         turns = kind_a != "arc" or kind_b != "arc" or abs(a["sweep"] - b["sweep"]) <= 0.5
         if kind_a != kind_b or not ends or not turns:
+            # Arcs in a row about centres close enough to be one arc on one
+            # side but not on the other (printing moves a centre): the side
+            # whose arc ends later goes back to its arcs, or the side whose
+            # arc ends first takes in its next arc.
+            if kind_a == kind_b == "arc" and not ends:
+                longer, k = (prog, i) if a["sweep"] > b["sweep"] else (ir, j)
+                shorter, q = (ir, j) if longer is prog else (prog, i)
+                if "parts" in longer[k]:
+                    longer[k:k + 1] = longer[k]["parts"]
+                    continue
+                if q + 1 < len(shorter) and joinable(shorter[q], shorter[q + 1]):
+                    merged = joined(shorter[q], shorter[q + 1])
+                    del merged["parts"]  # not to be taken apart again: each step shortens a list
+                    shorter[q:q + 2] = [merged]
+                    continue
             if tiny(a, decimals):
                 i += 1
                 continue

@@ -152,8 +152,8 @@ TEST_CASE("tool tables: entries by id or symbol, errors at line and column", "[b
   CHECK(table->find(t4) == nullptr);
 
   for (const char *bad : {"\"T2 ENDMILL 12\n", "T2 12\n", "%t2 0\n", "%t2 5 -1\n", "%t2 5 1 2\n", "%t2\n"}) {
-    DiagnosticCollector collector;
-    DiagnosticEngine d(collector);
+    DiagnosticCollector badCollector;
+    DiagnosticEngine d(badCollector);
     auto f = SourceFile::fromString("bad.txt", bad);
     CHECK_FALSE(ToolTable::parse(*f, d));
     CHECK(d.errorCount() == 1);

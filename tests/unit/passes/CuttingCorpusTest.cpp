@@ -10,6 +10,7 @@
 #include "tests/unit/TestSupport.h"
 #include "tests/unit/passes/DeflectionCheck.h"
 #include "tests/unit/passes/PassTestSupport.h"
+#include "tests/unit/passes/SlowPlaces.h"
 #include "tools/stepnc/Compile.h"
 #include "tools/stepnc/SchemaSelection.h"
 
@@ -120,11 +121,7 @@ TEST_CASE("adapt-feed and compensate-deflection: invariants on the corpus",
     return;
   }
   const cutting::CuttingData data = cutting::shippedCuttingData();
-  std::unique_ptr<SourceFile> machineFile;
-  DiagnosticCollector collector;
-  DiagnosticEngine machineDiags(collector);
-  const std::optional<runtime::Machine> machine = runtime::loadMachine("hsc-3axis", machineFile, machineDiags);
-  REQUIRE(machine);
+  const std::optional<runtime::Machine> machine = test::shippedMachine("hsc-3axis");
   for (const char *name : kFiles) {
     const std::string path = corpus + "/" + name;
     if (!std::filesystem::exists(path)) {
@@ -203,8 +200,16 @@ TEST_CASE("adapt-feed and compensate-deflection: invariants on the corpus",
     const test::DeflectionCheck check = test::checkDeflection(adapted, *l.module, data);
     for (const std::string &f : check.failures)
       FAIL_CHECK(f);
-    INFO(check.walls << " wall samples, " << check.offsetWalls << " offset, before " << check.worstBefore * 1000
-                     << " um");
+    INFO(check.walls << " wall samples, " << check.offsetWalls << " offset, error before " << check.worstBefore * 1000
+                     << " um, after " << check.worstResidual * 1000 << " um");
     CHECK(check.worstResidual <= 0.002);
+
+    // Where the offset changes the path does not step: the machine slows
+    // below half the feed nowhere the nominal program does not.
+    const std::vector<ir::Vec3> added =
+        test::placesAdded(test::slowPlaces(adapted, *machine, 0.5), test::slowPlaces(*l.module, *machine, 0.5), 0.5);
+    INFO(added.size() << " samples below half the feed where the nominal program runs faster, the first at "
+                      << (added.empty() ? ir::Vec3::Zero() : added.front()).transpose());
+    CHECK(added.empty());
   }
 }

@@ -2,7 +2,8 @@
 // cutting model: for every wall a finishing move cuts in the program as it
 // was (one-sided engagement at a sample of the cutting model), find the
 // move of the compensated program whose predicted path (`nominal`) passes
-// there, read its offset from its geometry and its feed, and evaluate the
+// there, read its offset where the programmed move runs beside the sample
+// (along the wall's normal) and its feed, and evaluate the
 // bend of the tool at mid-height of the cut on the model (passes::wallBend). The residual |bend - offset| is
 // the position error the compensated program is predicted to leave.
 #pragma once
@@ -66,20 +67,35 @@ inline DeflectionCheck checkDeflection(const ir::Module &before, const ir::Modul
           out.failures.push_back(where.str() + ": no move of the predicted path passes the wall");
           continue;
         }
+        // Where the programmed move runs beside the sample, along the
+        // wall's normal: a line where it crosses the normal (its offset
+        // may change along it), an arc at its radius about its centre.
         const Move &p = programmed[found];
-        // How far the programmed move stands from the predicted one at the
-        // sample: a line's shift, an arc's change of radius along its radius.
-        geom::Vec2 shift = (p.to - predicted[found].to).head<2>();
+        const geom::Vec2 n = s.intoWall();
+        double offset = 0;
         if (p.kind == MoveKind::Arc) {
-          const geom::Vec2 c = p.center.head<2>();
-          shift = ((p.to.head<2>() - c).norm() - (predicted[found].to.head<2>() - c).norm()) * (s.at - c).normalized();
+          // s.at + offset n on the circle: the root nearest the sample.
+          const geom::Vec2 w = s.at - p.center.head<2>();
+          const double r = (p.to - p.center).head<2>().norm(), half = w.dot(n);
+          const double disc = half * half - (w.squaredNorm() - r * r);
+          if (disc < 0) {
+            out.failures.push_back(where.str() + ": the programmed arc does not pass beside the wall");
+            continue;
+          }
+          offset = half >= 0 ? -half + std::sqrt(disc) : -half - std::sqrt(disc);
+        } else {
+          const geom::Vec2 a = p.from->head<2>(), d = (p.to - *p.from).head<2>();
+          const double den = geom::cross(n, d);
+          if (std::abs(den) < 1e-12) {
+            out.failures.push_back(where.str() + ": the programmed move runs along the wall's normal");
+            continue;
+          }
+          offset = geom::cross(a - s.at, d) / den; // s.at + offset n lies on the line
         }
-        const double offset = shift.norm();
-        if (offset > 0) {
+        if (offset < -1e-9)
+          out.failures.push_back(where.str() + ": offset away from the wall");
+        if (offset > 1e-9)
           ++out.offsetWalls;
-          if (shift.dot(s.intoWall()) < 0.99 * offset)
-            out.failures.push_back(where.str() + ": offset away from the wall");
-        }
         if (p.feed > cm.move.feed)
           out.failures.push_back(where.str() + ": feed raised");
         const double bend = wallBend(step, s, offset, p.feed / perFz).mid;
