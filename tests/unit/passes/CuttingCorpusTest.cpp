@@ -1,9 +1,11 @@
 // The invariants of adapt-feed and compensate-deflection on every corpus file
-// that reaches the toolpath IR: no adapted feed above the programmed one nor
-// above the machine's speed cap on its move, no chip above the material's
-// target, and after compensation every finishing wall within 2 um of its
-// nominal position on the model (DeflectionCheck.h), with the verifier
-// passing.
+// that reaches the toolpath IR, and on the bundled example: no adapted feed
+// above the programmed one nor above the machine's speed cap on its move, no
+// chip above the material's target, the chip within [0.9, 1.0] of it where it
+// sets the feed, and after compensation every finishing wall within 2 um of
+// its nominal position on the model (DeflectionCheck.h), the verifier
+// passing, and no place where the machine runs below half its feed that the
+// nominal program does not have.
 #include "passes/CuttingModel.h"
 #include "passes/MotionIR.h"
 
@@ -111,6 +113,92 @@ ChipFit chipFit(const ir::Module &programmed, const ir::Module &adapted, const c
   return fit;
 }
 
+/// The invariants on the program of the STEP-NC file at `path`.
+void checkInvariants(const std::string &path, const cutting::CuttingData &data, const runtime::Machine &machine) {
+  Loaded l = load(path);
+  std::vector<std::string> errors;
+  REQUIRE(test::runPipeline(*l.module, "resolve-feeds,expand-strategies", &errors));
+  const ir::Module programmed = *l.module;
+  REQUIRE(test::runPipeline(*l.module, "adapt-feed<machine=hsc-3axis>", &errors));
+  const ir::Module adapted = *l.module;
+
+  // Feeds: every piece of a move at or below its programmed feed, and at
+  // most 1 mm/min (feeds are whole mm/min) above the highest speed the
+  // machine reaches on it.
+  const ProgramPath before = programPath(programmed), after = programPath(adapted);
+  const runtime::Trajectory plan = runtime::plan(after.path, machine);
+  std::vector<double> cap(after.path.moves.size(), 0);
+  for (size_t k = 0; k < plan.segments.size(); ++k)
+    cap[plan.info[k].move] = std::max(cap[plan.info[k].move], plan.profiles[k].peak() * 60);
+  size_t j = 0, raised = 0, overCap = 0;
+  for (size_t i = 0; i < before.nodes.size(); ++i) {
+    const double feed = before.nodes[i]->number("feed").value_or(0);
+    const ir::Vec3 end = *before.nodes[i]->vec("to");
+    for (; j < after.nodes.size(); ++j) {
+      const double f = after.nodes[j]->number("feed").value_or(0);
+      raised += f > feed;
+      overCap += after.nodes[j]->kind != "rapid" && f > cap[j] + 1;
+      if ((*after.nodes[j]->vec("to") - end).norm() < 1e-9 && after.nodes[j]->kind == before.nodes[i]->kind)
+        break;
+    }
+    ++j;
+  }
+  CHECK(j == after.nodes.size());
+  CHECK(raised == 0);
+  CHECK(overCap == 0);
+
+  // Chips: at every sample of the adapted program, at most the target
+  // (2 % for where the samples of the analysis after fall between those
+  // the feeds were chosen on).
+  const CutAnalysis cuts = analyseCuts(adapted, {&data, &machine});
+  size_t samples = 0, overChip = 0;
+  for (const CutStep &step : cuts.steps)
+    for (const CutMove &cm : step.moves)
+      for (const CutSample &s : cm.samples) {
+        if (!(s.chipFactor > 0))
+          continue;
+        ++samples;
+        overChip += cm.fz * s.chipFactor > 1.02 * step.material->chipThickness;
+      }
+  INFO(samples << " samples, " << overChip << " over the chip target");
+  CHECK(overChip == 0);
+
+  // Where the chip limits the feed, the chip is within [0.9, 1.0] of the
+  // target. The corpus programs feeds below the chip target, so this is
+  // checked with increases allowed, and with no machine, so that nothing
+  // else caps them.
+  {
+    ir::Module increased = programmed;
+    REQUIRE(test::runPipeline(increased, "adapt-feed<allow-increase=true>", &errors));
+    const ChipFit fit = chipFit(programmed, increased, data);
+    INFO(fit.limited << " samples limited by the chip, " << fit.under << " below 0.9 of the target, lowest "
+                     << fit.lowest << ", " << fit.over << " above it");
+    CHECK(fit.limited > 0);
+    CHECK(fit.under == 0);
+    CHECK(fit.over == 0);
+  }
+
+  // Deflection: every finishing wall within 2 um of its nominal position,
+  // and the verifier passes on the predicted path.
+  REQUIRE(test::runPipeline(*l.module, "compensate-deflection,verify-toolpaths", &errors));
+  for (const std::string &e : errors)
+    FAIL_CHECK(e);
+  const test::DeflectionCheck check = test::checkDeflection(adapted, *l.module, data);
+  for (const std::string &f : check.failures)
+    FAIL_CHECK(f);
+  INFO(check.walls << " wall samples, " << check.offsetWalls << " offset, error before " << check.worstBefore * 1000
+                   << " um, after " << check.worstResidual * 1000 << " um");
+  CHECK(check.worstResidual <= 0.002);
+
+  // Where the offset changes the path does not step: the machine slows
+  // below half the feed nowhere the nominal program does not.
+  const std::vector<ir::Vec3> added =
+      test::placesAdded(test::slowPlaces(adapted, machine, 0.5), test::slowPlaces(*l.module, machine, 0.5), 0.5);
+  INFO(added.size() << " samples below half the feed where the nominal program runs faster, the first at "
+                    << (added.empty() ? ir::Vec3::Zero() : added.front()).transpose());
+  CHECK(added.empty());
+}
+
 } // namespace
 
 TEST_CASE("adapt-feed and compensate-deflection: invariants on the corpus",
@@ -121,7 +209,7 @@ TEST_CASE("adapt-feed and compensate-deflection: invariants on the corpus",
     return;
   }
   const cutting::CuttingData data = cutting::shippedCuttingData();
-  const std::optional<runtime::Machine> machine = test::shippedMachine("hsc-3axis");
+  const runtime::Machine machine = test::shippedMachine("hsc-3axis");
   for (const char *name : kFiles) {
     const std::string path = corpus + "/" + name;
     if (!std::filesystem::exists(path)) {
@@ -129,87 +217,12 @@ TEST_CASE("adapt-feed and compensate-deflection: invariants on the corpus",
       continue;
     }
     INFO(name);
-    Loaded l = load(path);
-    std::vector<std::string> errors;
-    REQUIRE(test::runPipeline(*l.module, "resolve-feeds,expand-strategies", &errors));
-    const ir::Module programmed = *l.module;
-    REQUIRE(test::runPipeline(*l.module, "adapt-feed<machine=hsc-3axis>", &errors));
-    const ir::Module adapted = *l.module;
-
-    // Feeds: every piece of a move at or below its programmed feed, and at
-    // most 1 mm/min (feeds are whole mm/min) above the highest speed the
-    // machine reaches on it.
-    const ProgramPath before = programPath(programmed), after = programPath(adapted);
-    const runtime::Trajectory plan = runtime::plan(after.path, *machine);
-    std::vector<double> cap(after.path.moves.size(), 0);
-    for (size_t k = 0; k < plan.segments.size(); ++k)
-      cap[plan.info[k].move] = std::max(cap[plan.info[k].move], plan.profiles[k].peak() * 60);
-    size_t j = 0, raised = 0, overCap = 0;
-    for (size_t i = 0; i < before.nodes.size(); ++i) {
-      const double feed = before.nodes[i]->number("feed").value_or(0);
-      const ir::Vec3 end = *before.nodes[i]->vec("to");
-      for (; j < after.nodes.size(); ++j) {
-        const double f = after.nodes[j]->number("feed").value_or(0);
-        raised += f > feed;
-        overCap += after.nodes[j]->kind != "rapid" && f > cap[j] + 1;
-        if ((*after.nodes[j]->vec("to") - end).norm() < 1e-9 && after.nodes[j]->kind == before.nodes[i]->kind)
-          break;
-      }
-      ++j;
-    }
-    CHECK(j == after.nodes.size());
-    CHECK(raised == 0);
-    CHECK(overCap == 0);
-
-    // Chips: at every sample of the adapted program, at most the target
-    // (2 % for where the samples of the analysis after fall between those
-    // the feeds were chosen on).
-    const CutAnalysis cuts = analyseCuts(adapted, {&data, &*machine});
-    size_t samples = 0, overChip = 0;
-    for (const CutStep &step : cuts.steps)
-      for (const CutMove &cm : step.moves)
-        for (const CutSample &s : cm.samples) {
-          if (!(s.chipFactor > 0))
-            continue;
-          ++samples;
-          overChip += cm.fz * s.chipFactor > 1.02 * step.material->chipThickness;
-        }
-    INFO(samples << " samples, " << overChip << " over the chip target");
-    CHECK(overChip == 0);
-
-    // Where the chip limits the feed, the chip is within [0.9, 1.0] of the
-    // target. The corpus programs feeds below the chip target, so this is
-    // checked with increases allowed, and with no machine, so that nothing
-    // else caps them.
-    {
-      ir::Module increased = programmed;
-      REQUIRE(test::runPipeline(increased, "adapt-feed<allow-increase=true>", &errors));
-      const ChipFit fit = chipFit(programmed, increased, data);
-      INFO(fit.limited << " samples limited by the chip, " << fit.under << " below 0.9 of the target, lowest "
-                       << fit.lowest << ", " << fit.over << " above it");
-      CHECK(fit.limited > 0);
-      CHECK(fit.under == 0);
-      CHECK(fit.over == 0);
-    }
-
-    // Deflection: every finishing wall within 2 um of its nominal position,
-    // and the verifier passes on the predicted path.
-    REQUIRE(test::runPipeline(*l.module, "compensate-deflection,verify-toolpaths", &errors));
-    for (const std::string &e : errors)
-      FAIL_CHECK(e);
-    const test::DeflectionCheck check = test::checkDeflection(adapted, *l.module, data);
-    for (const std::string &f : check.failures)
-      FAIL_CHECK(f);
-    INFO(check.walls << " wall samples, " << check.offsetWalls << " offset, error before " << check.worstBefore * 1000
-                     << " um, after " << check.worstResidual * 1000 << " um");
-    CHECK(check.worstResidual <= 0.002);
-
-    // Where the offset changes the path does not step: the machine slows
-    // below half the feed nowhere the nominal program does not.
-    const std::vector<ir::Vec3> added =
-        test::placesAdded(test::slowPlaces(adapted, *machine, 0.5), test::slowPlaces(*l.module, *machine, 0.5), 0.5);
-    INFO(added.size() << " samples below half the feed where the nominal program runs faster, the first at "
-                      << (added.empty() ? ir::Vec3::Zero() : added.front()).transpose());
-    CHECK(added.empty());
+    checkInvariants(path, data, machine);
   }
+}
+
+TEST_CASE("adapt-feed and compensate-deflection: invariants on the bundled example",
+          "[adapt-feed][compensate-deflection]") {
+  checkInvariants(std::string(STEPNC_SOURCE_DIR) + "/examples/example1.stp", cutting::shippedCuttingData(),
+                  test::shippedMachine("hsc-3axis"));
 }
