@@ -435,12 +435,15 @@ double Chain::length() const {
 
 // --- Distances and intersections ---------------------------------------------
 
-Vec2 nearestEquidistant(const Vec2 &c, const Vec2 &a, const Vec2 &b) {
-  const Vec2 d = b - a;
-  if (d.norm() <= kEps)
-    return c;
-  const Vec2 mid = (a + b) / 2, u = perp(d).normalized();
-  return mid + (c - mid).dot(u) * u;
+Vec2 balancedCentre(const Vec2 &from, const Vec2 &to, const Vec2 &centre) {
+  const Vec2 chord = to - from;
+  const double len = chord.norm();
+  if (len < 1e-12)
+    return centre;
+  // Project the centre onto the chord's perpendicular bisector.
+  const Vec2 mid = (from + to) / 2;
+  const Vec2 along = chord / len;
+  return centre - along * (centre - mid).dot(along);
 }
 
 Vec2 closestPoint(const Seg &s, const Vec2 &p) {

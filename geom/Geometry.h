@@ -109,9 +109,11 @@ struct Chain {
 
 // --- Distances and intersections ---------------------------------------------
 
-/// The point nearest c that is equally far from a and b (c itself when a
-/// and b coincide): the centre of an arc from a to b kept close to c.
-Vec2 nearestEquidistant(const Vec2 &c, const Vec2 &a, const Vec2 &b);
+/// The centre nearest to `centre` that lies as far from `from` as from `to`
+/// (on the chord's perpendicular bisector): an arc from `from` to `to` about
+/// it starts and ends at one radius. A whole circle (from == to) keeps its
+/// centre.
+Vec2 balancedCentre(const Vec2 &from, const Vec2 &to, const Vec2 &centre);
 
 Vec2 closestPoint(const Seg &s, const Vec2 &p);
 double distance(const Seg &s, const Vec2 &p);

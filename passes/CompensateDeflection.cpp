@@ -167,24 +167,6 @@ Profile fitProfile(std::vector<Band> bands) {
   return p;
 }
 
-/// The point `offset` mm to the left (right when negative) of the nominal
-/// point p of a horizontal move: a line is shifted along its normal, an
-/// arc's radius changes about its centre.
-ir::Vec3 offsetPoint(const Move &m, const ir::Vec3 &p, double offset) {
-  if (offset == 0)
-    return p;
-  Vec2 left;
-  if (m.kind == MoveKind::Arc) {
-    const Vec2 u = (p.head<2>() - m.center.head<2>()).normalized();
-    left = m.ccw ? -u : u; // the left of a counter-clockwise arc is its centre
-  } else {
-    const Vec2 d = (m.to - *m.from).head<2>().normalized();
-    left = Vec2(-d.y(), d.x());
-  }
-  const Vec2 q = p.head<2>() + offset * left;
-  return {q.x(), q.y(), p.z()};
-}
-
 /// The unit direction of a horizontal move at its point p.
 Vec2 tangentAt(const Move &m, const ir::Vec3 &p) {
   if (m.kind == MoveKind::Arc) {
@@ -192,6 +174,17 @@ Vec2 tangentAt(const Move &m, const ir::Vec3 &p) {
     return m.ccw ? Vec2(-u.y(), u.x()) : Vec2(u.y(), -u.x());
   }
   return (m.to - *m.from).head<2>().normalized();
+}
+
+/// The point `offset` mm to the left (right when negative) of the nominal
+/// point p of a horizontal move, square to its direction there: a line is
+/// shifted along its normal, an arc's radius changes about its centre.
+ir::Vec3 offsetPoint(const Move &m, const ir::Vec3 &p, double offset) {
+  if (offset == 0)
+    return p;
+  const Vec2 t = tangentAt(m, p);
+  const Vec2 q = p.head<2>() + offset * Vec2(-t.y(), t.x());
+  return {q.x(), q.y(), p.z()};
 }
 
 /// A horizontal milling move the model measured.
@@ -278,8 +271,8 @@ public:
           continue;
         fit.samples = planSamples(analysis, step, cm, f);
         fit.feeds = feedPieces(step, cm, fit.samples);
-        if (k > 0 && fits[k - 1].cm && !fits[k - 1].samples.empty() && cm.move.turns == 0 &&
-            step.moves[k - 1].move.turns == 0 && continues(step.moves[k - 1], cm)) {
+        if (k > 0 && !fits[k - 1].samples.empty() && cm.move.turns == 0 && step.moves[k - 1].move.turns == 0 &&
+            continues(step.moves[k - 1], cm)) {
           fit.run = fits[k - 1].run;
           fit.start = fits[k - 1].start + step.moves[k - 1].move.length();
         } else {
@@ -293,8 +286,7 @@ public:
       std::vector<Profile> profiles;
       for (std::vector<Band> &b : bands)
         profiles.push_back(fitProfile(std::move(b)));
-      // The offsets the samples get, and whether any move changes.
-      bool changes = false;
+      // The offsets the samples get.
       for (const MoveFit &fit : fits) {
         if (fit.samples.empty())
           continue;
@@ -302,7 +294,6 @@ public:
         for (size_t q = 0; q < fit.samples.size(); ++q) {
           const double offset = profile.at(fit.start + fit.cm->samples[q].s);
           f.offsetMax = std::max(f.offsetMax, std::abs(offset));
-          changes = changes || offset != 0;
           if (const SamplePlan &sp = fit.samples[q]; sp.wall) {
             const double into = sp.wall->side * offset;
             const WallBend b = wallBend(step, *sp.wall, into, sp.fz);
@@ -310,11 +301,8 @@ public:
             f.taperAfter = std::max(f.taperAfter, b.taper());
           }
         }
-        for (const FeedPiece &piece : fit.feeds)
-          changes = changes || piece.fz < fit.cm->fz;
       }
-      if (changes)
-        rewrite(step, fits, profiles, counts);
+      rewrite(step, fits, profiles, counts);
       if (f.wallLength > 0) {
         writeComment(*const_cast<ir::Node *>(step.movesNode), f);
         figures.emplace_back(&step, f);
@@ -512,7 +500,7 @@ private:
       const double fz = piece == fit.feeds.end() ? fit.feeds.back().fz : piece->fz;
       p.feed = fz < fit.cm->fz ? fit.cm->feedFor(fz) : m.feed;
       if (m.kind == MoveKind::Arc && oa != ob) {
-        const Vec2 c = geom::nearestEquidistant(m.center.head<2>(), p.from.head<2>(), p.to.head<2>());
+        const Vec2 c = geom::balancedCentre(p.from.head<2>(), p.to.head<2>(), m.center.head<2>());
         p.node.set("center", ir::Value::point({c.x(), c.y(), m.center.z()}))
             .set("nominal_center", ir::Value::point(m.center));
       }

@@ -182,7 +182,7 @@ void IsoEmitter::arc(const Move &m) {
       text += ' ';
       text += radiusWord(pieceSweep > std::numbers::pi ? -r : r);
     } else {
-      const geom::Vec2 ij = roundedCentreOffset(start, printedTo, balancedCentre(start, printedTo, m.centre),
+      const geom::Vec2 ij = roundedCentreOffset(start, printedTo, geom::balancedCentre(start, printedTo, m.centre),
                                                 d_.coordDecimals);
       text += word(" I", num(ij.x())) + word(" J", num(ij.y()));
     }

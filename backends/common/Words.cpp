@@ -69,17 +69,6 @@ bool ModalState::change(const std::string &word, const std::string &value) {
   return true;
 }
 
-geom::Vec2 balancedCentre(const geom::Vec2 &from, const geom::Vec2 &to, const geom::Vec2 &centre) {
-  const geom::Vec2 chord = to - from;
-  const double len = chord.norm();
-  if (len < 1e-12)
-    return centre;
-  // Project the centre onto the chord's perpendicular bisector.
-  const geom::Vec2 mid = (from + to) / 2;
-  const geom::Vec2 along = chord / len;
-  return centre - along * (centre - mid).dot(along);
-}
-
 geom::Vec2 roundedCentreOffset(const geom::Vec2 &from, const geom::Vec2 &to, const geom::Vec2 &centre, int decimals) {
   const double unit = std::pow(10.0, -decimals);
   const geom::Vec2 nearest(roundTo(centre.x() - from.x(), decimals), roundTo(centre.y() - from.y(), decimals));

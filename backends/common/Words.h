@@ -66,11 +66,6 @@ private:
   std::map<std::string, std::string> last_;
 };
 
-/// The centre nearest to `centre` that lies as far from `from` as from `to`
-/// (both as printed): start and end radius then agree to the rounding of the
-/// centre itself. A whole circle (from == to) keeps its centre.
-geom::Vec2 balancedCentre(const geom::Vec2 &from, const geom::Vec2 &to, const geom::Vec2 &centre);
-
 /// The centre's offset from `from` (I J), rounded to `decimals`, choosing
 /// among the neighbouring rounded values the one whose start and end radius
 /// (to the printed `from` and `to`) differ least: rounding I and J alone

@@ -449,7 +449,7 @@ private:
     const geom::Vec2 to(rounded(plannedTo.x()), rounded(plannedTo.y()));
     const double fromZ = at_[2] ? *at_[2] : m.to.z();
     const bool whole = (to - from).norm() < u / 2;
-    const geom::Vec2 c = gridCentre(from, to, whole ? m.centre : balancedCentre(from, to, m.centre), 2);
+    const geom::Vec2 c = gridCentre(from, to, whole ? m.centre : geom::balancedCentre(from, to, m.centre), 2);
     const double printedSweep = whole ? kTwoPi : turnAngle(from - c, to - c, m.ccw);
     if (depth < 4 && arcGap(from, c, printedSweep, plannedFrom, m.centre, sweep, m.ccw) > 3 * u) {
       const geom::Vec2 mid = arcSplitPoints(plannedFrom, m.centre, m.ccw, sweep / 2, 1).front();

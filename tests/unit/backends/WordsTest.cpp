@@ -43,11 +43,11 @@ TEST_CASE("modal words are written only when they change", "[backends]") {
 TEST_CASE("arc centres are balanced between the endpoints as printed", "[backends]") {
   // A quarter arc of radius 10 about the origin, its end rounded off the circle.
   const geom::Vec2 from(10, 0), to(0.0004, 10.0004), centre(0, 0);
-  const geom::Vec2 c = balancedCentre(from, to, centre);
+  const geom::Vec2 c = geom::balancedCentre(from, to, centre);
   CHECK(std::abs((c - from).norm() - (c - to).norm()) < 1e-12);
   CHECK((c - centre).norm() < 1e-3);
   // A whole circle keeps its centre.
-  CHECK((balancedCentre(from, from, centre) - centre).norm() == 0);
+  CHECK((geom::balancedCentre(from, from, centre) - centre).norm() == 0);
 }
 
 TEST_CASE("rounded centre offsets keep start and end radius together", "[backends]") {
@@ -67,7 +67,7 @@ TEST_CASE("rounded centre offsets keep start and end radius together", "[backend
     const double r = 0.1 + next() * 50, a0 = next() * 6.3, a1 = next() * 6.3;
     const geom::Vec2 from(roundTo(c.x() + r * std::cos(a0), 3), roundTo(c.y() + r * std::sin(a0), 3));
     const geom::Vec2 to(roundTo(c.x() + r * std::cos(a1), 3), roundTo(c.y() + r * std::sin(a1), 3));
-    const geom::Vec2 ij = roundedCentreOffset(from, to, balancedCentre(from, to, c), 3);
+    const geom::Vec2 ij = roundedCentreOffset(from, to, geom::balancedCentre(from, to, c), 3);
     CHECK(roundTo(ij.x(), 3) == ij.x());
     worst = std::max(worst, std::abs(ij.norm() - (from + ij - to).norm()));
   }

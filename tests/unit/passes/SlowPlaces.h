@@ -7,26 +7,14 @@
 #include "passes/MotionIR.h"
 #include "runtime/Planner.h"
 #include "runtime/Player.h"
-
-#include <catch2/catch.hpp>
+#include "tests/unit/runtime/ShippedMachine.h"
 
 #include <cmath>
 #include <map>
-#include <memory>
 #include <utility>
 #include <vector>
 
 namespace stepnc::test {
-
-/// A shipped machine (hsc-3axis, conventional-3axis).
-inline runtime::Machine shippedMachine(const std::string &name) {
-  std::unique_ptr<SourceFile> file;
-  DiagnosticCollector collector;
-  DiagnosticEngine diags(collector);
-  const std::optional<runtime::Machine> machine = runtime::loadMachine(name, file, diags);
-  REQUIRE(machine);
-  return *machine;
-}
 
 /// The sampled positions where the program runs a feed move below
 /// `fraction` of its programmed feed.

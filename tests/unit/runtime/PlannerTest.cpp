@@ -6,6 +6,7 @@
 // bound computed here, independently of the planner.
 #include "runtime/Planner.h"
 #include "runtime/Player.h"
+#include "tests/unit/runtime/ShippedMachine.h"
 
 #include <Eigen/Geometry>
 #include <catch2/catch.hpp>
@@ -22,15 +23,6 @@ using namespace stepnc::runtime;
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-Machine shipped(const std::string &name) {
-  std::unique_ptr<SourceFile> file;
-  DiagnosticCollector collector;
-  DiagnosticEngine diags(collector);
-  auto m = loadMachine(name, file, diags);
-  REQUIRE(m);
-  return *m;
-}
 
 PathMove line(double x, double y, double z, double feed) {
   PathMove m;
@@ -104,7 +96,7 @@ double restToRest(double length, double v, double a, double j) {
 } // namespace
 
 TEST_CASE("a long line reaches the feed and takes the time-optimal time", "[planner]") {
-  const Machine m = shipped("hsc-3axis");
+  const Machine m = test::shippedMachine("hsc-3axis");
   PathInput p;
   p.moves.push_back(line(300, 0, 0, 3000));
   const SimReport r = check(p, m);
@@ -117,7 +109,7 @@ TEST_CASE("a long line reaches the feed and takes the time-optimal time", "[plan
 }
 
 TEST_CASE("a diagonal line is limited by its binding axis", "[planner]") {
-  const Machine m = shipped("conventional-3axis");
+  const Machine m = test::shippedMachine("conventional-3axis");
   PathInput p;
   p.moves.push_back(line(200, 100, -50, 0));  // a rapid: the axes' own speeds
   const SimReport r = check(p, m);
@@ -129,7 +121,7 @@ TEST_CASE("a diagonal line is limited by its binding axis", "[planner]") {
 }
 
 TEST_CASE("a rectangle takes within 2 % of the unrolled-perimeter lower bound", "[planner]") {
-  const Machine m = shipped("hsc-3axis");
+  const Machine m = test::shippedMachine("hsc-3axis");
   PathInput p;
   for (auto [x, y] : {std::pair{400.0, 0.0}, {400.0, 300.0}, {0.0, 300.0}, {0.0, 0.0}})
     p.moves.push_back(line(x, y, 0, 3000));
@@ -144,7 +136,7 @@ TEST_CASE("a rectangle takes within 2 % of the unrolled-perimeter lower bound", 
 
 TEST_CASE("stress paths hold every bound on both shipped machines", "[planner]") {
   for (const std::string name : {"hsc-3axis", "conventional-3axis"}) {
-    const Machine m = shipped(name);
+    const Machine m = test::shippedMachine(name);
     SECTION(name + ": tiny zigzag") {
       PathInput p;
       for (int i = 0; i < 400; ++i)
@@ -217,7 +209,7 @@ TEST_CASE("stress paths hold every bound on both shipped machines", "[planner]")
 }
 
 TEST_CASE("the tool stops where the program says and at reversals", "[planner]") {
-  const Machine m = shipped("hsc-3axis");
+  const Machine m = test::shippedMachine("hsc-3axis");
   PathInput p;
   p.moves.push_back(line(10, 0, 0, 3000));
   p.moves.push_back(line(0, 0, 0, 3000));  // straight back
@@ -244,7 +236,7 @@ TEST_CASE("a curve written as short lines takes within 5 % of its lower bound", 
   // times one axis's); the circle's curvature caps, sqrt(a R) and
   // (j R^2)^(1/3), are far above the feed here. Measured: 3.2, 2.7 and
   // 1.9 % above it.
-  const Machine m = shipped("hsc-3axis");
+  const Machine m = test::shippedMachine("hsc-3axis");
   for (const int n : {300, 3000, 30000}) {
     PathInput p;
     p.start = Vec3(20, 0, 0);
