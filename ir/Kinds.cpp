@@ -184,7 +184,8 @@ std::vector<KindSpec> makeTable() {
   add({"knot", "knot", Sigil::None, false, {{"value", T::Ratio, true}, {"multiplicity", T::Count, true}}, {}});
 
   // Operations (the child of a workingstep).
-  const char *millingChildren = "technology machine_functions strategy approach retract toolpath";
+  const char *millingChildren =
+      "technology machine_functions strategy trochoidal_strategy plunge_strategy approach retract toolpath";
   for (std::string_view op : {"plane_rough_milling", "plane_finish_milling"})
     add({op, "operation", Sigil::None, true,
          join(kOperationCommon, std::vector<AttrSpec>{{"axial_depth", T::Length}, {"allowance_bottom", T::Length}}),
@@ -250,6 +251,23 @@ std::vector<KindSpec> makeTable() {
                                   {"cutmode", T::Word, false, "climb conventional"},
                                   {"spiral_cutmode_change", T::Flag}}),
        {}});
+  // Pattern strategies (stepnc's extension schema, docs/pattern-strategies.md):
+  // a motif repeated along the path of their one child `strategy`, the guide.
+  add({"trochoidal_strategy", "strategy", Sigil::None, false,
+       join(kMillingStrategyCommon,
+            std::vector<AttrSpec>{{"radius", T::Length, true},
+                                  {"step", T::Length, true},
+                                  {"rotation", T::Word, false, "cw ccw"},
+                                  {"cutmode", T::Word, false, "climb conventional"}}),
+       "strategy"});
+  add({"plunge_strategy", "strategy", Sigil::None, false,
+       join(kMillingStrategyCommon,
+            std::vector<AttrSpec>{{"clearance", T::Length, true},
+                                  {"retract_offset", T::Length, true},
+                                  {"bottom_radius", T::Length, true},
+                                  {"radial_step", T::Length, true},
+                                  {"link_radius", T::Length, true}}),
+       "strategy"});
   add({"drilling_strategy", "strategy", Sigil::None, false,
        {{"reduced_cut_at_start", T::Ratio}, {"reduced_feed_at_start", T::Ratio}, {"depth_of_start", T::Length},
         {"reduced_cut_at_end", T::Ratio}, {"reduced_feed_at_end", T::Ratio}, {"depth_of_end", T::Length}},

@@ -36,7 +36,8 @@ constexpr RefRule kRefRules[] = {
 
 /// Children an operation has at most one of; the kinds of one entry count together.
 constexpr std::string_view kAtMostOnePerOperation[] = {
-    "technology", "machine_functions", "strategy drilling_strategy", "approach", "retract",
+    "technology", "machine_functions", "strategy drilling_strategy trochoidal_strategy plunge_strategy", "approach",
+    "retract",
 };
 
 constexpr double kUnitTolerance = 1e-6;
@@ -51,7 +52,7 @@ bool isRadius(std::string_view name) { return name == "radius" || name.ends_with
 /// Lengths that must be positive; radii may also be 0.
 bool isDimension(std::string_view name) {
   return isRadius(name) || name == "depth" || name == "diameter" || name == "width" || name == "length" ||
-         name == "pitch" || name == "travel";
+         name == "pitch" || name == "travel" || name == "step" || name == "radial_step";
 }
 
 bool isNumber(ValueType t) {
@@ -285,6 +286,11 @@ void Verifier::checkChildren(const Node &n, const KindSpec &spec) {
     auto moves = count([](const Node &c) { return c.kind == "moves"; });
     if (moves > 1)
       report(n, "expected at most one 'moves', found " + std::to_string(moves));
+  }
+  if (spec.kind == "trochoidal_strategy" || spec.kind == "plunge_strategy") {
+    auto guides = count([](const Node &c) { return c.kind == "strategy"; });
+    if (guides != 1)
+      report(n, "expected exactly one guide 'strategy', found " + std::to_string(guides));
   }
   if (spec.category != "operation")
     return;

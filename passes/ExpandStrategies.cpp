@@ -21,9 +21,11 @@
 #include "ir/Kinds.h"
 #include "passes/Curves.h"
 #include "passes/FeatureShape.h"
+#include "passes/PatternPaths.h"
 #include "support/Format.h"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <numbers>
 
@@ -42,6 +44,14 @@ using ir::Vec3;
 constexpr double kPi = std::numbers::pi;
 /// Height above a feature's top where plunges start when the operation gives no retract plane (mm).
 constexpr double kDefaultClearance = 2.0;
+/// Largest engagement angle of a trochoid's tool (deg) when the pass is not given max-engagement.
+constexpr double kDefaultMaxEngagement = 90.0;
+/// How far the line segments of a curve the strategy makes (trochoids,
+/// rounded links) may stray from it (mm) when the pass is not given chord-tolerance.
+constexpr double kDefaultChordTolerance = 0.005;
+/// Overlap of neighbouring guide paths of a pattern strategy that gives none:
+/// a share of the width one pass of the motif cuts.
+constexpr double kPatternOverlap = 0.2;
 /// Extra depth past the floor of a through hole, beyond the tool's point, when
 /// the operation's overcut is smaller (mm).
 constexpr double kBreakthrough = 1.0;
@@ -187,9 +197,16 @@ struct Plan {
 
 class ExpandStrategiesPass final : public Pass {
 public:
+  ExpandStrategiesPass(double maxEngagement, double chordTolerance, std::string optionError)
+      : maxEngagement_(maxEngagement), chordTolerance_(chordTolerance), optionError_(std::move(optionError)) {}
+
   std::string_view name() const override { return "expand-strategies"; }
 
   PassResult run(ir::Module &module, DiagnosticEngine &diags, PassStats &stats) override {
+    if (!optionError_.empty()) {
+      diags.error({}, optionError_);
+      return {false, false};
+    }
     module_ = &module;
     diags_ = &diags;
     stats_ = &stats;
@@ -326,8 +343,11 @@ private:
     return nullptr;
   }
 
-  void report(const Node &ws, const std::string &message) {
-    diags_->error(ws.origin.loc, ws.kind + " " + ws.symbol + ": " + message).entity(ws.origin.entityId);
+  void report(const Node &ws, const std::string &message) { report(ws, ws, message); }
+
+  /// An error about workingstep `ws` located at `at` (a part of it the file gives, such as its strategy).
+  void report(const Node &ws, const Node &at, const std::string &message) {
+    diags_->error(at.origin.loc, ws.kind + " " + ws.symbol + ": " + message).entity(at.origin.entityId);
     result_.ok = false;
   }
 
@@ -464,7 +484,27 @@ private:
 
   // --- Milling ------------------------------------------------------------------
 
+  /// The heights a milling operation cuts at, from the top down to the
+  /// floor plus its allowance, in equal steps no deeper than the axial
+  /// depth of cut; none (after a warning) when the allowance leaves nothing.
+  std::vector<double> levelsOf(const Node &ws, const Node &op, const FeatureShape &s, const Plan &p) {
+    const double floorZ = s.bottom + p.allowanceBottom;
+    if (floorZ >= s.top - 1e-9) {
+      unsupported(ws, "the bottom allowance leaves nothing to cut");
+      return {};
+    }
+    const double ap = op.number("axial_depth").value_or(0);
+    const int count = ap > 1e-9 ? std::max(1, static_cast<int>(std::ceil((s.top - floorZ) / ap - 1e-9))) : 1;
+    std::vector<double> out;
+    for (int i = 1; i <= count; ++i)
+      out.push_back(s.top - (s.top - floorZ) * i / count);
+    return out;
+  }
+
   bool milling(const Node &ws, const Node &op, const FeatureShape &s, const Plan &p, Node &moves) {
+    for (const char *kind : {"trochoidal_strategy", "plunge_strategy"})
+      if (const Node *pattern = op.child(kind))
+        return patternMilling(ws, op, *pattern, s, p, moves);
     const Node *strategy = op.child("strategy");
     std::string type = strategy ? strategy->text("type").value_or("") : "";
     const bool face = op.kind == "plane_rough_milling" || op.kind == "plane_finish_milling" || s.kind == "planar_face";
@@ -472,14 +512,9 @@ private:
       type = face ? "bidirectional" : "contour_parallel";
     const bool sideOnly = op.kind == "side_rough_milling" || op.kind == "side_finish_milling";
 
-    // Levels, from the top down to the floor (plus its allowance).
-    const double floorZ = s.bottom + p.allowanceBottom;
-    if (floorZ >= s.top - 1e-9) {
-      unsupported(ws, "the bottom allowance leaves nothing to cut");
+    const std::vector<double> levels = levelsOf(ws, op, s, p);
+    if (levels.empty())
       return false;
-    }
-    const double ap = op.number("axial_depth").value_or(0);
-    const int levels = ap > 1e-9 ? std::max(1, static_cast<int>(std::ceil((s.top - floorZ) / ap - 1e-9))) : 1;
 
     // The stepover: the radial depth of cut, else the overlap; never so wide
     // that a ring leaves material at the region's sharpest convex corner.
@@ -493,15 +528,7 @@ private:
     const double limitBidir = 2 * p.radius * 0.98;
     stepover = std::min(stepover, type == "bidirectional" || type == "unidirectional" ? limitBidir : coverLimit);
 
-    // Cut direction: climb keeps the wall on the tool's right for a clockwise
-    // (M3) spindle, which is the Region orientation; conventional reverses it.
-    bool followOrientation = true;
-    const std::string cutmode = strategy ? strategy->text("cutmode").value_or("") : "";
-    const std::string rotation = strategy ? strategy->text("rotation").value_or("") : "";
-    if (!cutmode.empty())
-      followOrientation = (cutmode == "climb") == (p.spindle <= 0);
-    else if (!rotation.empty())
-      followOrientation = rotation == "ccw";
+    const bool followOrientation = counterClockwise(strategy, p.spindle);
 
     const Vec2 strokeDir = strokeDirection(*p.feature, s, strategy);
     const bool linkAtDepth = type == "contour_spiral" || type == "contour_parallel" || type == "bidirectional" ||
@@ -512,8 +539,8 @@ private:
     std::optional<std::vector<bool>> standing;
     Region centres;
     std::vector<std::vector<Seg>> paths;
-    for (int i = 1; i <= levels; ++i) {
-      const double z = s.top - (s.top - floorZ) * i / levels;
+    for (size_t i = 0; i < levels.size(); ++i) {
+      const double z = levels[i];
       std::vector<bool> here;
       for (const IslandShape &isl : s.islands)
         here.push_back(isl.top > z + 1e-9);
@@ -562,7 +589,7 @@ private:
       if (s.slot && paths.size() == 1 && !geom::Chain{paths[0]}.closed()) {
         // One open path per level (center milling): down at the end where the
         // level before finished, and back along it.
-        if (i > 1) {
+        if (i > 0) {
           Loop back{paths[0]};
           back.reverse();
           paths[0] = std::move(back.segs);
@@ -691,6 +718,18 @@ private:
     return out;
   }
 
+  /// Whether a strategy's paths turn counter-clockwise (the orientation of
+  /// a Region's outer loops): climb keeps the wall on the tool's right for a
+  /// clockwise (M3) spindle, conventional on its left; without a cut mode,
+  /// the rotation it names; else counter-clockwise.
+  static bool counterClockwise(const Node *strategy, double spindle) {
+    const std::string cutmode = strategy ? strategy->text("cutmode").value_or("") : "";
+    const std::string rotation = strategy ? strategy->text("rotation").value_or("") : "";
+    if (!cutmode.empty())
+      return (cutmode == "climb") == (spindle <= 0);
+    return rotation.empty() || rotation == "ccw";
+  }
+
   /// The stroke direction: the strategy's feed direction, else the face's
   /// course of travel, else the feature's x axis.
   static Vec2 strokeDirection(const Node &feature, const FeatureShape &s, const Node *strategy) {
@@ -722,7 +761,9 @@ private:
         }
     // For faces the area is already grown by the radius: strokes run from
     // edge to edge of the face, the first and last a radius inside its sides.
-    const double inset = overtravel > 0 ? overtravel : 0;
+    // Otherwise the outer strokes run a hair inside the area, not along its
+    // boundary, where clipping could lose them.
+    const double inset = overtravel > 0 ? overtravel : 1e-6;
     const double width = std::max(0.0, hi - lo - 2 * inset);
     const int n = std::max(1, static_cast<int>(std::ceil(width / stepover - 1e-9)) + 1);
     const double pitch = n > 1 ? width / (n - 1) : 0;
@@ -822,6 +863,305 @@ private:
     e.linear(at(start, z), p.plungeFeed, "plunge");
   }
 
+  // --- Pattern strategies (docs/pattern-strategies.md) -------------------------
+
+  bool patternMilling(const Node &ws, const Node &op, const Node &pattern, const FeatureShape &s, const Plan &p,
+                      Node &moves) {
+    const Node *guide = pattern.child("strategy");
+    const std::string type = guide ? guide->text("type").value_or("") : "";
+    if (type.empty() || type == "explicit") {
+      report(ws, "its " + pattern.kind +
+                     " needs an ordinary strategy as its guide (contour parallel, "
+                     "bidirectional, center milling, ...), found " +
+                     (type.empty() ? "none" : "'" + type + "'"));
+      return false;
+    }
+    const std::vector<double> levels = levelsOf(ws, op, s, p);
+    if (levels.empty())
+      return false;
+    return pattern.kind == "trochoidal_strategy" ? trochoidal(ws, op, pattern, *guide, s, p, levels, moves)
+                                                 : plunging(ws, op, pattern, *guide, s, p, levels, moves);
+  }
+
+  /// The guide's paths at height z for a motif that reaches `reach.radius`
+  /// from the guide (the tool's radius plus the motif's), `spacing` apart,
+  /// kept `margin` further from the walls; `area` receives where the guide
+  /// may run. None after a diagnostic when the motif does not fit.
+  std::optional<std::vector<std::vector<Seg>>> guidePaths(const Node &ws, const Node &op, const Node &guide,
+                                                          const FeatureShape &s, const Plan &reach, double z,
+                                                          double spacing, double margin, Region &area) {
+    const std::string type = guide.text("type").value_or("");
+    area = centreArea(s, s.unbounded ? s.target : s.limit, islandsAt(s, z, reach.allowanceSide), reach);
+    if (margin > 0 && !area.empty())
+      area = geom::offset(area, -margin);
+    auto tooWide = [&](const std::string &what) {
+      report(ws, "its tool " + reach.tool->symbol + " with the motif of its pattern strategy reaches " +
+                     formatFixed(reach.radius, 3) + " mm from the guide and does not fit in " + what +
+                     " with the side allowance");
+    };
+    if (s.slot && (type == "center_milling" || area.empty())) {
+      std::optional<std::vector<Seg>> line = slotCentreline(*s.slot, reach);
+      if (!line) {
+        tooWide("slot " + s.symbol + " (width " + formatFixed(s.slot->width, 3) + " mm)");
+        return std::nullopt;
+      }
+      area = geom::offset(s.target, -geom::kEps);
+      return std::vector<std::vector<Seg>>{std::move(*line)};
+    }
+    if (type == "center_milling") {
+      unsupported(ws, "center milling follows the course of travel of a slot; " + s.symbol + " is a " + s.kind);
+      return std::nullopt;
+    }
+    if (area.empty()) {
+      tooWide(s.symbol);
+      return std::nullopt;
+    }
+    const bool face = op.kind == "plane_rough_milling" || op.kind == "plane_finish_milling" || s.kind == "planar_face";
+    const bool sideOnly = op.kind == "side_rough_milling" || op.kind == "side_finish_milling";
+    auto made = strategyPaths(type, face, s.unbounded, sideOnly, area, strokeDirection(*reach.feature, s, &guide),
+                              spacing, counterClockwise(&guide, reach.spindle), reach.radius);
+    if (!made) {
+      unsupported(ws, "strategy '" + type + "' is not expanded yet");
+      return std::nullopt;
+    }
+    return made;
+  }
+
+  /// The islands standing at height z, grown by the side allowance.
+  static std::vector<Region> islandsAt(const FeatureShape &s, double z, double allowance) {
+    std::vector<Region> out;
+    for (const IslandShape &isl : s.islands)
+      if (isl.top > z + 1e-9)
+        out.push_back(geom::offset(isl.region, allowance));
+    return out;
+  }
+
+  /// After a motif at height z: one contour of the tool along every wall,
+  /// climb, taking what the motif leaves there (its scallops or cusps
+  /// between loops or plunges, and corners tighter than its reach).
+  void wallPass(Emitter &e, const Node &op, const FeatureShape &s, const Plan &p, double z, bool ccw) {
+    const Region centres = centreArea(s, s.unbounded ? s.target : s.limit, islandsAt(s, z, p.allowanceSide), p);
+    if (centres.empty())
+      return;
+    for (const std::vector<Seg> &ring : rings(centres, p.radius, ccw, /*all=*/false, p.radius))
+      cutPath(e, ring, z, p, op, centres, /*mayLink=*/true, s.unbounded);
+  }
+
+  /// Paths joined into chains: each path goes on from the end of the one
+  /// before by a straight link when the link stays inside `area`; a closed
+  /// path starts where it is nearest to that end.
+  static std::vector<std::vector<Seg>> chains(const std::vector<std::vector<Seg>> &paths, const Region &area) {
+    std::vector<std::vector<Seg>> out;
+    for (const std::vector<Seg> &path : paths) {
+      if (path.empty())
+        continue;
+      std::vector<Seg> next = path;
+      const bool closed = path.size() > 1 && (path.front().a - path.back().b).norm() < 1e-7;
+      if (!out.empty() && closed) {
+        Loop ring{path};
+        next = startNearest(ring, out.back().back().b).segs;
+      }
+      if (!out.empty()) {
+        const Vec2 from = out.back().back().b, to = next.front().a;
+        double inside = 0;
+        for (const Seg &piece : geom::clip(area, from, to))
+          inside += piece.length();
+        if (std::abs(inside - (to - from).norm()) < 1e-6) {
+          if ((to - from).norm() > geom::kEps)
+            out.back().push_back(Seg::line(from, to));
+          out.back().insert(out.back().end(), next.begin(), next.end());
+          continue;
+        }
+      }
+      out.push_back(std::move(next));
+    }
+    return out;
+  }
+
+  /// The spacing of guide paths for a motif as wide as a tool of radius
+  /// `radius`: from the pattern's overlap (default kPatternOverlap), never
+  /// so wide that a ring leaves material at the region's sharpest corner.
+  static double guideSpacing(const Node &pattern, const FeatureShape &s, double radius) {
+    double overlap = pattern.number("overlap").value_or(kPatternOverlap);
+    if (overlap <= 0 || overlap >= 1)
+      overlap = kPatternOverlap;
+    const double coverLimit = radius * (1 + std::sin(sharpestCorner(s.target) / 2)) * 0.98;
+    return std::min(2 * radius * (1 - overlap), coverLimit);
+  }
+
+  bool trochoidal(const Node &ws, const Node &op, const Node &pattern, const Node &guide, const FeatureShape &s,
+                  const Plan &p, const std::vector<double> &levels, Node &moves) {
+    const double loop = pattern.number("radius").value_or(0);
+    const double step = pattern.number("step").value_or(0);
+    if (loop <= 0 || step <= 0) {
+      report(ws, pattern, "its trochoidal strategy needs a positive trochoid radius and step per revolution");
+      return false;
+    }
+    if (step >= 2 * kPi * loop) {
+      report(ws, pattern,
+             "its trochoidal step per revolution " + formatFixed(step, 3) +
+                 " mm is not less than 2 pi times the trochoid radius (" + formatFixed(2 * kPi * loop, 3) +
+                 " mm): the tool would stop on every loop");
+      return false;
+    }
+    // The step the engagement allows, on a straight guide in full material.
+    const double used = largestTrochoidStep(p.radius, loop, maxEngagement_ * kPi / 180, step);
+    if (used <= 0) {
+      report(ws, pattern,
+             "no trochoid of radius " + formatFixed(loop, 3) + " mm keeps the engagement of its tool under " +
+                 formatFixed(maxEngagement_, 1) + " deg");
+      return false;
+    }
+    const TrochoidMotif motif{loop, used, counterClockwise(&pattern, p.spindle)};
+    const double w = trochoidSmoothing(used, loop);
+    Plan reach = p;
+    reach.radius = p.radius + loop;
+    const double spacing = guideSpacing(pattern, s, reach.radius);
+    const Node *a = op.child("approach");
+    const std::string entry = a ? a->text("type").value_or("plunge_helix") : "plunge_helix";
+    const double angle = std::max(a ? a->number("angle").value_or(5.0) : 5.0, 0.5) * kPi / 180;
+    Emitter e(moves, ws.number("secplane").value_or(0));
+    long loops = 0;
+    for (double z : levels) {
+      Region area;
+      auto paths = guidePaths(ws, op, guide, s, reach, z, spacing, SmoothGuide::arcShrink(w, reach.radius), area);
+      if (!paths)
+        return false;
+      for (std::vector<Seg> &chain : chains(*paths, area)) {
+        const SmoothGuide g(std::move(chain), w);
+        const std::vector<Vec2> points = trochoidPoints(g, motif, chordTolerance_);
+        loops += trochoidLoops(g, used);
+        // Down about the guide's start on the first loop: a helix, unless
+        // the operation asks for a plunge along the tool axis.
+        e.travel(points.front(), p.clearanceZ);
+        if (entry == "plunge_toolaxis") {
+          e.linear(at(points.front(), z), p.plungeFeed, "plunge");
+        } else {
+          const double perTurn = 2 * kPi * loop * std::tan(angle);
+          const int64_t turns = static_cast<int64_t>(std::ceil((p.clearanceZ - z) / perTurn - 1e-9));
+          e.arc(at(points.front(), z), g.raw(0), motif.ccw, std::max<int64_t>(turns - 1, 0), p.plungeFeed, "plunge");
+          // One more turn at the bottom takes the ramp the helix leaves, so
+          // that the first loop meets only what the loops are sized for.
+          e.arc(at(points.front(), z), g.raw(0), motif.ccw, 0, p.plungeFeed, "plunge");
+        }
+        for (size_t k = 1; k < points.size(); ++k)
+          e.linear(at(points[k], z), p.feed, "cut");
+      }
+      wallPass(e, op, s, p, z, motif.ccw);
+    }
+    e.retract();
+    std::string note = "trochoid radius " + formatFixed(loop, 3) + " mm, step " + formatFixed(used, 3) + " mm";
+    if (used < step)
+      note += " (" + formatFixed(step, 3) + " lowered: engagement at most " + formatFixed(maxEngagement_, 1) + " deg)";
+    ir::replaceCommentPart(moves, {"trochoid "}, note + ", " + std::to_string(loops) + " loops");
+    (*stats_)["trochoid loops"] += loops;
+    return true;
+  }
+
+  bool plunging(const Node &ws, const Node &op, const Node &pattern, const Node &guide, const FeatureShape &s,
+                const Plan &p, const std::vector<double> &levels, Node &moves) {
+    const double clearance = pattern.number("clearance").value_or(0);
+    const double backOff = std::max(0.0, pattern.number("retract_offset").value_or(0));
+    const double bottom = pattern.number("bottom_radius").value_or(0);
+    const double pitch = pattern.number("radial_step").value_or(0);
+    const double linkRadius = std::max(0.0, pattern.number("link_radius").value_or(0));
+    if (bottom <= 0 || bottom > p.radius + 1e-9) {
+      report(ws, pattern,
+             "its plunge bottom radius " + formatFixed(bottom, 3) + " mm is not within the radius of its tool " +
+                 p.tool->symbol + " (" + formatFixed(p.radius, 3) + " mm)");
+      return false;
+    }
+    // Plunges on a square grid of pitch p cover the area when p <= sqrt(2) R.
+    if (pitch <= 0 || pitch > std::sqrt(2.0) * bottom * (1 + 1e-9)) {
+      report(ws, pattern,
+             "its plunge radial step " + formatFixed(pitch, 3) + " mm leaves material between plunges: at most " +
+                 "sqrt(2) times the plunge bottom radius, " + formatFixed(std::sqrt(2.0) * bottom, 3) + " mm");
+      return false;
+    }
+    if (clearance <= 0) {
+      report(ws, pattern,
+             "its plunge clearance height " + formatFixed(clearance, 3) +
+                 " mm does not take the tool out of the material between plunges");
+      return false;
+    }
+    const double secplane = ws.number("secplane").value_or(0);
+    const double above = std::min(s.top + clearance, secplane);
+    // Rounded corners stay above the material: the way down is a plunge.
+    const double corner = std::min(linkRadius, above - s.top);
+    Emitter e(moves, secplane);
+    long plunges = 0;
+    for (double z : levels) {
+      Region area;
+      auto paths = guidePaths(ws, op, guide, s, p, z, pitch, 0, area);
+      if (!paths)
+        return false;
+      for (std::vector<Seg> path : *paths) {
+        const bool closed = path.size() > 1 && (path.front().a - path.back().b).norm() < 1e-7;
+        if (closed && e.positioned())
+          path = startNearest(Loop{path}, e.position().head<2>()).segs;
+        const std::vector<Vec2> centres = plungeCentres(path, pitch, bottom);
+        for (size_t k = 0; k < centres.size(); ++k) {
+          const Vec2 c = centres[k];
+          if (k == 0)
+            e.travel(c, above);
+          else
+            link(e, e.position().head<2>(), c, above, corner, p.feed);
+          e.linear(at(c, z), p.plungeFeed, "plunge");
+          ++plunges;
+          // Away from the wall just cut, into the hole of the plunge before,
+          // then straight up.
+          Vec2 out = c;
+          if (k > 0 && backOff > 0) {
+            const Vec2 back = centres[k - 1] - c;
+            out = c + back * std::min(1.0, backOff / back.norm());
+            e.linear(at(out, z), p.feed, "retract");
+          }
+          e.rapid(at(out, k + 1 < centres.size() ? above - corner : secplane), "retract");
+        }
+      }
+      wallPass(e, op, s, p, z, counterClockwise(&pattern, p.spindle));
+    }
+    e.retract();
+    const double cusp = bottom - std::sqrt(bottom * bottom - pitch * pitch / 4);
+    ir::replaceCommentPart(moves, {"plunges "},
+                           "plunges " + std::to_string(plunges) + " on a " + formatFixed(pitch, 3) +
+                               " mm pitch, wall cusp " + formatFixed(cusp, 3) + " mm");
+    (*stats_)["plunges"] += plunges;
+    return true;
+  }
+
+  /// From `from`, `corner` below the height `above`, to over `to` at `corner`
+  /// below it: up, across and down in the vertical plane through both, the
+  /// two bends rounded to radius `corner` (shortened to half the way
+  /// across), as feed moves within the chord tolerance.
+  void link(Emitter &e, const Vec2 &from, const Vec2 &to, double above, double corner, double feed) {
+    const double across = (to - from).norm();
+    if (across <= geom::kEps)
+      return;
+    const Vec2 u = (to - from) / across;
+    const double r = std::min(corner, across / 2);
+    // The bends start `corner` below `above`: lower them when r is shorter.
+    if (r < corner)
+      e.rapid(at(from, above - r), "retract");
+    const int n =
+        r > chordTolerance_ ? std::max(2, int(std::ceil(kPi / 2 / (2 * std::acos(1 - chordTolerance_ / r))))) : 1;
+    for (int i = 1; i <= n; ++i) { // up into the horizontal
+      const double a = kPi / 2 * i / n;
+      e.linear(Vec3(from.x() + u.x() * r * (1 - std::cos(a)), from.y() + u.y() * r * (1 - std::cos(a)),
+                    above - r + r * std::sin(a)),
+               feed, "link");
+    }
+    e.linear(at(to - u * r, above), feed, "link");
+    for (int i = 1; i <= n; ++i) { // across into the vertical
+      const double a = kPi / 2 * i / n;
+      const Vec2 xy = to - u * (r * (1 - std::sin(a)));
+      e.linear(Vec3(xy.x(), xy.y(), above - r + r * std::cos(a)), feed, "link");
+    }
+  }
+
+  double maxEngagement_ = kDefaultMaxEngagement;   ///< deg
+  double chordTolerance_ = kDefaultChordTolerance; ///< mm
+  std::string optionError_;
   ir::Module *module_ = nullptr;
   DiagnosticEngine *diags_ = nullptr;
   PassStats *stats_ = nullptr;
@@ -831,8 +1171,29 @@ private:
 
 } // namespace
 
-std::unique_ptr<Pass> createExpandStrategiesPass(const PassOptions &) {
-  return std::make_unique<ExpandStrategiesPass>();
+std::unique_ptr<Pass> createExpandStrategiesPass(const PassOptions &options) {
+  double maxEngagement = kDefaultMaxEngagement, chord = kDefaultChordTolerance;
+  std::string error;
+  if (auto it = options.find("max-engagement"); it != options.end()) {
+    double v = 0;
+    const char *first = it->second.data(), *last = first + it->second.size();
+    std::string_view unit;
+    auto [end, ec] = std::from_chars(first, last, v);
+    unit = std::string_view(end, size_t(last - end));
+    if (ec != std::errc() || !(v > 0 && v <= 180) || !(unit.empty() || unit == "deg"))
+      error = "expand-strategies: max-engagement='" + it->second +
+              "' is not an angle: expected degrees in (0, 180], such as max-engagement=60";
+    else
+      maxEngagement = v;
+  }
+  if (auto it = options.find("chord-tolerance"); it != options.end()) {
+    if (auto v = parseLengthOption(it->second))
+      chord = *v;
+    else
+      error = "expand-strategies: chord-tolerance='" + it->second +
+              "' is not a length: expected a positive number of mm, such as chord-tolerance=0.005";
+  }
+  return std::make_unique<ExpandStrategiesPass>(maxEngagement, chord, std::move(error));
 }
 
 } // namespace stepnc::passes

@@ -3,6 +3,7 @@
 #include "support/Format.h"
 
 #include <algorithm>
+#include <cctype>
 #include <map>
 #include <set>
 
@@ -203,6 +204,18 @@ void Binder::reportUnknown(size_t index, std::string_view name, uint64_t at) {
   const std::string &best = it->second;
   auto d = diags_.error(file_.loc(at), "unknown entity '" + std::string(name) + "' in schema '" + schema_.name + "'");
   d.entity(entry(index).id, std::string(name));
+  // A name another schema of the model declares: the file forgot to list it.
+  const std::string lowered = express::lower(name);
+  for (const express::Schema &other : model_.schemas())
+    if (&other != &schema_)
+      if (auto found = other.scope.find(lowered); found != other.scope.end() && found->second.first) {
+        std::string listed = other.name;
+        for (char &c : listed)
+          c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+        d.note("'" + lowered + "' is declared in schema '" + other.name + "': list '" + listed +
+               "' in the file's FILE_SCHEMA");
+        return;
+      }
   if (!best.empty())
     d.note("did you mean '" + best + "'?");
 }

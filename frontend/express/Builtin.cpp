@@ -30,24 +30,47 @@ const Model &builtinModel() {
   return model;
 }
 
+namespace {
+
+constexpr std::string_view kExtensionName = "STEPNC_PATTERN_STRATEGIES";
+
+std::string upper(std::string_view name) {
+  std::string out(name);
+  for (char &c : out)
+    if (c >= 'a' && c <= 'z')
+      c = static_cast<char>(c - 32);
+  return out;
+}
+
+} // namespace
+
 const std::vector<std::string_view> &builtinSchemaNames() {
   // ISO 14649 names its schemas per part; files name one or several of them,
-  // or the merged schema's name.
+  // or the merged schema's name; stepnc's extension goes beside them.
   static const std::vector<std::string_view> names = {
-      "MACHINING_SCHEMA", "MILLING_SCHEMA",      "TURNING_SCHEMA",        "MILLING_TOOL_SCHEMA",
-      "TURNING_TOOL_SCHEMA", "COMBINED_SCHEMA",  "ISO14649_ARM"};
+      "MACHINING_SCHEMA",    "MILLING_SCHEMA",  "TURNING_SCHEMA", "MILLING_TOOL_SCHEMA",
+      "TURNING_TOOL_SCHEMA", "COMBINED_SCHEMA", "ISO14649_ARM",   kExtensionName};
   return names;
 }
 
 const Schema *builtinSchemaFor(std::string_view name) {
-  std::string upper(name);
-  for (char &c : upper)
-    if (c >= 'a' && c <= 'z')
-      c = static_cast<char>(c - 32);
+  const std::string wanted = upper(name);
+  if (wanted == kExtensionName)
+    return builtinModel().findSchema(kExtensionName);
   for (std::string_view n : builtinSchemaNames())
-    if (n == upper)
-      return &builtinModel().schemas().front();
+    if (n == wanted)
+      return builtinModel().findSchema("iso14649_arm");
   return nullptr;
+}
+
+const Schema *builtinSchemaFor(const std::vector<std::string> &names) {
+  // The extension interfaces the whole ARM: when a file lists it, it is the
+  // schema that sees every entity the file may use.
+  const Schema *chosen = nullptr;
+  for (const std::string &n : names)
+    if (const Schema *s = builtinSchemaFor(n); s && (!chosen || upper(n) == kExtensionName))
+      chosen = s;
+  return chosen;
 }
 
 } // namespace stepnc::express

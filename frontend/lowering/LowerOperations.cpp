@@ -110,6 +110,92 @@ void checkPlausible(Lowerer &l, const Instance &tech, std::string_view attribute
   l.diags().warning(tech.attrLoc(attribute), text).entity(tech.id(), "MILLING_TECHNOLOGY");
 }
 
+/// What every 2.5D milling strategy has: overlap and multiple passes.
+void commonStrategyAttributes(Lowerer &l, Node &s, const Instance &strategy) {
+  if (auto o = strategy.real("overlap")) {
+    s.set("overlap", Value::ratio(*o));
+    if (*o > 1.0)
+      l.diags()
+          .warning(strategy.attrLoc("overlap"),
+                   "overlap " + formatFixed(*o, 4) +
+                       " is more than 1: ISO 14649 gives it as a ratio (0.5 = 50 %); read as written, the file may "
+                       "mean percent")
+          .entity(strategy.id(), std::string(strategy.entityName()));
+  }
+  copyFlag(s, "multiple_passes", strategy, "allow_multiple_passes");
+}
+
+/// A 2.5D milling strategy: an ordinary one as `strategy`, a pattern
+/// strategy (stepnc's extension schema) as `trochoidal_strategy` or
+/// `plunge_strategy` with its guide as child. None, after a diagnostic, for
+/// a strategy stepnc does not know.
+std::optional<Node> millingStrategy(Lowerer &l, const Instance &strategy) {
+  const bool trochoidal = strategy.isA("trochoidal_milling");
+  if (trochoidal || strategy.isA("plunge_milling")) {
+    Node p(trochoidal ? "trochoidal_strategy" : "plunge_strategy");
+    l.stamp(p, strategy, "");
+    commonStrategyAttributes(l, p, strategy);
+    if (trochoidal) {
+      copyReal(p, "radius", strategy, "trochoid_radius", Value::length);
+      copyReal(p, "step", strategy, "step_per_revolution", Value::length);
+      if (auto w = strategy.enumeration("rotation_direction"))
+        p.set("rotation", Value::word(*w));
+      if (auto w = strategy.enumeration("cutmode"))
+        p.set("cutmode", Value::word(*w));
+    } else {
+      copyReal(p, "clearance", strategy, "clearance_height", Value::length);
+      copyReal(p, "retract_offset", strategy, "retract_offset", Value::length);
+      copyReal(p, "bottom_radius", strategy, "plunge_bottom_radius", Value::length);
+      copyReal(p, "radial_step", strategy, "radial_step", Value::length);
+      copyReal(p, "link_radius", strategy, "link_radius", Value::length);
+    }
+    Instance guide = strategy.ref("guide");
+    if (guide.isA("pattern_strategy")) {
+      l.diags()
+          .error(strategy.attrLoc("guide"), "the guide of a pattern strategy is an ordinary 2.5D strategy, found " +
+                                                std::string(guide.entityName()))
+          .entity(strategy.id(), std::string(strategy.entityName()));
+      return std::nullopt;
+    }
+    if (!guide) {
+      l.missing(strategy, "guide");
+      return std::nullopt;
+    }
+    std::optional<Node> g = millingStrategy(l, guide);
+    if (!g)
+      return std::nullopt;
+    p.add(std::move(*g));
+    return p;
+  }
+  std::string_view type;
+  for (const auto &[entity, word] : kStrategies)
+    if (strategy.isA(entity)) {
+      type = word;
+      break;
+    }
+  if (type.empty()) {
+    l.unsupported(strategy, "machining strategy");
+    return std::nullopt;
+  }
+  Node s("strategy");
+  l.stamp(s, strategy, "");
+  s.set("type", Value::word(std::string(type)));
+  commonStrategyAttributes(l, s, strategy);
+  if (Instance fd = strategy.ref("feed_direction"))
+    if (auto d = l.direction(fd))
+      s.set("feed_dir", Value::direction(*d));
+  if (auto w = strategy.enumeration("stepover_direction"))
+    s.set("stepover_dir", Value::word(*w));
+  if (auto w = strategy.enumeration("its_stroke_connection_strategy"))
+    s.set("stroke_connection", Value::word(*w == "straghtline" ? "straightline" : *w));  // the ARM's spelling
+  if (auto w = strategy.enumeration("rotation_direction"))
+    s.set("rotation", Value::word(*w));
+  if (auto w = strategy.enumeration("cutmode"))
+    s.set("cutmode", Value::word(*w));
+  copyFlag(s, "spiral_cutmode_change", strategy, "spiral_cutmode_change");
+  return s;
+}
+
 Node technology(Lowerer &l, const Instance &tech) {
   Node n("technology");
   if (auto f = tech.real("feedrate")) {
@@ -206,43 +292,8 @@ std::optional<Node> Lowerer::operation(const Instance &op) {
       copyReal(d, "depth_of_start", strategy, "depth_of_start", Value::length);
       copyReal(d, "depth_of_end", strategy, "depth_of_end", Value::length);
       n.add(std::move(d));
-    } else {
-      std::string_view type;
-      for (const auto &[entity, word] : kStrategies)
-        if (strategy.isA(entity)) {
-          type = word;
-          break;
-        }
-      if (type.empty()) {
-        unsupported(strategy, "machining strategy");
-      } else {
-        Node s("strategy");
-        stamp(s, strategy, "");
-        s.set("type", Value::word(std::string(type)));
-        if (auto o = strategy.real("overlap")) {
-          s.set("overlap", Value::ratio(*o));
-          if (*o > 1.0)
-            diags_.warning(strategy.attrLoc("overlap"),
-                           "overlap " + formatFixed(*o, 4) +
-                               " is more than 1: ISO 14649 gives it as a ratio (0.5 = 50 %); read as written, "
-                               "the file may mean percent")
-                .entity(strategy.id(), std::string(strategy.entityName()));
-        }
-        copyFlag(s, "multiple_passes", strategy, "allow_multiple_passes");
-        if (Instance fd = strategy.ref("feed_direction"))
-          if (auto d = direction(fd))
-            s.set("feed_dir", Value::direction(*d));
-        if (auto w = strategy.enumeration("stepover_direction"))
-          s.set("stepover_dir", Value::word(*w));
-        if (auto w = strategy.enumeration("its_stroke_connection_strategy"))
-          s.set("stroke_connection", Value::word(*w == "straghtline" ? "straightline" : *w));  // the ARM's spelling
-        if (auto w = strategy.enumeration("rotation_direction"))
-          s.set("rotation", Value::word(*w));
-        if (auto w = strategy.enumeration("cutmode"))
-          s.set("cutmode", Value::word(*w));
-        copyFlag(s, "spiral_cutmode_change", strategy, "spiral_cutmode_change");
-        n.add(std::move(s));
-      }
+    } else if (auto lowered = millingStrategy(*this, strategy)) {
+      n.add(std::move(*lowered));
     }
   }
   for (std::string_view which : {"approach", "retract"}) {

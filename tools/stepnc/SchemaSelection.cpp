@@ -54,11 +54,10 @@ const express::Schema *SchemaSelection::select(const p21::Part21File &file, Diag
                           "; checking against schema '" + first->name + "' given with --schema");
     return first;
   }
-  for (const std::string &n : names)
-    if (const express::Schema *s = express::builtinSchemaFor(n)) {
-      model = &express::builtinModel();
-      return s;
-    }
+  if (const express::Schema *s = express::builtinSchemaFor(names)) {
+    model = &express::builtinModel();
+    return s;
+  }
   diags.warning(at, names.empty() ? "FILE_SCHEMA names no schema; checked for Part 21 syntax only"
                                   : "schema " + listed +
                                         " is not built in; checked for Part 21 syntax only (give its "

@@ -110,7 +110,20 @@ TEST_CASE("each mutation of a valid module gives its error", "[ir]") {
     drilling.add(Node(*drilling.child("technology")));
     drilling.add(Node(*drilling.child("drilling_strategy")));
     CHECK(verify(m) == Errors{"drilling \"DRILL HOLE1\": expected at most one technology, found 2",
-                              "drilling \"DRILL HOLE1\": expected at most one strategy or drilling_strategy, found 2"});
+                              "drilling \"DRILL HOLE1\": expected at most one strategy, drilling_strategy, "
+                              "trochoidal_strategy or plunge_strategy, found 2"});
+  }
+  SECTION("a pattern strategy without its guide") {
+    Node *pattern = nullptr;
+    for (Node &op : find(root, "@ws_rough_pocket1").children)
+      for (Node &c : op.children)
+        if (c.kind == "strategy")
+          pattern = &(c = Node("trochoidal_strategy"));
+    REQUIRE(pattern);
+    pattern->set("radius", Value::length(3)).set("step", Value::length(1));
+    CHECK(verify(m) == Errors{"trochoidal_strategy: expected exactly one guide 'strategy', found 0"});
+    pattern->add(Node("strategy")).set("type", Value::word("center_milling"));
+    CHECK(verify(m).empty());
   }
   SECTION("child its parent does not take") {
     Node tool = find(root, "%drill_10mm");

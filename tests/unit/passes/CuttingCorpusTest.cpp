@@ -13,8 +13,6 @@
 #include "tests/unit/passes/DeflectionCheck.h"
 #include "tests/unit/passes/PassTestSupport.h"
 #include "tests/unit/passes/SlowPlaces.h"
-#include "tools/stepnc/Compile.h"
-#include "tools/stepnc/SchemaSelection.h"
 
 #include <catch2/catch.hpp>
 
@@ -37,28 +35,6 @@ const char *const kFiles[] = {
     "unseenlaser__iso-14649-toolkit/ex1.stp",
     "unseenlaser__iso-14649-toolkit/ex1E.stp",
 };
-
-struct Loaded {
-  std::unique_ptr<SourceFile> source;
-  std::unique_ptr<ir::Module> module;
-};
-
-Loaded load(const std::string &path) {
-  Loaded l;
-  std::string error;
-  l.source = SourceFile::open(path, error);
-  INFO(error);
-  REQUIRE(l.source);
-  DiagnosticCollector c;
-  DiagnosticEngine diags(c);
-  const tool::SchemaOptions options;
-  tool::SchemaSelection schemas(options);
-  bool usage = false;
-  REQUIRE(schemas.load(diags, usage));
-  l.module = tool::loadModule(*l.source, schemas, diags, usage);
-  REQUIRE(l.module);
-  return l;
-}
 
 /// How close to the chip target adapt-feed comes where the chip limits the
 /// feed, read on the samples it chose the feeds on: the samples of the
@@ -115,7 +91,7 @@ ChipFit chipFit(const ir::Module &programmed, const ir::Module &adapted, const c
 
 /// The invariants on the program of the STEP-NC file at `path`.
 void checkInvariants(const std::string &path, const cutting::CuttingData &data, const runtime::Machine &machine) {
-  Loaded l = load(path);
+  test::Loaded l = test::loadStepnc(path);
   std::vector<std::string> errors;
   REQUIRE(test::runPipeline(*l.module, "resolve-feeds,expand-strategies", &errors));
   const ir::Module programmed = *l.module;

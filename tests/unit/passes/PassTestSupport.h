@@ -1,11 +1,13 @@
 // Helpers shared by the unit tests of the passes that work on moves:
-// a block with a pocket to cut, running a pipeline on a module, and writing
-// a straight cut by hand.
+// a block with a pocket to cut, a STEP-NC file read into the IR, running a
+// pipeline on a module, and writing a straight cut by hand.
 #pragma once
 
 #include "passes/PassManager.h"
 #include "support/Format.h"
 #include "tests/unit/ir/SampleModule.h"
+#include "tools/stepnc/Compile.h"
+#include "tools/stepnc/SchemaSelection.h"
 
 #include <catch2/catch.hpp>
 
@@ -37,6 +39,30 @@ inline std::string blockPocketModule(double cornerRadius, const std::string &wor
 /// IR line, such as `side_finish_milling "OP" tool=%mill10`).
 inline std::string oneStep(const std::string &operation) {
   return "    workingstep @ws \"WS\" feature=%pocket secplane=20.0000mm\n      " + operation + "\n";
+}
+
+/// A STEP-NC file read, checked and lowered as `stepnc compile` does; the
+/// source stays alive with the module (diagnostics point into it).
+struct Loaded {
+  std::unique_ptr<SourceFile> source;
+  std::unique_ptr<ir::Module> module;
+};
+
+inline Loaded loadStepnc(const std::string &path) {
+  Loaded l;
+  std::string error;
+  l.source = SourceFile::open(path, error);
+  INFO(error);
+  REQUIRE(l.source);
+  DiagnosticCollector c;
+  DiagnosticEngine diags(c);
+  const tool::SchemaOptions options;
+  tool::SchemaSelection schemas(options);
+  bool usage = false;
+  REQUIRE(schemas.load(diags, usage));
+  l.module = tool::loadModule(*l.source, schemas, diags, usage);
+  REQUIRE(l.module);
+  return l;
 }
 
 /// `text` parsed, failing the test on any error.
