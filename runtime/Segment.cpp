@@ -110,9 +110,16 @@ void blendArcTable(const QuinticCurve &q, std::array<double, Segment::kBlendTabl
 template <int D>
 void sampleBlendDemand(const QuinticCurve &q, AxisDemand &d) {
   using Pair = Eigen::Array2d;
-  constexpr int kSamples = 32;
-  // Derivatives' coefficients in u.
-  double a1[D][5], a2[D][4], a3[D][3];
+  static constexpr int kSamples = 32, kPairs = kSamples / 2 + 1;
+  static const std::array<Pair, kPairs> ts = [] {
+    std::array<Pair, kPairs> out;
+    for (int i = 0; i < kPairs; ++i)
+      out[i] = Pair(double(2 * i) / kSamples, double(std::min(2 * i + 1, kSamples)) / kSamples);
+    return out;
+  }();
+  // Derivatives' coefficients in u, each in both halves of a pair, so that
+  // the loop below multiplies by them without first spreading them.
+  Pair a1[D][5], a2[D][4], a3[D][3];
   for (int k = 0; k < D; ++k) {
     a1[k][0] = q.c[1][k], a1[k][1] = 2 * q.c[2][k], a1[k][2] = 3 * q.c[3][k], a1[k][3] = 4 * q.c[4][k];
     a1[k][4] = 5 * q.c[5][k];
@@ -122,8 +129,7 @@ void sampleBlendDemand(const QuinticCurve &q, AxisDemand &d) {
   Pair m1[D], m2[D], m3[D];
   for (int k = 0; k < D; ++k)
     m1[k] = m2[k] = m3[k] = Pair::Zero();
-  for (int i = 0; i <= kSamples; i += 2) {
-    const Pair t(double(i) / kSamples, double(std::min(i + 1, kSamples)) / kSamples);
+  for (const Pair &t : ts) {
     Pair d1[D], d2[D], d3[D];
     Pair q2 = Pair::Zero(), d12 = Pair::Zero(), d22 = Pair::Zero(), d13 = Pair::Zero();
     for (int k = 0; k < D; ++k) {
