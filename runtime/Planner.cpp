@@ -90,6 +90,28 @@ struct Piece {
 constexpr int kDeviationSamples = 24;
 struct DeviationPoints {
   std::array<double, kDeviationSamples> x, y, z;
+
+  /// The blend's points, as QuinticCurve::point gives them (the same
+  /// operations on each coordinate), a coordinate at a time so that the
+  /// compiler evaluates two points at once.
+  explicit DeviationPoints(const std::array<Vec3, 6> &ctrl) {
+    static constexpr std::array<double, kDeviationSamples> u = [] {
+      std::array<double, kDeviationSamples> out{};
+      for (int i = 0; i < kDeviationSamples; ++i)
+        out[i] = double(std::min(i + 1, kDeviationSamples - 1)) / kDeviationSamples;
+      return out;
+    }();
+    const QuinticCurve curve(ctrl);
+    auto coordinate = [&](int k, std::array<double, kDeviationSamples> &out) {
+      const double c0 = curve.c[0][k], c1 = curve.c[1][k], c2 = curve.c[2][k], c3 = curve.c[3][k],
+                   c4 = curve.c[4][k], c5 = curve.c[5][k];
+      for (int i = 0; i < kDeviationSamples; ++i)
+        out[i] = ((((c5 * u[i] + c4) * u[i] + c3) * u[i] + c2) * u[i] + c1) * u[i] + c0;
+    };
+    coordinate(0, x);
+    coordinate(1, y);
+    coordinate(2, z);
+  }
 };
 
 /// The part [s0, s1] of a line or arc, for the squared distances of many
@@ -104,9 +126,10 @@ class PartDistance {
 public:
   using Squares = std::array<double, kDeviationSamples>;
 
-  PartDistance(const Segment &seg, double s0, double s1) {
-    first_ = seg.at(s0).p;
-    last_ = seg.at(s1).p;
+  /// `first` and `last` are seg.at(s0).p and seg.at(s1).p, which the
+  /// callers have at hand (the blend's ends, the pieces' ends).
+  PartDistance(const Segment &seg, double s0, double s1, const Vec3 &first, const Vec3 &last)
+      : first_(first), last_(last) {
     if (seg.kind == SegmentKind::Line) {
       dir_ = seg.length > 0 ? Vec3((seg.end - seg.start) / seg.length) : Vec3::Zero();
       span_ = s1 - s0;
@@ -213,20 +236,15 @@ std::array<Vec3, 6> blendPoints(const Segment &a, double la, const Segment &b, d
 }
 
 /// How far a blend strays from the two pieces it replaces (sampled along
-/// its parameter: no arc-length inversion needed to find the worst point).
-double blendDeviation(const std::array<Vec3, 6> &ctrl, const Segment &a, double la, const Segment &b, double lb) {
-  const QuinticCurve curve(ctrl);
-  DeviationPoints pts;
-  for (size_t i = 0; i < kDeviationSamples; ++i) {
-    const double u = double(std::min<size_t>(i + 1, kDeviationSamples - 1)) / kDeviationSamples;
-    const Vec3 p = curve.point(u);
-    pts.x[i] = p.x();
-    pts.y[i] = p.y();
-    pts.z[i] = p.z();
-  }
+/// its parameter: no arc-length inversion needed to find the worst point):
+/// the blend from a's point at a.length - la to b's at lb, which are ctrl's
+/// ends, and b's start `bStart` (b.at(0).p).
+double blendDeviation(const std::array<Vec3, 6> &ctrl, const Segment &a, double la, const Segment &b, double lb,
+                      const Vec3 &bStart) {
+  const DeviationPoints pts(ctrl);
   PartDistance::Squares toA, toB;
-  PartDistance(a, a.length - la, a.length).squares(pts, toA);
-  PartDistance(b, 0, lb).squares(pts, toB);
+  PartDistance(a, a.length - la, a.length, ctrl[0], a.end).squares(pts, toA);
+  PartDistance(b, 0, lb, bStart, ctrl[5]).squares(pts, toB);
   double worst = 0;
   for (size_t i = 0; i < kDeviationSamples; ++i)
     worst = std::max(worst, std::min(toA[i], toB[i]));
@@ -266,7 +284,7 @@ void join(Piece &a, const Segment &sa, Piece &b, const Segment &sb, double toler
     // and the same shape at every size: its deviation is its middle's
     // distance from the lines, proportional to l.
     const QuinticCurve curve(blendPoints(sa, l, sb, l));
-    const Vec3 mid = curve.point(0.5), dir = sa.at(0).r1;
+    const Vec3 mid = curve.point(0.5), &dir = ea.r1;  // a line's direction, as at(0) would give it
     const Vec3 off = mid - sa.end;
     const double dev = (off - dir * off.dot(dir)).norm();
     if (dev > target)
@@ -279,7 +297,7 @@ void join(Piece &a, const Segment &sa, Piece &b, const Segment &sb, double toler
   double lastL = 0, lastDev = 0;
   for (int it = 0; it < 40 && l >= kTinyBlend; ++it) {
     const std::array<Vec3, 6> ctrl = blendPoints(sa, l, sb, l);
-    const double dev = blendDeviation(ctrl, sa, l, sb, l);
+    const double dev = blendDeviation(ctrl, sa, l, sb, l, bs.p);
     if (dev <= target) {
       blendHere();
       return;
@@ -413,7 +431,7 @@ void smoothChains(const PathInput &input, std::vector<Piece> &pieces, double tol
       if (!a.hasMidCurvature && !b.hasMidCurvature)
         continue;  // zero-curvature ends again: the blend join() made and checked
       const Segment sa = a.segment(input), sb = b.segment(input);
-      if (blendDeviation(blendBetween(a, sa, b, sb), sa, a.cutEnd, sb, b.cutStart) <= target)
+      if (blendDeviation(blendBetween(a, sa, b, sb), sa, a.cutEnd, sb, b.cutStart, sb.at(0).p) <= target)
         continue;
       // Back to zero curvature at both ends; the blends across those
       // middles are made again to match.
