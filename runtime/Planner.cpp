@@ -578,10 +578,14 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   std::vector<double> vj(m + 1, 0.0);
   for (size_t r = 1; r < m; ++r)
     vj[r] = out.info[runs[r].first].stop != StopReason::None ? 0 : std::min(runs[r - 1].limits.v, runs[r].limits.v);
+  // reachableSpeed(v, ...) is at least v: a bound no higher than that
+  // speed keeps its value without it.
   for (size_t r = m; r-- > 0;)
-    vj[r] = std::min(vj[r], reachableSpeed(vj[r + 1], runs[r].length, runs[r].limits.a, runs[r].limits.j));
+    if (vj[r] > vj[r + 1])
+      vj[r] = std::min(vj[r], reachableSpeed(vj[r + 1], runs[r].length, runs[r].limits.a, runs[r].limits.j));
   for (size_t r = 0; r < m; ++r)
-    vj[r + 1] = std::min(vj[r + 1], reachableSpeed(vj[r], runs[r].length, runs[r].limits.a, runs[r].limits.j));
+    if (vj[r + 1] > vj[r])
+      vj[r + 1] = std::min(vj[r + 1], reachableSpeed(vj[r], runs[r].length, runs[r].limits.a, runs[r].limits.j));
 
   // 6. Profiles: one per run, cut at its members' ends.
   out.profiles.reserve(n);

@@ -185,23 +185,27 @@ Profile planProfile(double v0, double v1, double length, const PathLimits &limit
     // Highest peak whose rise and fall fit: distance(vp) grows with vp.
     // Newton from below inside a shrinking bracket; `lo` always fits, so
     // the cruise below makes up any remainder and the length is exact.
-    // d/dvp of one ramp's distance (v + vp)/2 T(vp - v).
-    auto slope = [&](double v, double x) {
+    // The distance and its slope d/dx both come from each ramp's time
+    // T(|x - v|), computed once per side: rampDistance's (v + x)/2 T, and
+    // T/2 + (v + x)/2 dT/dx where x > v (0 elsewhere).
+    const double dvFull = a * a / j;
+    auto slope = [&](double v, double x, double time) {
       const double dv = x - v;
       if (dv <= 0)
-        return rampTime(0, a, j) / 2;
-      const double dT = dv >= a * a / j ? 1 / a : 1 / std::sqrt(j * dv);
-      return rampTime(dv, a, j) / 2 + (v + x) / 2 * dT;
+        return 0.0;
+      const double dT = dv >= dvFull ? 1 / a : 1 / std::sqrt(j * dv);
+      return time / 2 + (v + x) / 2 * dT;
     };
     double lo = low, hi = std::min(vp, reachableSpeed(std::min(v0, v1), length, a, j));
     double x = hi;
     for (int it = 0; it < 60 && hi - lo > 1e-12 * hi; ++it) {
-      const double f = distance(x) - length;
+      const double rise = rampTime(std::abs(x - v0), a, j), fall = rampTime(std::abs(x - v1), a, j);
+      const double f = ((v0 + x) / 2 * rise + (x + v1) / 2 * fall) - length;
       if (f <= 0)
         lo = x;
       else
         hi = x;
-      const double df = slope(v0, x) + slope(v1, x);
+      const double df = slope(v0, x, rise) + slope(v1, x, fall);
       double next = df > 0 ? x - f / df : (lo + hi) / 2;
       if (!(next > lo && next < hi))
         next = (lo + hi) / 2;
