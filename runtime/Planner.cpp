@@ -338,8 +338,13 @@ void limitsFor(const Segment &seg, double feed, const Machine &machine, SegmentI
       cap(ax.velocity / 60 / d.r1[k], SpeedLimit::AxisVelocity);
     if (d.r2[k] > 0)
       cap(std::sqrt(kCurveAccel * ax.acceleration / d.r2[k]), SpeedLimit::Acceleration);
-    if (d.r3[k] > 0)
-      cap(std::cbrt(kCurveJerk * ax.jerk / d.r3[k]), SpeedLimit::Jerk);
+    if (d.r3[k] > 0) {
+      // The cube root only where it may be the lower: above (1 + 1e-12) v^3
+      // its root exceeds v by far more than cbrt's and the cube's rounding.
+      const double jerkRoom = kCurveJerk * ax.jerk / d.r3[k];
+      if (!(jerkRoom > v * v * v * (1 + 1e-12)))
+        cap(std::cbrt(jerkRoom), SpeedLimit::Jerk);
+    }
   }
   double a = kInf, jerk = kInf;
   for (size_t k = 0; k < n; ++k) {
