@@ -2,6 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <limits>
+#include <type_traits>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace stepnc::runtime {
 
@@ -59,10 +66,11 @@ bool inPlaneZ(const QuinticCurve &q) {
 /// The arc-length table of a blend: five-point Gauss-Legendre on each of the
 /// kBlendTable intervals, as QuinticCurve::length computes it (same points,
 /// same operations in the same order, so the same bits), all 40 speeds in
-/// one loop that the compiler can evaluate two at a time. D = 2 leaves out z
-/// when it is zero.
+/// one loop that the compiler evaluates two or (in the AVX clone) four at a
+/// time. D = 2 leaves out z when it is zero.
 template <int D>
-void blendArcTable(const QuinticCurve &q, std::array<double, Segment::kBlendTable + 1> &table) {
+[[gnu::always_inline]] inline void blendArcTable(const QuinticCurve &q,
+                                                 std::array<double, Segment::kBlendTable + 1> &table) {
   constexpr size_t kIntervals = Segment::kBlendTable, kNodes = kGaussX.size(), kPoints = kNodes * kIntervals;
   // u of node i in interval j at i * kIntervals + j, computed as
   // QuinticCurve::length computes it.
@@ -102,36 +110,77 @@ void blendArcTable(const QuinticCurve &q, std::array<double, Segment::kBlendTabl
   }
 }
 
+/// Two or four doubles in the compiler's generic vectors: one SSE2 or AVX
+/// register. The kernels below take four at a time in their versions for
+/// processors with AVX and two elsewhere, with the same IEEE operations on
+/// each element (no fused multiply-add: no version enables it), so that both
+/// give the same bits.
+using Pair = double __attribute__((vector_size(16)));
+using Quad = double __attribute__((vector_size(32)));
+/// Their bits, as integers.
+using PairBits = int64_t __attribute__((vector_size(16)));
+using QuadBits = int64_t __attribute__((vector_size(32)));
+
+/// m = max(m, |x|) element by element, as std::max and std::abs give them
+/// (|x| by clearing the sign bit).
+template <class V>
+[[gnu::always_inline]] inline void raiseToAbs(V &m, const V &x) {
+  using Bits = std::conditional_t<sizeof(V) == sizeof(Pair), PairBits, QuadBits>;
+  constexpr int64_t kMagnitude = std::numeric_limits<int64_t>::max();
+  const V a = V(Bits(x) & kMagnitude);
+  m = m < a ? a : m;
+}
+
+/// The square roots of the elements, correctly rounded as std::sqrt gives
+/// them: two at a time with SSE2, which every x86-64 has; else one at a time
+/// (generic vectors have no square root).
+template <class V>
+[[gnu::always_inline]] inline void squareRoots(const V &x, V &root) {
+#if defined(__SSE2__)
+  if constexpr (sizeof(V) == sizeof(Pair)) {
+    root = _mm_sqrt_pd(x);
+  } else {
+    const __m128d lo = _mm_sqrt_pd(__builtin_shufflevector(x, x, 0, 1));
+    const __m128d hi = _mm_sqrt_pd(__builtin_shufflevector(x, x, 2, 3));
+    root = __builtin_shufflevector(lo, hi, 0, 1, 2, 3);
+  }
+#else
+  for (size_t l = 0; l < sizeof(V) / sizeof(double); ++l)
+    root[l] = std::sqrt(x[l]);
+#endif
+}
+
 /// The blend's largest |r1|, |r2|, |r3| per axis over the samples u = i / 32,
 /// i = 0..32 (fromParameter's formulas, with one division per sample instead
-/// of many; the results agree to rounding). Two samples at a time in one
-/// Eigen::Array2d (one vector register where there are any; the last pair
-/// takes u = 1 twice). D = 2 leaves out z when it is zero.
-template <int D>
-void sampleBlendDemand(const QuinticCurve &q, AxisDemand &d) {
-  using Pair = Eigen::Array2d;
-  static constexpr int kSamples = 32, kPairs = kSamples / 2 + 1;
-  static const std::array<Pair, kPairs> ts = [] {
-    std::array<Pair, kPairs> out;
-    for (int i = 0; i < kPairs; ++i)
-      out[i] = Pair(double(2 * i) / kSamples, double(std::min(2 * i + 1, kSamples)) / kSamples);
+/// of many; the results agree to rounding), as many samples at a time as V
+/// holds (the last group takes u = 1 again). D = 2 leaves out z when it is
+/// zero.
+template <int D, class V>
+[[gnu::always_inline]] inline void sampleBlendDemand(const QuinticCurve &q, AxisDemand &d) {
+  static constexpr int kSamples = 32, kLanes = sizeof(V) / sizeof(double), kGroups = kSamples / kLanes + 1;
+  static constexpr std::array<double, kLanes * kGroups> ts = [] {
+    std::array<double, kLanes * kGroups> out{};
+    for (int i = 0; i < kLanes * kGroups; ++i)
+      out[i] = double(std::min(i, kSamples)) / kSamples;
     return out;
   }();
-  // Derivatives' coefficients in u, each in both halves of a pair, so that
-  // the loop below multiplies by them without first spreading them.
-  Pair a1[D][5], a2[D][4], a3[D][3];
+  // Derivatives' coefficients in u.
+  double a1[D][5], a2[D][4], a3[D][3];
   for (int k = 0; k < D; ++k) {
     a1[k][0] = q.c[1][k], a1[k][1] = 2 * q.c[2][k], a1[k][2] = 3 * q.c[3][k], a1[k][3] = 4 * q.c[4][k];
     a1[k][4] = 5 * q.c[5][k];
     a2[k][0] = 2 * q.c[2][k], a2[k][1] = 6 * q.c[3][k], a2[k][2] = 12 * q.c[4][k], a2[k][3] = 20 * q.c[5][k];
     a3[k][0] = 6 * q.c[3][k], a3[k][1] = 24 * q.c[4][k], a3[k][2] = 60 * q.c[5][k];
   }
-  Pair m1[D], m2[D], m3[D];
+  const V zero{};
+  V m1[D], m2[D], m3[D];
   for (int k = 0; k < D; ++k)
-    m1[k] = m2[k] = m3[k] = Pair::Zero();
-  for (const Pair &t : ts) {
-    Pair d1[D], d2[D], d3[D];
-    Pair q2 = Pair::Zero(), d12 = Pair::Zero(), d22 = Pair::Zero(), d13 = Pair::Zero();
+    m1[k] = m2[k] = m3[k] = zero;
+  for (int i = 0; i < kGroups; ++i) {
+    V t;
+    std::memcpy(&t, &ts[kLanes * i], sizeof t);
+    V d1[D], d2[D], d3[D];
+    V q2 = zero, d12 = zero, d22 = zero, d13 = zero;
     for (int k = 0; k < D; ++k) {
       d1[k] = (((a1[k][4] * t + a1[k][3]) * t + a1[k][2]) * t + a1[k][1]) * t + a1[k][0];
       d2[k] = ((a2[k][3] * t + a2[k][2]) * t + a2[k][1]) * t + a2[k][0];
@@ -144,22 +193,73 @@ void sampleBlendDemand(const QuinticCurve &q, AxisDemand &d) {
     // With q = |d1|: r1 = d1 / q, r2 = (d2 - d1 d12 / q^2) / q^2 and
     // r3 = d3 / q^3 - d2 3 d12 / q^5 - d1 ((d22 + d13) / q^5 - 4 d12^2 / q^7);
     // where q = 0 fromParameter gives zeros, and so do these with 1/q := 0.
-    const Pair iq = (q2 > 0).select(q2.sqrt().inverse(), Pair::Zero());
-    const Pair iq2 = iq * iq, iq5 = iq2 * iq2 * iq;
-    const Pair b2 = d12 * iq2;
-    const Pair e3 = iq2 * iq, f3 = 3 * d12 * iq5, g3 = (d22 + d13) * iq5 - 4 * d12 * d12 * iq5 * iq2;
+    V speed;
+    squareRoots(q2, speed);
+    const V iq = q2 > 0 ? 1 / speed : zero;
+    const V iq2 = iq * iq, iq5 = iq2 * iq2 * iq;
+    const V b2 = d12 * iq2;
+    const V e3 = iq2 * iq, f3 = 3 * d12 * iq5, g3 = (d22 + d13) * iq5 - 4 * d12 * d12 * iq5 * iq2;
     for (int k = 0; k < D; ++k) {
-      m1[k] = m1[k].max((d1[k] * iq).abs());
-      m2[k] = m2[k].max(((d2[k] - d1[k] * b2) * iq2).abs());
-      m3[k] = m3[k].max((e3 * d3[k] - f3 * d2[k] - g3 * d1[k]).abs());
+      raiseToAbs(m1[k], d1[k] * iq);
+      raiseToAbs(m2[k], (d2[k] - d1[k] * b2) * iq2);
+      raiseToAbs(m3[k], e3 * d3[k] - f3 * d2[k] - g3 * d1[k]);
     }
   }
+  // All lanes hold values >= +0 and no NaN (a NaN never raises m): their
+  // largest, whatever the order.
   for (int k = 0; k < D; ++k) {
-    d.r1[k] = m1[k].maxCoeff();
-    d.r2[k] = m2[k].maxCoeff();
-    d.r3[k] = m3[k].maxCoeff();
+    d.r1[k] = d.r2[k] = d.r3[k] = 0;
+    for (int l = 0; l < kLanes; ++l) {
+      d.r1[k] = std::max(d.r1[k], m1[k][l]);
+      d.r2[k] = std::max(d.r2[k], m2[k][l]);
+      d.r3[k] = std::max(d.r3[k], m3[k][l]);
+    }
   }
 }
+
+// The blend kernels in two versions on x86-64 (GCC's function
+// multiversioning picks one when the program starts): for processors with
+// AVX and for the rest.
+#if defined(__GNUC__) && defined(__x86_64__) && defined(__ELF__)
+#define STEPNC_MULTIVERSIONED 1
+#endif
+
+#if STEPNC_MULTIVERSIONED
+__attribute__((target("default")))
+#endif
+void blendArcTable(const QuinticCurve &q, std::array<double, Segment::kBlendTable + 1> &table) {
+  if (inPlaneZ(q))
+    blendArcTable<2>(q, table);
+  else
+    blendArcTable<3>(q, table);
+}
+
+#if STEPNC_MULTIVERSIONED
+__attribute__((target("default")))
+#endif
+void sampleBlendDemand(const QuinticCurve &q, AxisDemand &d) {
+  if (inPlaneZ(q))
+    sampleBlendDemand<2, Pair>(q, d);
+  else
+    sampleBlendDemand<3, Pair>(q, d);
+}
+
+#if STEPNC_MULTIVERSIONED
+__attribute__((target("avx"))) void blendArcTable(const QuinticCurve &q,
+                                                  std::array<double, Segment::kBlendTable + 1> &table) {
+  if (inPlaneZ(q))
+    blendArcTable<2>(q, table);
+  else
+    blendArcTable<3>(q, table);
+}
+
+__attribute__((target("avx"))) void sampleBlendDemand(const QuinticCurve &q, AxisDemand &d) {
+  if (inPlaneZ(q))
+    sampleBlendDemand<2, Quad>(q, d);
+  else
+    sampleBlendDemand<3, Quad>(q, d);
+}
+#endif
 
 } // namespace
 
@@ -238,11 +338,7 @@ Segment Segment::blend(const std::array<Vec3, 6> &ctrl) {
   s.ctrl = ctrl;
   s.start = ctrl[0];
   s.end = ctrl[5];
-  const QuinticCurve q(ctrl);
-  if (inPlaneZ(q))
-    blendArcTable<2>(q, s.arcTable);
-  else
-    blendArcTable<3>(q, s.arcTable);
+  blendArcTable(QuinticCurve(ctrl), s.arcTable);
   s.length = s.arcTable[kBlendTable];
   return s;
 }
@@ -319,11 +415,7 @@ AxisDemand Segment::demand() const {
   case SegmentKind::Blend: {
     // Sampled densely in u; a quintic's derivatives vary smoothly, and the
     // margin covers what lies between samples.
-    const QuinticCurve q(ctrl);
-    if (inPlaneZ(q))
-      sampleBlendDemand<2>(q, d);
-    else
-      sampleBlendDemand<3>(q, d);
+    sampleBlendDemand(QuinticCurve(ctrl), d);
     constexpr double kMargin = 1.1;
     d.r1 = (d.r1 * kMargin).cwiseMin(Vec3::Ones());
     d.r2 *= kMargin;
