@@ -4,8 +4,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numbers>
+
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 namespace stepnc::runtime {
 
@@ -315,6 +320,25 @@ void join(Piece &a, const Segment &sa, Piece &b, const Segment &sb, double toler
   b.stopReason = StopReason::Tiny;
 }
 
+/// Asks the kernel to back a freshly reserved output array with huge pages
+/// where it can (Linux's transparent huge pages, on request): the planner
+/// writes it once from front to back, and with 4 KiB pages a long plan
+/// spends about a sixth of its time in page faults for its output (a page
+/// fault per 12 segments). Only a hint: where it is not taken, nothing
+/// changes but the time.
+template <class T>
+void preferHugePages(const std::vector<T> &v) {
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  constexpr uintptr_t kHuge = uintptr_t(1) << 21;
+  const uintptr_t begin = (reinterpret_cast<uintptr_t>(v.data()) + kHuge - 1) & ~(kHuge - 1);
+  const uintptr_t end = reinterpret_cast<uintptr_t>(v.data() + v.capacity()) & ~(kHuge - 1);
+  if (end > begin)
+    madvise(reinterpret_cast<void *>(begin), end - begin, MADV_HUGEPAGE);
+#else
+  (void)v;
+#endif
+}
+
 /// The speed cap and the path acceleration and jerk for one segment.
 void limitsFor(const Segment &seg, double feed, const Machine &machine, SegmentInfo &info) {
   const AxisDemand d = seg.demand();
@@ -500,6 +524,8 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
     count += size_t(p.blendBefore) + size_t(p.keepsMiddle());
   out.segments.reserve(count);
   out.info.reserve(count);
+  preferHugePages(out.segments);
+  preferHugePages(out.info);
   auto push = [&](double feed, uint32_t move, uint32_t next, StopReason stop) {
     SegmentInfo &info = out.info.emplace_back();
     info.feed = feed;
@@ -594,6 +620,7 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
 
   // 6. Profiles: one per run, cut at its members' ends.
   out.profiles.reserve(n);
+  preferHugePages(out.profiles);
   for (size_t r = 0; r < m; ++r) {
     const Run &run = runs[r];
     const Profile whole = planProfile(vj[r], vj[r + 1], run.length, run.limits);
