@@ -99,7 +99,7 @@ struct DeviationPoints {
   /// The blend's points, as QuinticCurve::point gives them (the same
   /// operations on each coordinate), a coordinate at a time so that the
   /// compiler evaluates two points at once.
-  explicit DeviationPoints(const std::array<Vec3, 6> &ctrl) {
+  [[gnu::always_inline]] explicit DeviationPoints(const std::array<Vec3, 6> &ctrl) {
     static constexpr std::array<double, kDeviationSamples> u = [] {
       std::array<double, kDeviationSamples> out{};
       for (int i = 0; i < kDeviationSamples; ++i)
@@ -107,15 +107,14 @@ struct DeviationPoints {
       return out;
     }();
     const QuinticCurve curve(ctrl);
-    auto coordinate = [&](int k, std::array<double, kDeviationSamples> &out) {
+    std::array<double, kDeviationSamples> *coordinates[3] = {&x, &y, &z};
+    for (int k = 0; k < 3; ++k) {
       const double c0 = curve.c[0][k], c1 = curve.c[1][k], c2 = curve.c[2][k], c3 = curve.c[3][k],
                    c4 = curve.c[4][k], c5 = curve.c[5][k];
+      std::array<double, kDeviationSamples> &out = *coordinates[k];
       for (int i = 0; i < kDeviationSamples; ++i)
         out[i] = ((((c5 * u[i] + c4) * u[i] + c3) * u[i] + c2) * u[i] + c1) * u[i] + c0;
-    };
-    coordinate(0, x);
-    coordinate(1, y);
-    coordinate(2, z);
+    }
   }
 };
 
@@ -162,7 +161,7 @@ public:
   }
 
   /// The squared distance of each point.
-  void squares(const DeviationPoints &pts, Squares &out) const {
+  [[gnu::always_inline]] void squares(const DeviationPoints &pts, Squares &out) const {
     constexpr size_t n = kDeviationSamples;
     switch (kind_) {
     case Kind::Line:
@@ -244,8 +243,8 @@ std::array<Vec3, 6> blendPoints(const Segment &a, double la, const Segment &b, d
 /// its parameter: no arc-length inversion needed to find the worst point):
 /// the blend from a's point at a.length - la to b's at lb, which are ctrl's
 /// ends, and b's start `bStart` (b.at(0).p).
-double blendDeviation(const std::array<Vec3, 6> &ctrl, const Segment &a, double la, const Segment &b, double lb,
-                      const Vec3 &bStart) {
+[[gnu::always_inline]] inline double blendDeviationOf(const std::array<Vec3, 6> &ctrl, const Segment &a, double la,
+                                                      const Segment &b, double lb, const Vec3 &bStart) {
   const DeviationPoints pts(ctrl);
   PartDistance::Squares toA, toB;
   PartDistance(a, a.length - la, a.length, ctrl[0], a.end).squares(pts, toA);
@@ -255,6 +254,26 @@ double blendDeviation(const std::array<Vec3, 6> &ctrl, const Segment &a, double 
     worst = std::max(worst, std::min(toA[i], toB[i]));
   return std::sqrt(worst);
 }
+
+// In two versions on x86-64 (GCC's function multiversioning picks one when
+// the program starts), as Segment.cpp's blend kernels: the compiler takes
+// four sample points at a time in the one for processors with AVX, two in
+// the other, with the same operations on each (the same bits).
+#if defined(__GNUC__) && defined(__x86_64__) && defined(__ELF__)
+__attribute__((target("default"))) double blendDeviation(const std::array<Vec3, 6> &ctrl, const Segment &a, double la,
+                                                         const Segment &b, double lb, const Vec3 &bStart) {
+  return blendDeviationOf(ctrl, a, la, b, lb, bStart);
+}
+__attribute__((target("avx"))) double blendDeviation(const std::array<Vec3, 6> &ctrl, const Segment &a, double la,
+                                                     const Segment &b, double lb, const Vec3 &bStart) {
+  return blendDeviationOf(ctrl, a, la, b, lb, bStart);
+}
+#else
+double blendDeviation(const std::array<Vec3, 6> &ctrl, const Segment &a, double la, const Segment &b, double lb,
+                      const Vec3 &bStart) {
+  return blendDeviationOf(ctrl, a, la, b, lb, bStart);
+}
+#endif
 
 /// Decides how pieces a and b (whose segments are sa and sb) meet: smoothly,
 /// through a blend (b.blendBefore, with a.cutEnd and b.cutStart), or at rest
