@@ -74,9 +74,10 @@ struct Piece {
   const Vec3 &from(const PathInput &input) const { return move == 0 ? input.start : input.moves[move - 1].to; }
   const Vec3 &to(const PathInput &input) const { return input.moves[move].to; }
 
-  /// The move's segment, as Segment::line or Segment::arcTurns made it.
-  Segment segment(const PathInput &input) const {
-    Segment s;
+  /// The move's segment, as Segment::line or Segment::arcTurns made it,
+  /// written into s (whose blend fields stay as they are: the steps below
+  /// reuse two segments instead of making and copying one per piece).
+  void segment(const PathInput &input, Segment &s) const {
     s.kind = kind;
     s.start = from(input);
     s.end = to(input);
@@ -86,7 +87,6 @@ struct Piece {
     s.startAngle = startAngle;
     s.sweep = sweep;
     s.ccw = ccw;
-    return s;
   }
 };
 
@@ -469,6 +469,7 @@ void smoothChains(const PathInput &input, std::vector<Piece> &pieces, double tol
   std::vector<char> pending(n, 0);
   for (size_t j = 1; j < n; ++j)
     pending[j] = pieces[j].blendBefore && (pieces[j - 1].hasMidCurvature || pieces[j].hasMidCurvature);
+  Segment sa, sb;
   for (bool again = true; again;) {
     again = false;
     for (size_t j = 1; j < n; ++j) {
@@ -478,7 +479,8 @@ void smoothChains(const PathInput &input, std::vector<Piece> &pieces, double tol
       Piece &a = pieces[j - 1], &b = pieces[j];
       if (!a.hasMidCurvature && !b.hasMidCurvature)
         continue;  // zero-curvature ends again: the blend join() made and checked
-      const Segment sa = a.segment(input), sb = b.segment(input);
+      a.segment(input, sa);
+      b.segment(input, sb);
       if (blendDeviation(blendBetween(a, sa, b, sb), sa, a.cutEnd, sb, b.cutStart, sb.at(0).p) <= target)
         continue;
       // Back to zero curvature at both ends; the blends across those
@@ -527,12 +529,11 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
 
   // 2. Junctions: blends or stops.
   {
-    Segment before, here;
+    Segment segments[2];  // piece i's in segments[i % 2]
     for (size_t i = 0; i < pieces.size(); ++i) {
-      before = here;
-      here = pieces[i].segment(input);
+      pieces[i].segment(input, segments[i % 2]);
       if (i > 0)
-        join(pieces[i - 1], before, pieces[i], here, tolerance);
+        join(pieces[i - 1], segments[(i - 1) % 2], pieces[i], segments[i % 2], tolerance);
     }
   }
   smoothChains(input, pieces, tolerance);
@@ -555,11 +556,11 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   };
   StopReason stop = StopReason::Start;
   {
-    Segment before, here;
+    Segment segments[2];  // piece i's in segments[i % 2]
     for (size_t i = 0; i < pieces.size(); ++i) {
       const Piece &p = pieces[i];
-      before = here;
-      here = p.segment(input);
+      const Segment &before = segments[(i + 1) % 2], &here = segments[i % 2];
+      p.segment(input, segments[i % 2]);
       if (i > 0) {
         if (p.stopReason != StopReason::None)
           stop = p.stopReason;
