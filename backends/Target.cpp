@@ -16,7 +16,7 @@ bool parseInt(const std::string &text, long lo, long hi, long &out) {
 
 std::string overrideHelp() {
   return "decimals=N (coordinates, 0..6), line-numbers=none|every, number-step=N, "
-         "max-line-length=N (0: none), arcs=ijk|radius, cycles=on|off";
+         "max-line-length=N (0: none), arcs=ijk|radius, cycles=on|off, splines=on|off";
 }
 
 std::string applyOverrides(TargetDescriptor &d, const std::vector<std::string> &overrides) {
@@ -43,6 +43,11 @@ std::string applyOverrides(TargetDescriptor &d, const std::vector<std::string> &
     } else if (key == "cycles" && (value == "on" || value == "off")) {
       if (value == "off")
         d.cycles.clear();
+    } else if (key == "splines" && (value == "on" || value == "off")) {
+      if (value == "on" && d.splines == SplineForm::None)
+        return "--target-opt splines: " + d.name + " has no spline blocks stepnc writes; smooth runs stay lines";
+      if (value == "off")
+        d.splines = SplineForm::None;
     } else {
       return "--target-opt '" + o + "' is not understood (" + overrideHelp() + ")";
     }

@@ -24,6 +24,14 @@ enum class Numbering {
   FromZero,  ///< 0, 1, 2, ... on every line (Heidenhain)
 };
 
+/// How a run of lines that are chords of one smooth curve (toolpath IR
+/// `smooth`, e.g. a trochoid) is written.
+enum class SplineForm {
+  None,          ///< as the lines
+  CubicBezier,   ///< one cubic Bézier block per line, the C2 spline through the points (LinuxCNC G5 X Y I J P Q)
+  Interpolating, ///< the points in the controller's cubic spline mode, C2 through them (840D CSPLINE)
+};
+
 /// Canned cycles a controller has, by what they do.
 enum class CycleKind { Drill, Peck, Bore, Tap };
 
@@ -35,6 +43,7 @@ struct TargetDescriptor {
   bool helix = true;         ///< helical arcs (a z change along an arc) in one block
   bool helixTurns = true;    ///< several turns of a helix in one block
   std::set<CycleKind> cycles;  ///< canned cycles used when they reproduce the planned moves
+  SplineForm splines = SplineForm::None;
   Numbering numbering = Numbering::None;
   int numberStep = 10;
   size_t maxLineLength = 0;  ///< 0: no limit
@@ -46,8 +55,8 @@ struct TargetDescriptor {
 
 /// Applies `key=value` overrides (--target-opt) to a descriptor: decimals,
 /// line-numbers (none|every), number-step, max-line-length, arcs
-/// (ijk|radius), cycles (on|off). Returns an error message, or "" when all
-/// applied.
+/// (ijk|radius), cycles (on|off), splines (on|off). Returns an error
+/// message, or "" when all applied.
 std::string applyOverrides(TargetDescriptor &d, const std::vector<std::string> &overrides);
 
 /// The overrides applyOverrides understands, one per line, for --help.

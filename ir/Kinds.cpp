@@ -313,8 +313,16 @@ std::vector<KindSpec> makeTable() {
   // take the bent tool (docs/deflection-compensation.md); `nominal_center`:
   // the centre of the arc it is predicted to follow, where the programmed
   // arc's is moved (the offset changes along it).
+  // `smooth`: the line is a chord of a curvature-continuous curve through
+  // its end points (a trochoid, docs/pattern-strategies.md), as are its
+  // neighbours marked so; a target with splines may write the run of them
+  // as a spline through the same points.
   add({"linear", "move", Sigil::None, false,
-       {{"to", T::Point, true}, {"feed", T::Feed, true}, {"role", T::Word, false, roles}, {"nominal", T::Point}},
+       {{"to", T::Point, true},
+        {"feed", T::Feed, true},
+        {"role", T::Word, false, roles},
+        {"nominal", T::Point},
+        {"smooth", T::Flag}},
        {}});
   add({"arc", "move", Sigil::None, false,
        {{"to", T::Point, true},

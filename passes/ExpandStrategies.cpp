@@ -77,13 +77,16 @@ public:
     positioned_ = true;
   }
 
-  void linear(const Vec3 &to, double feed, const char *role) {
+  /// `smooth`: a chord of a curvature-continuous curve (IR `smooth`).
+  void linear(const Vec3 &to, double feed, const char *role, bool smooth = false) {
     if ((to - pos_).norm() <= geom::kEps)
       return;
     Node &m = moves_.add(Node("linear"));
     m.set("to", Value::point(to));
     m.set("feed", Value::feed(feed));
     m.set("role", Value::word(role));
+    if (smooth)
+      m.set("smooth", Value::boolean(true));
     pos_ = to;
   }
 
@@ -1045,7 +1048,7 @@ private:
           e.arc(at(points.front(), z), g.raw(0), motif.ccw, 0, p.plungeFeed, "plunge");
         }
         for (size_t k = 1; k < points.size(); ++k)
-          e.linear(at(points[k], z), p.feed, "cut");
+          e.linear(at(points[k], z), p.feed, "cut", /*smooth=*/true);
       }
       wallPass(e, op, s, p, z, motif.ccw);
     }

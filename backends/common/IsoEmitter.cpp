@@ -1,5 +1,6 @@
 #include "backends/common/IsoEmitter.h"
 
+#include "geom/Spline.h"
 #include "support/Format.h"
 
 #include <cmath>
@@ -68,8 +69,15 @@ std::optional<std::string> IsoEmitter::run(const Program &p) {
           .entity(s.exec->origin.entityId);
       continue;
     }
-    for (const Move &m : s.moves)
-      move(m);
+    for (size_t i = 0; i < s.moves.size();) {
+      const size_t end = smoothRunEnd(s.moves, i);
+      if (end >= i + 2) {
+        spline(s.moves, i, end);
+        i = end;
+      } else {
+        move(s.moves[i++]);
+      }
+    }
   }
   footer(p);
   for (size_t line : out_.overlong())
@@ -153,6 +161,54 @@ void IsoEmitter::move(const Move &m) {
   if (m.kind == Move::Kind::Linear)
     text += feedWord(m.feed);
   out_.block(text);
+}
+
+size_t IsoEmitter::smoothRunEnd(const std::vector<Move> &moves, size_t i) const {
+  if (d_.splines == SplineForm::None)
+    return i;
+  size_t j = i;
+  while (j < moves.size() && moves[j].kind == Move::Kind::Linear && moves[j].smooth &&
+         moves[j].from.z() == moves[i].from.z() && moves[j].to.z() == moves[i].from.z() &&
+         (moves[j].to - moves[j].from).norm() > 1e-9)
+    ++j;
+  return j;
+}
+
+void IsoEmitter::spline(const std::vector<Move> &moves, size_t begin, size_t end) {
+  afterToolChange_ = false;
+  std::vector<geom::Vec2> points{moves[begin].from.head<2>()};
+  for (size_t i = begin; i < end; ++i)
+    points.push_back(moves[i].to.head<2>());
+  if (d_.splines == SplineForm::CubicBezier) {
+    // One G5 per piece: its end, and its two inner control points as offsets
+    // from its start (I J) and from its end (P Q). The curve is the C2 spline
+    // through the points, computed here, so the controller draws exactly it.
+    const std::vector<geom::BezierPiece> pieces = geom::splineThrough(points);
+    for (size_t k = 0; k < pieces.size(); ++k) {
+      const Move &m = moves[begin + k];
+      const geom::Vec2 from = points[k], to = points[k + 1];
+      modal_.change("X", num(to.x()));
+      modal_.change("Y", num(to.y()));
+      const geom::Vec2 ij = pieces[k].c1 - from, pq = pieces[k].c2 - to;
+      modal_.change("G", "G5"); // written on every block: LinuxCNC reads P as G2/G3's turns otherwise
+      out_.block("G5 " + word("X", num(to.x())) + word(" Y", num(to.y())) + word(" I", num(ij.x())) +
+                 word(" J", num(ij.y())) + word(" P", num(pq.x())) + word(" Q", num(pq.y())) + feedWord(m.feed));
+    }
+    return;
+  }
+  // The controller's cubic spline through the points, its ends set by the
+  // first and last points alone (BAUTO EAUTO: the moves before and after
+  // need not be tangent to it); the next straight move selects G1 again.
+  for (size_t i = begin; i < end; ++i) {
+    const Move &m = moves[i];
+    const bool first = i == begin;
+    modal_.change("X", num(m.to.x()));
+    modal_.change("Y", num(m.to.y()));
+    std::string text = first ? "CSPLINE BAUTO EAUTO " : "";
+    text += word("X", num(m.to.x())) + word(" Y", num(m.to.y())) + feedWord(m.feed);
+    out_.block(text);
+  }
+  modal_.change("G", "CSPLINE");
 }
 
 void IsoEmitter::arc(const Move &m) {

@@ -73,6 +73,13 @@ protected:
 
 private:
   void arc(const Move &m);
+  /// Where the run of smooth lines starting at `i` ends (one past its last
+  /// move): lines marked smooth at one height; `i` when the target writes
+  /// no splines or moves[i] is no such line.
+  size_t smoothRunEnd(const std::vector<Move> &moves, size_t i) const;
+  /// moves[begin, end) as a spline through their end points, in the
+  /// descriptor's form.
+  void spline(const std::vector<Move> &moves, size_t begin, size_t end);
   int tool_ = -1;
   bool afterToolChange_ = false;
   double spindle_ = 0;

@@ -165,6 +165,7 @@ private:
                 : m.kind == passes::MoveKind::Arc ? Move::Kind::Arc
                                                   : Move::Kind::Linear;
       mv.feed = m.feed;
+      mv.smooth = mv.kind == Move::Kind::Linear && m.node && m.node->flag("smooth").value_or(false);
       mv.centre = m.center.head<2>();
       mv.ccw = m.ccw;
       mv.turns = m.turns;

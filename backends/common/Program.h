@@ -35,6 +35,7 @@ struct Move {
   bool ccw = false;
   int64_t turns = 0;  ///< arcs: full turns before the last arc (toolpath IR rule)
   double feed = 0;    ///< mm/min; 0 for rapids
+  bool smooth = false;  ///< a line that is a chord of a smooth curve (toolpath IR `smooth`)
   std::string role;
   const ir::Node *node = nullptr;
 

@@ -20,6 +20,7 @@ TargetDescriptor rs274Descriptor() {
   d.helix = true;
   d.helixTurns = true;  // P: number of turns
   d.cycles = {CycleKind::Drill, CycleKind::Peck, CycleKind::Bore, CycleKind::Tap};
+  d.splines = SplineForm::CubicBezier;  // G5
   d.numbering = Numbering::None;
   d.maxLineLength = 254;  // LinuxCNC rejects lines of 255 characters or more
   d.coordDecimals = 4;

@@ -29,6 +29,7 @@ TargetDescriptor siemensDescriptor() {
   d.helix = true;
   d.helixTurns = true;  // TURN=
   d.cycles = {CycleKind::Drill, CycleKind::Peck, CycleKind::Tap};
+  d.splines = SplineForm::Interpolating;  // CSPLINE
   d.numbering = Numbering::None;
   d.maxLineLength = 512;  // conservative: the controller's own limit is not in the sources
   d.coordDecimals = 3;

@@ -12,7 +12,12 @@ one, within 0.001 mm:
   * rapids: a run of consecutive rapids is compared by where it ends (a
     backend may split a rapid, e.g. XY then Z after a tool change);
   * feed moves: end point, and feed rate within the program's rounding;
-  * arcs: end point, centre, direction and number of turns.
+  * arcs: end point, centre, direction and number of turns;
+  * cubic splines (G5, which rs274 reports as NURBS_FEED without
+    coordinates): each NURBS_FEED is matched with its G5 block in the
+    program, in order; its end point is the block's X Y, and the Bézier its
+    I J P Q give must stay within the target's 0.01 mm of the IR's line
+    (the line is a chord of the curve the spline follows).
 Moves that go nowhere are left out on both sides. With canned cycles on,
 the cycles' own rapids are the controller's: only the feed moves must match
 (--cycles); with --no-cycles everything must.
@@ -32,12 +37,22 @@ import toolpath_ir
 
 TOL = 1e-3
 
-CANON_RE = re.compile(r"(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED|SET_FEED_RATE)\(([^)]*)\)")
+CANON_RE = re.compile(r"(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED|SET_FEED_RATE|NURBS_FEED)\(([^)]*)\)")
+G5_RE = re.compile(r"^G5 X(\S+) Y(\S+) I(\S+) J(\S+) P(\S+) Q(\S+)")
+SPLINE_TOL = 0.01
 
 
-def canon_moves(path):
+def g5_blocks(program):
+    """The G5 blocks of a program, in order: (x, y, i, j, p, q)."""
+    with open(program) as f:
+        return [tuple(float(v) for v in m.groups()) for m in (G5_RE.match(line) for line in f) if m]
+
+
+def canon_moves(path, program):
     out = []
     feed = 0.0
+    splines = iter(g5_blocks(program))
+    at = (0.0, 0.0, 0.0)
     with open(path) as f:
         for n, line in enumerate(f, 1):
             m = CANON_RE.search(line)
@@ -46,6 +61,14 @@ def canon_moves(path):
             args = [a.strip() for a in m.group(2).split(",")]
             if m.group(1) == "SET_FEED_RATE":
                 feed = float(args[0])
+                continue
+            if m.group(1) == "NURBS_FEED":
+                x, y, i, j, p, q = next(splines)
+                out.append({"kind": "linear", "to": (x, y, at[2]), "feed": feed,
+                            "bezier": ((at[0], at[1]), (at[0] + i, at[1] + j), (x + p, y + q), (x, y)),
+                            "text": "canon line %d: %s (G5 X%g Y%g I%g J%g P%g Q%g)" % (n, line.strip(), x, y, i, j, p,
+                                                                                       q)})
+                at = out[-1]["to"]
                 continue
             if m.group(1) == "ARC_FEED":
                 e1, e2, c1, c2, turn, e3 = (float(a) for a in args[:6])
@@ -58,7 +81,24 @@ def canon_moves(path):
                 if kind == "linear":
                     move["feed"] = feed
                 out.append(move)
+            at = out[-1]["to"]
     return out
+
+
+def bezier_strays(bezier, a, b):
+    """How far the cubic Bézier strays from the segment a-b (sampled)."""
+    (x0, y0), (x1, y1), (x2, y2), (x3, y3) = bezier
+    dx, dy = b[0] - a[0], b[1] - a[1]
+    length2 = dx * dx + dy * dy
+    worst = 0.0
+    for k in range(1, 16):
+        t = k / 16.0
+        u = 1 - t
+        px = u * u * u * x0 + 3 * u * u * t * x1 + 3 * u * t * t * x2 + t * t * t * x3
+        py = u * u * u * y0 + 3 * u * u * t * y1 + 3 * u * t * t * y2 + t * t * t * y3
+        s = max(0.0, min(1.0, ((px - a[0]) * dx + (py - a[1]) * dy) / length2)) if length2 > 0 else 0.0
+        worst = max(worst, ((px - a[0] - s * dx) ** 2 + (py - a[1] - s * dy) ** 2) ** 0.5)
+    return worst
 
 
 def close(a, b):
@@ -97,6 +137,8 @@ def compare(ir, canon, feeds_only, feed_tol):
         elif x["kind"] == "arc" and (not close(x["centre"], y["centre"]) or x["ccw"] != y["ccw"]
                                      or x["turns"] != y["turns"]):
             why = "arc centre, direction or turns differ"
+        elif "bezier" in y and i > 0 and bezier_strays(y["bezier"], a[i - 1]["to"], x["to"]) > SPLINE_TOL:
+            why = "the spline strays %.4f mm from the line" % bezier_strays(y["bezier"], a[i - 1]["to"], x["to"])
         if why:
             problems.append("move %d: %s\n    IR:    %s\n    %s" % (i + 1, why, x["text"], y["text"]))
             if len(problems) >= 5:
@@ -150,7 +192,7 @@ def check(stepnc, path, cycles, extra, workdir, program=None):
                  canon_path], cwd=workdir, stdin=subprocess.DEVNULL)
     if r.returncode != 0:
         return ["rs274 rejected the program (exit %d):\n%s%s" % (r.returncode, r.stdout, r.stderr)]
-    problems, n = compare(toolpath_ir.read_moves(ir_path), canon_moves(canon_path), cycles, 0.05 + 1e-9)
+    problems, n = compare(toolpath_ir.read_moves(ir_path), canon_moves(canon_path, ngc_path), cycles, 0.05 + 1e-9)
     if not problems:
         print("ok: %s%s: %d moves match" % (os.path.basename(path), "" if cycles else " (--no-cycles)", n))
     return problems

@@ -23,7 +23,11 @@ and reports what would be wrong there:
     radius at the start and at the end agree within 0.001 mm (whole circles
     too); with CR= the radius reaches across the chord; TURN= only with I/J;
   * modal cycles: `MCALL CYCLE..` then position blocks (X/Y only, from above
-    the reference plane) then a bare `MCALL`, nothing else in between.
+    the reference plane) then a bare `MCALL`, nothing else in between;
+  * cubic splines: `CSPLINE BAUTO EAUTO` (no end condition taken from the
+    blocks around) then points with X and Y only, in the plane at one
+    height; each point is a move whose end must be the plan's (the curve
+    between is the controller's cubic spline through the points).
 
 With --ir (one program) the moves the program makes are also compared with
 the toolpath IR's, within the rounding of 3 decimals: feed moves one by one
@@ -68,6 +72,7 @@ TOKEN_RE = re.compile(
     r'\s*(?:(?P<msg>MSG\("[^"]*"\))'
     r"|(?P<call>(?:CYCLE\d+)\([^()]*\))"
     r"|(?P<mcall>MCALL)(?![A-Z0-9_])"
+    r"|(?P<keyword>CSPLINE|BAUTO|EAUTO)(?![A-Z0-9_])"
     r"|(?P<assign>(?:CR|TURN)=(?P<avalue>" + NUMBER + r"))"
     r"|(?P<letter>[A-Z])(?P<value>" + NUMBER + r"))")
 
@@ -303,6 +308,8 @@ class Checker:
                 words.append(("CALL", m.group("call")))
             elif m.group("mcall"):
                 words.append(("MCALL", ""))
+            elif m.group("keyword"):
+                words.append((m.group("keyword"), ""))
             elif m.group("assign"):
                 words.append((m.group("assign").split("=")[0], m.group("avalue")))
             else:
@@ -314,7 +321,7 @@ class Checker:
         gs, ms = [], []
         bad = False
         for address, value in words:
-            if address in ("MSG", "CALL", "MCALL"):
+            if address in ("MSG", "CALL", "MCALL", "CSPLINE", "BAUTO", "EAUTO"):
                 continue
             if address in LENGTH_WORDS or address in INTEGER_WORDS or address in "GM":
                 problem = number_problem(address, value)
@@ -327,7 +334,7 @@ class Checker:
         if bad:
             return
         for address, value in words:
-            if address in ("MSG", "CALL", "MCALL"):
+            if address in ("MSG", "CALL", "MCALL", "CSPLINE", "BAUTO", "EAUTO"):
                 continue
             if address == "G":
                 g = float(value)
@@ -360,6 +367,13 @@ class Checker:
         for call in calls:
             self.direct_call(n, call, len(words))
 
+        keywords = [a for a in kinds if a in ("CSPLINE", "BAUTO", "EAUTO")]
+        if keywords and keywords != ["CSPLINE", "BAUTO", "EAUTO"]:
+            self.problem(n, "a spline starts with CSPLINE BAUTO EAUTO, found %s" % " ".join(keywords))
+        if keywords and gs and any(g in MOTION for g in gs):
+            self.problem(n, "CSPLINE and a motion G code in one block")
+        if keywords:
+            self.motion = "cspline"
         for g in gs:
             if g in MOTION:
                 self.motion = g
@@ -450,6 +464,8 @@ class Checker:
         if self.motion in (2, 3):
             self.arc(n, seen)
             return
+        if self.motion == "cspline" and any(a not in ("X", "Y", "F") for a in seen):
+            self.problem(n, "a spline point with more than X, Y and F")
         for bad in ("I", "J", "K", "CR", "TURN"):
             if bad in seen:
                 self.problem(n, "%s on a straight move" % bad)
