@@ -91,3 +91,30 @@ TEST_CASE("a long profile cruises at its speed limit", "[profile]") {
   const double ramp = 2 * std::sqrt(50.0 / 80000);
   CHECK(p.duration() == Approx(2 * ramp + (300 - 50 * ramp) / 50).epsilon(1e-12));
 }
+
+TEST_CASE("a profile too short to cruise peaks at the highest speed that fits", "[profile]") {
+  // Its rise and fall fit in the length, and at a peak higher by 1e-12 they
+  // would not: the root finder is at least as fine as its bracket.
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<double> lengths(1e-4, 20), speeds(0, 300);
+  const double a = 6000, j = 80000;
+  auto distance = [&](double v0, double vp, double v1) { return rampDistance(v0, vp, a, j) + rampDistance(vp, v1, a, j); };
+  int checked = 0;
+  for (int i = 0; i < 3000; ++i) {
+    const double length = lengths(rng);
+    double v0 = speeds(rng);
+    double v1 = std::min(speeds(rng), reachableSpeed(v0, length, a, j));
+    v0 = std::min(v0, reachableSpeed(v1, length, a, j));
+    const PathLimits limits{1e4, a, j};
+    const double peak = planProfile(v0, v1, length, limits).peak();
+    // Peaks at an end speed are where the ends are only just reachable
+    // from each other (reachableSpeed's own rounding decides).
+    if (peak <= std::max(v0, v1) * (1 + 1e-9) || peak >= limits.v)
+      continue;
+    INFO("v0 " << v0 << " v1 " << v1 << " length " << length << " peak " << peak);
+    CHECK(distance(v0, peak, v1) <= length * (1 + 1e-13));
+    CHECK(distance(v0, peak * (1 + 1e-12), v1) > length);
+    ++checked;
+  }
+  CHECK(checked > 1000);
+}
