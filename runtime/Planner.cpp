@@ -358,9 +358,9 @@ void preferHugePages(const std::vector<T> &v) {
 #endif
 }
 
-/// The speed cap and the path acceleration and jerk for one segment.
-void limitsFor(const Segment &seg, double feed, const Machine &machine, SegmentInfo &info) {
-  const AxisDemand d = seg.demand();
+/// The speed cap and the path acceleration and jerk for a segment whose
+/// demand() is d.
+void limitsFor(const AxisDemand &d, double feed, const Machine &machine, SegmentInfo &info) {
   double v = kInf;
   SpeedLimit by = SpeedLimit::Feed;
   auto cap = [&](double value, SpeedLimit why) {
@@ -546,13 +546,14 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   out.info.reserve(count);
   preferHugePages(out.segments);
   preferHugePages(out.info);
-  auto push = [&](double feed, uint32_t move, uint32_t next, StopReason stop) {
+  // d is the last segment's demand().
+  auto push = [&](double feed, uint32_t move, uint32_t next, StopReason stop, const AxisDemand &d) {
     SegmentInfo &info = out.info.emplace_back();
     info.feed = feed;
     info.move = move;
     info.nextMove = next;
     info.stop = stop;
-    limitsFor(out.segments.back(), feed, machine, info);
+    limitsFor(d, feed, machine, info);
   };
   StopReason stop = StopReason::Start;
   {
@@ -571,14 +572,15 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
             feed = std::min(prev.feed, p.feed);
           else
             feed = std::max(prev.feed, p.feed);
-          out.segments.push_back(Segment::blend(blendBetween(prev, before, p, here)));
-          push(feed, prev.move, p.move, stop);
+          AxisDemand demand;
+          out.segments.push_back(Segment::blend(blendBetween(prev, before, p, here), demand));
+          push(feed, prev.move, p.move, stop, demand);
           stop = StopReason::None;
         }
       }
       if (p.keepsMiddle()) {
         out.segments.push_back(here.part(p.cutStart, here.length - p.cutEnd));
-        push(p.feed, p.move, p.move, stop);
+        push(p.feed, p.move, p.move, stop, out.segments.back().demand());
         stop = StopReason::None;
       }
     }

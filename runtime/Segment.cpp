@@ -332,6 +332,24 @@ Segment Segment::part(double s0, double s1) const {
   return out;
 }
 
+namespace {
+
+/// A blend's bounds from its 33 samples, with the margin for what lies
+/// between them.
+AxisDemand blendDemand(const QuinticCurve &q) {
+  // Sampled densely in u; a quintic's derivatives vary smoothly, and the
+  // margin covers what lies between samples.
+  AxisDemand d;
+  sampleBlendDemand(q, d);
+  constexpr double kMargin = 1.1;
+  d.r1 = (d.r1 * kMargin).cwiseMin(Vec3::Ones());
+  d.r2 *= kMargin;
+  d.r3 *= kMargin;
+  return d;
+}
+
+} // namespace
+
 Segment Segment::blend(const std::array<Vec3, 6> &ctrl) {
   Segment s;
   s.kind = SegmentKind::Blend;
@@ -340,6 +358,19 @@ Segment Segment::blend(const std::array<Vec3, 6> &ctrl) {
   s.end = ctrl[5];
   blendArcTable(QuinticCurve(ctrl), s.arcTable);
   s.length = s.arcTable[kBlendTable];
+  return s;
+}
+
+Segment Segment::blend(const std::array<Vec3, 6> &ctrl, AxisDemand &demand) {
+  Segment s;
+  s.kind = SegmentKind::Blend;
+  s.ctrl = ctrl;
+  s.start = ctrl[0];
+  s.end = ctrl[5];
+  const QuinticCurve q(ctrl);
+  blendArcTable(q, s.arcTable);
+  s.length = s.arcTable[kBlendTable];
+  demand = blendDemand(q);
   return s;
 }
 
@@ -412,16 +443,9 @@ AxisDemand Segment::demand() const {
     }
     break;
   }
-  case SegmentKind::Blend: {
-    // Sampled densely in u; a quintic's derivatives vary smoothly, and the
-    // margin covers what lies between samples.
-    sampleBlendDemand(QuinticCurve(ctrl), d);
-    constexpr double kMargin = 1.1;
-    d.r1 = (d.r1 * kMargin).cwiseMin(Vec3::Ones());
-    d.r2 *= kMargin;
-    d.r3 *= kMargin;
+  case SegmentKind::Blend:
+    d = blendDemand(QuinticCurve(ctrl));
     break;
-  }
   }
   return d;
 }

@@ -88,6 +88,9 @@ struct Segment {
   /// about the moved centre.
   static Segment arcTurns(const Vec3 &from, const Vec3 &to, const Vec3 &center, bool ccw, int64_t turns);
   static Segment blend(const std::array<Vec3, 6> &ctrl);
+  /// The same, with its demand() written to `demand` (the same bits), both
+  /// from one evaluation of the curve's power form.
+  static Segment blend(const std::array<Vec3, 6> &ctrl, AxisDemand &demand);
   /// The part of this segment from arc length s0 to s1 (a line, arc or blend
   /// of the same curve; blends only whole).
   Segment part(double s0, double s1) const;
