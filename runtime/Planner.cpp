@@ -285,11 +285,16 @@ void join(Piece &a, const Segment &sa, Piece &b, const Segment &sb, double toler
   }
   const PathPoint ea = sa.at(sa.length), bs = sb.at(0);
   const double cosTurn = std::clamp(ea.r1.dot(bs.r1), -1.0, 1.0);
-  const double turn = std::acos(cosTurn);
+  // The turn's angle decides only whether it is below 1e-9 or above
+  // kReversal, and the arc cosine is needed for neither elsewhere: below
+  // 1e-9 is cosTurn = 1 (the next double down already gives 1.5e-8), and
+  // kReversal's cosine is -0.99985, so that nearer 1 it cannot be exceeded.
+  const bool aligned = cosTurn == 1.0;
+  const bool reversal = cosTurn < -0.99 && std::acos(cosTurn) > kReversal;
   const double scale = 1 / std::max(1e-3, std::max(ea.r2.norm(), bs.r2.norm()));  // a length of the curves
-  if (turn < 1e-9 && (ea.r2 - bs.r2).norm() * scale < 1e-9)
+  if (aligned && (ea.r2 - bs.r2).norm() * scale < 1e-9)
     return;  // tangent and curvature already agree
-  if (turn > kReversal) {
+  if (reversal) {
     b.stopReason = StopReason::Reversal;
     return;
   }
