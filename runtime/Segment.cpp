@@ -110,39 +110,50 @@ template <int D>
   }
 }
 
-/// Two or four doubles in the compiler's generic vectors: one SSE2 or AVX
-/// register. The kernels below take four at a time in their versions for
-/// processors with AVX and two elsewhere, with the same IEEE operations on
-/// each element (no fused multiply-add: no version enables it), so that both
-/// give the same bits.
+/// Two, four or eight doubles in the compiler's generic vectors: one SSE2,
+/// AVX or AVX-512 register. The kernels below take eight at a time in their
+/// versions for processors with AVX-512, four with AVX and two elsewhere,
+/// with the same IEEE operations on each element (no fused multiply-add:
+/// AVX-512 has it, and the build turns contraction off on x86-64 for that),
+/// so that all give the same bits.
 using Pair = double __attribute__((vector_size(16)));
 using Quad = double __attribute__((vector_size(32)));
+using Oct = double __attribute__((vector_size(64)));
 /// Their bits, as integers.
 using PairBits = int64_t __attribute__((vector_size(16)));
 using QuadBits = int64_t __attribute__((vector_size(32)));
+using OctBits = int64_t __attribute__((vector_size(64)));
 
 /// m = max(m, |x|) element by element, as std::max and std::abs give them
 /// (|x| by clearing the sign bit).
 template <class V>
 [[gnu::always_inline]] inline void raiseToAbs(V &m, const V &x) {
-  using Bits = std::conditional_t<sizeof(V) == sizeof(Pair), PairBits, QuadBits>;
+  using Bits = std::conditional_t<sizeof(V) == sizeof(Pair), PairBits,
+                                  std::conditional_t<sizeof(V) == sizeof(Quad), QuadBits, OctBits>>;
   constexpr int64_t kMagnitude = std::numeric_limits<int64_t>::max();
   const V a = V(Bits(x) & kMagnitude);
   m = m < a ? a : m;
 }
 
 /// The square roots of the elements, correctly rounded as std::sqrt gives
-/// them: two at a time with SSE2, which every x86-64 has; else one at a time
-/// (generic vectors have no square root).
+/// them: two at a time with SSE2, which every x86-64 has (the wider
+/// square-root intrinsics would need this template compiled for AVX); else
+/// one at a time (generic vectors have no square root).
 template <class V>
 [[gnu::always_inline]] inline void squareRoots(const V &x, V &root) {
 #if defined(__SSE2__)
   if constexpr (sizeof(V) == sizeof(Pair)) {
     root = _mm_sqrt_pd(x);
-  } else {
+  } else if constexpr (sizeof(V) == sizeof(Quad)) {
     const __m128d lo = _mm_sqrt_pd(__builtin_shufflevector(x, x, 0, 1));
     const __m128d hi = _mm_sqrt_pd(__builtin_shufflevector(x, x, 2, 3));
     root = __builtin_shufflevector(lo, hi, 0, 1, 2, 3);
+  } else {
+    const Quad lo = {x[0], x[1], x[2], x[3]}, hi = {x[4], x[5], x[6], x[7]};
+    Quad rootLo, rootHi;
+    squareRoots(lo, rootLo);
+    squareRoots(hi, rootHi);
+    root = __builtin_shufflevector(rootLo, rootHi, 0, 1, 2, 3, 4, 5, 6, 7);
   }
 #else
   for (size_t l = 0; l < sizeof(V) / sizeof(double); ++l)
@@ -217,9 +228,10 @@ template <int D, class V>
   }
 }
 
-// The blend kernels in two versions on x86-64 (GCC's function
+// The blend kernels in three versions on x86-64 (GCC's function
 // multiversioning picks one when the program starts): for processors with
-// AVX and for the rest.
+// AVX-512 (preferring its full width where the compiler vectorizes loops),
+// with AVX, and for the rest.
 #if defined(__GNUC__) && defined(__x86_64__) && defined(__ELF__)
 #define STEPNC_MULTIVERSIONED 1
 #endif
@@ -258,6 +270,22 @@ __attribute__((target("avx"))) void sampleBlendDemand(const QuinticCurve &q, Axi
     sampleBlendDemand<2, Quad>(q, d);
   else
     sampleBlendDemand<3, Quad>(q, d);
+}
+
+__attribute__((target("avx512f,prefer-vector-width=512"))) void
+blendArcTable(const QuinticCurve &q, std::array<double, Segment::kBlendTable + 1> &table) {
+  if (inPlaneZ(q))
+    blendArcTable<2>(q, table);
+  else
+    blendArcTable<3>(q, table);
+}
+
+__attribute__((target("avx512f,prefer-vector-width=512"))) void sampleBlendDemand(const QuinticCurve &q,
+                                                                                  AxisDemand &d) {
+  if (inPlaneZ(q))
+    sampleBlendDemand<2, Oct>(q, d);
+  else
+    sampleBlendDemand<3, Oct>(q, d);
 }
 #endif
 
