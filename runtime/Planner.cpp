@@ -108,7 +108,14 @@ struct DeviationPoints {
     }();
     const QuinticCurve curve(ctrl);
     std::array<double, kDeviationSamples> *coordinates[3] = {&x, &y, &z};
-    for (int k = 0; k < 3; ++k) {
+    // A curve that keeps its z (every coefficient but the first has z = 0)
+    // gives c[0].z() at every u (up to the sign of a zero, which no squared
+    // distance below sees).
+    const bool inPlane = curve.c[1].z() == 0 && curve.c[2].z() == 0 && curve.c[3].z() == 0 &&
+                         curve.c[4].z() == 0 && curve.c[5].z() == 0;
+    if (inPlane)
+      z.fill(curve.c[0].z());
+    for (int k = 0; k < (inPlane ? 2 : 3); ++k) {
       const double c0 = curve.c[0][k], c1 = curve.c[1][k], c2 = curve.c[2][k], c3 = curve.c[3][k],
                    c4 = curve.c[4][k], c5 = curve.c[5][k];
       std::array<double, kDeviationSamples> &out = *coordinates[k];
