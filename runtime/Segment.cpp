@@ -402,16 +402,11 @@ Segment Segment::blend(const std::array<Vec3, 6> &ctrl, AxisDemand &demand) {
   return s;
 }
 
-PathPoint Segment::at(double s) const {
+PathPoint Segment::curveAt(double s) const {
   s = std::clamp(s, 0.0, length);
   switch (kind) {
-  case SegmentKind::Line: {
-    PathPoint out;
-    if (length > 0)
-      out.r1 = (end - start) / length;
-    out.p = s >= length ? end : Vec3(start + out.r1 * s);
-    return out;
-  }
+  case SegmentKind::Line:
+    return at(s);
   case SegmentKind::Arc: {
     const double rise = sweep > 0 ? (end.z() - start.z()) / sweep : 0;  // mm per radian
     const double k = std::sqrt(radius * radius + rise * rise);         // mm per radian along the path

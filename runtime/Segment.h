@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 
@@ -96,8 +97,20 @@ struct Segment {
   Segment part(double s0, double s1) const;
 
   /// The point at arc length s (clamped to [0, length]); `at(length).p` is
-  /// exactly `end`.
-  PathPoint at(double s) const;
+  /// exactly `end`. Lines here, where the compiler can inline them (the
+  /// planner asks for many line points), arcs and blends in curveAt.
+  PathPoint at(double s) const {
+    if (kind != SegmentKind::Line)
+      return curveAt(s);
+    s = std::clamp(s, 0.0, length);
+    PathPoint out;
+    if (length > 0)
+      out.r1 = (end - start) / length;
+    out.p = s >= length ? end : Vec3(start + out.r1 * s);
+    return out;
+  }
+  /// at() for arcs and blends.
+  PathPoint curveAt(double s) const;
   /// Upper bounds of the derivatives per axis over the whole segment.
   AxisDemand demand() const;
 };
