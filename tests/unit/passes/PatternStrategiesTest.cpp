@@ -264,6 +264,24 @@ TEST_CASE("pattern: a trochoidal pocket stays smooth across its rings and verifi
   CHECK(largest <= trochoidEngagement(5, 3, 1.0, trochoidSmoothing(1.0, 3)) + 2 * kPi / 180);
 }
 
+TEST_CASE("pattern: a trochoid along zigzag strokes is one smooth run through them and their links", "[pattern]") {
+  // The pocket with a bidirectional guide: strokes along x, 12.8 mm apart
+  // (80 % of the 16 mm the loops cut), each joined to the next at its end.
+  test::Loaded l = test::loadStepnc(example("trochoidal-pocket.stp"));
+  setGuide(l.module->root, "bidirectional");
+  CHECK(run(*l.module, "resolve-feeds,expand-strategies").empty());
+  const std::vector<Move> troch = trochoidRun(walkMoves(movesOf(*l.module)));
+  const Smoothness s = smoothness(pointsOf(troch));
+  INFO("largest turn " << s.largestTurn * 180 / kPi << " deg, jump " << s.largestJump << " /mm");
+  CHECK(troch.size() > 7000); // about 149 loops of 56 lines: every stroke in one run
+  CHECK(s.largestTurn < 10 * kPi / 180);
+  CHECK(s.largestJump < 0.02);
+  const double largest =
+      measuredEngagement(troch, troch.front().from->head<2>() - Vec2(3, 0), 3, 5, {{0, 0}, {100, 60}});
+  INFO("largest engagement " << largest * 180 / kPi << " deg");
+  CHECK(largest <= trochoidEngagement(5, 3, 1.0, trochoidSmoothing(1.0, 3)) + 2 * kPi / 180);
+}
+
 TEST_CASE("pattern: plunges go along the tool axis, link above the material, leave the cusp their pitch implies",
           "[pattern]") {
   // The examples' contour-parallel guides, and the pocket's plunges on
