@@ -185,6 +185,13 @@ double sharpestCorner(const Region &r) {
   return sharpest;
 }
 
+/// The widest stepover between rings of a tool of radius `radius` that
+/// leaves no material at the target's sharpest convex corner
+/// (R (1 + sin(theta / 2)), REFERENCES), with 2 % to spare.
+double ringCoverLimit(const FeatureShape &s, double radius) {
+  return radius * (1 + std::sin(sharpestCorner(s.target) / 2)) * 0.98;
+}
+
 struct Plan {
   const Node *feature = nullptr;
   const Node *op = nullptr;
@@ -527,7 +534,7 @@ private:
       stepover = 2 * p.radius * (1 - overlap);
     if (stepover <= 0)
       stepover = p.radius;
-    const double coverLimit = p.radius * (1 + std::sin(sharpestCorner(s.target) / 2)) * 0.98;
+    const double coverLimit = ringCoverLimit(s, p.radius);
     const double limitBidir = 2 * p.radius * 0.98;
     stepover = std::min(stepover, type == "bidirectional" || type == "unidirectional" ? limitBidir : coverLimit);
 
@@ -988,8 +995,7 @@ private:
     double overlap = pattern.number("overlap").value_or(kPatternOverlap);
     if (overlap <= 0 || overlap >= 1)
       overlap = kPatternOverlap;
-    const double coverLimit = radius * (1 + std::sin(sharpestCorner(s.target) / 2)) * 0.98;
-    return std::min(2 * radius * (1 - overlap), coverLimit);
+    return std::min(2 * radius * (1 - overlap), ringCoverLimit(s, radius));
   }
 
   bool trochoidal(const Node &ws, const Node &op, const Node &pattern, const Node &guide, const FeatureShape &s,
