@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
+#include <iterator>
 #include <fcntl.h>
 #include <sys/mman.h>
 #include <sys/stat.h>
@@ -72,6 +73,24 @@ std::unique_ptr<SourceFile> SourceFile::fromString(std::string name, std::string
   return file;
 }
 
+std::unique_ptr<SourceFile> SourceFile::translation(std::unique_ptr<SourceFile> original, std::string text,
+                                                    std::vector<std::pair<uint64_t, uint64_t>> originMap) {
+  std::unique_ptr<SourceFile> file(new SourceFile());
+  file->name_ = std::string(original->name());
+  file->owned_ = std::move(text);
+  file->data_ = file->owned_.c_str();
+  file->size_ = file->owned_.size();
+  file->original_ = std::move(original);
+  file->originMap_ = std::move(originMap);
+  return file;
+}
+
+uint64_t SourceFile::originalOffset(uint64_t offset) const {
+  auto it = std::upper_bound(originMap_.begin(), originMap_.end(), offset,
+                             [](uint64_t o, const std::pair<uint64_t, uint64_t> &p) { return o < p.first; });
+  return it == originMap_.begin() ? 0 : std::prev(it)->second;
+}
+
 void SourceFile::buildLineTable() const {
   lineStarts_.push_back(0);
   const char *p = data_;
@@ -86,6 +105,8 @@ void SourceFile::buildLineTable() const {
 }
 
 LineCol SourceFile::lineCol(uint64_t offset) const {
+  if (original_)
+    return original_->lineCol(originalOffset(offset));
   if (lineStarts_.empty())
     buildLineTable();
   offset = std::min(offset, size_);
@@ -95,7 +116,29 @@ LineCol SourceFile::lineCol(uint64_t offset) const {
   return {line, static_cast<uint32_t>(offset - start + 1)};
 }
 
+void SourceFile::releaseBefore(uint64_t offset) const {
+  if (!mapping_)
+    return;
+  const auto page = static_cast<uint64_t>(::sysconf(_SC_PAGESIZE));
+  const uint64_t end = std::min(offset, size_) / page * page;
+  if (end > 0)
+    ::madvise(mapping_, end, MADV_DONTNEED);
+}
+
+uint64_t SourceFile::offsetOf(LineCol at) const {
+  if (lineStarts_.empty())
+    buildLineTable();
+  if (at.line == 0)
+    return 0;
+  if (at.line > lineStarts_.size())
+    return size_;
+  const uint64_t start = lineStarts_[at.line - 1];
+  return std::min(size_, start + (at.col > 0 ? at.col - 1 : 0));
+}
+
 std::string_view SourceFile::lineText(uint32_t line) const {
+  if (original_)
+    return original_->lineText(line);
   if (lineStarts_.empty())
     buildLineTable();
   if (line == 0 || line > lineStarts_.size())

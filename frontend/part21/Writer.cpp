@@ -251,6 +251,7 @@ namespace {
 struct Side {
   const Part21File &file;
   const ValueArena &arena;
+  const NameMap *rename = nullptr;  ///< for the record names of one side
 };
 
 bool sameValue(const Value &x, const Side &a, const Value &y, const Side &b) {
@@ -291,7 +292,10 @@ bool sameValue(const Value &x, const Side &a, const Value &y, const Side &b) {
 }
 
 bool sameRecord(const Record &x, const Side &a, const Record &y, const Side &b) {
-  if (a.file.names().name(x.name) != b.file.names().name(y.name) || x.count != y.count)
+  const std::string_view nameA = a.file.names().name(x.name);
+  const bool sameName = a.rename && *a.rename ? (*a.rename)(nameA) == b.file.names().name(y.name)
+                                              : nameA == b.file.names().name(y.name);
+  if (!sameName || x.count != y.count)
     return false;
   auto px = a.arena.params(x);
   auto py = b.arena.params(y);
@@ -309,7 +313,7 @@ std::string recordText(const Record &r, const Side &s) {
 
 } // namespace
 
-std::string compareGraphs(const Part21File &a, const Part21File &b) {
+std::string compareGraphs(const Part21File &a, const Part21File &b, const NameMap &renameA) {
   Side ma{a, a.metadata()}, mb{b, b.metadata()};
   if (a.header().size() != b.header().size())
     return "header entity count differs: " + std::to_string(a.header().size()) + " vs " +
@@ -355,7 +359,7 @@ std::string compareGraphs(const Part21File &a, const Part21File &b) {
     bool okB = b.decodeInstance(static_cast<size_t>(j), arenaB, nullptr);
     if (!okA || !okB)
       return id + " does not decode";
-    Side sa{a, arenaA}, sb{b, arenaB};
+    Side sa{a, arenaA, &renameA}, sb{b, arenaB};
     auto ra = arenaA.records();
     auto rb = arenaB.records();
     if (ra.size() != rb.size())

@@ -43,9 +43,15 @@ bool writePart21(const Part21File &file, OutputFile &out, DiagnosticEngine &diag
 /// Convenience for small files and tests: the canonical text as a string.
 std::string writePart21ToString(const Part21File &file, DiagnosticEngine &diags, bool *ok = nullptr);
 
+/// Maps an entity name of the first graph (upper case) to the name it must
+/// have in the second, e.g. an alias to its schema name.
+using NameMap = std::function<std::string(std::string_view)>;
+
 /// Compares two files' instance graphs: header entities, sections, anchors,
 /// references and every instance (ids, entity names, values; reals bit for
-/// bit). Returns an empty string when equal, else the first difference.
-std::string compareGraphs(const Part21File &a, const Part21File &b);
+/// bit). `renameA`, if given, maps the entity names of `a`'s instance records
+/// before they are compared. Returns an empty string when equal, else the
+/// first difference.
+std::string compareGraphs(const Part21File &a, const Part21File &b, const NameMap &renameA = {});
 
 } // namespace stepnc::p21

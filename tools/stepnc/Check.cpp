@@ -98,6 +98,12 @@ int runCheckFiles(const CheckOptions &opts) {
       continue;
     }
     diags.resetCounts();
+    if (!schemas.readAsPart21(source, diags)) {
+      std::cout << path << ": not read; " << diags.errorCount() << (diags.errorCount() == 1 ? " error" : " errors")
+                << '\n';
+      status = kExitDiagnostics;
+      continue;
+    }
     auto file = p21::readPart21(*source, diags);
     const express::Schema *checked = checkFile(*file, schemas, diags);
     std::string names;

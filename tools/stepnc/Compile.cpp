@@ -126,7 +126,9 @@ int runCompile(const CompileOptions &opts) {
   bool usage = false;
   if (!schemas.load(diags, usage))
     return usage ? kExitUsage : kExitDiagnostics;
-  auto module = loadModule(*source, schemas, diags, usage);
+  std::unique_ptr<ir::Module> module;
+  if (schemas.readAsPart21(source, diags))
+    module = loadModule(*source, schemas, diags, usage);
   if (module && !ir::verifyModule(*module, diags))
     module.reset();
   if (!module) {

@@ -1,10 +1,14 @@
 // `stepnc convert IN -o OUT`: re-writes a STEP file in stepnc's canonical Part 21
-// form. Nothing is written when the input has errors; the output appears
+// form, or as Part 28 XML when OUT ends in .stpx or .xml; the input may be
+// either. Nothing is written when the input has errors; the output appears
 // atomically (temporary file + rename).
+#include "frontend/binding/Binder.h"
 #include "frontend/part21/Part21File.h"
 #include "frontend/part21/Writer.h"
+#include "frontend/part28/Writer.h"
 #include "support/OutputFile.h"
 #include "tools/stepnc/Driver.h"
+#include "tools/stepnc/SchemaSelection.h"
 
 #include <CLI/CLI.hpp>
 #include <iostream>
@@ -16,6 +20,7 @@ namespace {
 struct ConvertOptions {
   std::string input;
   std::string output;
+  SchemaOptions schema;
   DiagnosticOptions diag;
 };
 
@@ -32,21 +37,47 @@ bool hasSuffix(const std::string &s, std::string_view suffix) {
   return true;
 }
 
-int runConvert(const ConvertOptions &opts) {
-  if (hasSuffix(opts.output, ".stpx") || hasSuffix(opts.output, ".xml")) {
-    printToolError("writing Part 28 XML is not supported yet; write a .stp file");
-    return kExitUsage;
+/// Writes `file` as Part 28 through its schema. The schema check itself is
+/// `stepnc check`'s business: binding here only names each instance's entity,
+/// and only what the mapping cannot express is an error.
+bool writeXml(const p21::Part21File &file, const SchemaSelection &schemas, OutputFile &out, DiagnosticEngine &diags) {
+  const express::Model *model = nullptr;
+  const express::Schema *schema = schemas.find(file.schemaNames(), model);
+  if (!schema) {
+    std::string listed;
+    for (const std::string &n : file.schemaNames())
+      listed += (listed.empty() ? "" : ", ") + n;
+    printToolError("writing Part 28 needs the file's schema, and " +
+                   (listed.empty() ? std::string("FILE_SCHEMA names none") : "schema " + listed + " is not built in") +
+                   ": give its EXPRESS file with --schema FILE.exp");
+    return false;
   }
+  DiagnosticCollector ignored;
+  DiagnosticEngine bindDiags(ignored);
+  binding::BindOptions lenient;
+  lenient.lenient = true;
+  auto bound = binding::bind(file, *model, *schema, bindDiags, lenient);
+  return p28::writePart28(*bound, [&out](std::string_view chunk) { out.write(chunk); }, diags);
+}
+
+int runConvert(const ConvertOptions &opts) {
+  const bool toXml = hasSuffix(opts.output, ".stpx") || hasSuffix(opts.output, ".xml");
   auto source = openInput(opts.input);
   if (!source)
     return kExitUsage;
   DiagnosticSession session(opts.diag);
   DiagnosticEngine &diags = session.engine();
-  auto file = p21::readPart21(*source, diags);
+  SchemaSelection schemas(opts.schema);
+  bool usage = false;
+  if (!schemas.load(diags, usage))
+    return usage ? kExitUsage : kExitDiagnostics;
   auto nothingWritten = [&] {
     std::cerr << "stepnc: " << opts.input << " has errors; nothing written\n";
     return kExitDiagnostics;
   };
+  if (!schemas.readAsPart21(source, diags))
+    return nothingWritten();
+  auto file = p21::readPart21(*source, diags);
   if (diags.hasErrors())
     return nothingWritten();
   OutputFile out;
@@ -55,10 +86,17 @@ int runConvert(const ConvertOptions &opts) {
     printToolError(error);
     return kExitUsage;
   }
-  // One pass: decode, check references and write; on any error `out`
-  // discards the temporary file.
-  if (!p21::writePart21(*file, out, diags, {.checkReferences = true}))
+  if (toXml) {
+    p21::checkInstances(*file, diags);  // syntax and references, as the Part 21 writer checks them
+    if (diags.hasErrors())
+      return nothingWritten();
+    if (!writeXml(*file, schemas, out, diags))
+      return diags.hasErrors() ? nothingWritten() : kExitUsage;
+  } else if (!p21::writePart21(*file, out, diags, {.checkReferences = true})) {
+    // One pass: decode, check references and write; on any error `out`
+    // discards the temporary file.
     return nothingWritten();
+  }
   if (!out.commit(error)) {
     printToolError(error);
     return kExitUsage;
@@ -72,10 +110,12 @@ void registerConvert(CLI::App &app, std::function<void(int)> setResult) {
   auto opts = std::make_shared<ConvertOptions>();
   CLI::App *cmd = app.add_subcommand(
       "convert", "Re-write a STEP file in stepnc's canonical Part 21 form (sorted ids, one\n"
-                 "instance per line, shortest exact reals). The output is written atomically and\n"
-                 "not at all when the input has errors.");
-  cmd->add_option("input", opts->input, "Input Part 21 file")->required();
+                 "instance per line, shortest exact reals), or as Part 28 XML when the output ends\n"
+                 "in .stpx or .xml. The input may be Part 21 or Part 28. The output is written\n"
+                 "atomically and not at all when the input has errors.");
+  cmd->add_option("input", opts->input, "Input Part 21 or Part 28 file")->required();
   cmd->add_option("-o,--output", opts->output, "Output file ('-' for standard output)")->required();
+  addSchemaOptions(*cmd, opts->schema);
   addDiagnosticOptions(*cmd, opts->diag);
   cmd->callback([opts, setResult] { setResult(runConvert(*opts)); });
 }

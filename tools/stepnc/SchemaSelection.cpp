@@ -2,6 +2,7 @@
 
 #include "frontend/express/Builtin.h"
 #include "frontend/express/SchemaReader.h"
+#include "frontend/part28/Reader.h"
 #include "tools/stepnc/Driver.h"
 
 #include <CLI/CLI.hpp>
@@ -63,6 +64,34 @@ const express::Schema *SchemaSelection::select(const p21::Part21File &file, Diag
                                         " is not built in; checked for Part 21 syntax only (give its "
                                         "EXPRESS file with --schema FILE.exp)");
   return nullptr;
+}
+
+const express::Schema *SchemaSelection::find(const std::vector<std::string> &names,
+                                             const express::Model *&model) const {
+  if (opts_.none)
+    return nullptr;
+  if (!opts_.files.empty()) {
+    model = &loaded_;
+    for (const std::string &n : names)
+      if (const express::Schema *s = loaded_.findSchema(n))
+        return s;
+    return loaded_.schemas().empty() ? nullptr : &loaded_.schemas().front();
+  }
+  model = &express::builtinModel();
+  return express::builtinSchemaFor(names.empty() ? std::vector<std::string>{"ISO14649_ARM"} : names);
+}
+
+bool SchemaSelection::readAsPart21(std::unique_ptr<SourceFile> &source, DiagnosticEngine &diags) const {
+  if (!p28::isXml(source->text()))
+    return true;
+  auto choose = [this](const std::vector<std::string> &names, const express::Model *&model) {
+    return find(names, model);
+  };
+  auto translation = p28::translatePart28(source, choose, diags);
+  if (!translation)
+    return false;
+  source = std::move(translation);
+  return true;
 }
 
 } // namespace stepnc::tool

@@ -1,5 +1,7 @@
-// Choosing the EXPRESS schema a Part 21 file is checked against: the files
-// given with --schema, else the built-in schema its FILE_SCHEMA names.
+// Choosing the EXPRESS schema a STEP file is checked against: the files
+// given with --schema, else the built-in schema its FILE_SCHEMA names. Part 28
+// XML is read through that schema too, so its translation to Part 21 text
+// starts here.
 #pragma once
 
 #include "frontend/express/Schema.h"
@@ -33,6 +35,18 @@ public:
   /// (unknown schema, --no-schema is silent). `model` receives its model.
   const express::Schema *select(const p21::Part21File &file, DiagnosticEngine &diags,
                                 const express::Model *&model) const;
+
+  /// The schema for a document naming `names`, without diagnostics: with
+  /// --schema the one named (else the first given), else the built-in one the
+  /// names answer to (the ARM when no name is given); null with --no-schema or
+  /// when none fits.
+  const express::Schema *find(const std::vector<std::string> &names, const express::Model *&model) const;
+
+  /// Makes `source` Part 21 text: Part 28 XML is translated through its
+  /// schema and `source` becomes the translation (which reports at the XML's
+  /// lines and columns); Part 21 is left as it is. Returns false after
+  /// reporting when XML cannot be translated.
+  bool readAsPart21(std::unique_ptr<SourceFile> &source, DiagnosticEngine &diags) const;
 
 private:
   const SchemaOptions &opts_;

@@ -62,7 +62,8 @@ int runSim(const SimCommandOptions &opts) {
     bool usage = false;
     if (!schemas.load(diags, usage))
       return usage ? kExitUsage : kExitDiagnostics;
-    module = loadModule(*source, schemas, diags, usage);
+    if (schemas.readAsPart21(source, diags))
+      module = loadModule(*source, schemas, diags, usage);
     if (!module)
       return usage ? kExitUsage : kExitDiagnostics;
     // Whatever the input lacks is made: moves, then the motion.

@@ -1,0 +1,77 @@
+#include "frontend/part28/Mapping.h"
+
+namespace stepnc::p28 {
+
+std::string schemaNamespace(std::string_view schemaName) { return "urn:iso10303-28:xs/" + express::lower(schemaName); }
+
+std::string xmlName(std::string_view expressName) {
+  std::string s = express::lower(expressName);
+  if (!s.empty() && s[0] >= 'a' && s[0] <= 'z')
+    s[0] = static_cast<char>(s[0] - 'a' + 'A');
+  return s;
+}
+
+TypeView viewType(const express::Model &model, express::TypeId type) {
+  TypeView view;
+  // A chain of defined types is finite (resolve() rejects cycles), but bound
+  // the walk anyway so a bad model cannot hang the mapping.
+  for (int depth = 0; depth < 64 && type != express::kNone; ++depth) {
+    const express::TypeExpr &t = model.type(type);
+    switch (t.kind) {
+    case express::TypeExpr::Simple:
+      view.kind = TypeView::Simple;
+      view.simple = t.simple;
+      return view;
+    case express::TypeExpr::Aggregate:
+      view.kind = TypeView::Aggregate;
+      view.aggregate = type;
+      return view;
+    case express::TypeExpr::Named: {
+      if (t.entity != express::kNone) {
+        view.kind = TypeView::Entity;
+        view.entity = t.entity;
+        return view;
+      }
+      if (t.declared == express::kNone)
+        return view;
+      if (view.decl == express::kNone)
+        view.decl = t.declared;
+      const express::TypeDecl &d = model.typeDecl(t.declared);
+      const express::TypeExpr &u = model.type(d.underlying);
+      if (u.kind == express::TypeExpr::Select || u.kind == express::TypeExpr::Enumeration) {
+        view.kind = u.kind == express::TypeExpr::Select ? TypeView::Select : TypeView::Enumeration;
+        view.innerDecl = t.declared;
+        return view;
+      }
+      type = d.underlying;
+      break;
+    }
+    case express::TypeExpr::Select:
+    case express::TypeExpr::Enumeration:
+    case express::TypeExpr::Generic:
+      return view;
+    }
+  }
+  return view;
+}
+
+std::string_view simpleMemberName(express::SimpleKind kind) {
+  switch (kind) {
+  case express::SimpleKind::Real:
+  case express::SimpleKind::Number:
+    return "double";
+  case express::SimpleKind::Integer:
+    return "long";
+  case express::SimpleKind::String:
+    return "string";
+  case express::SimpleKind::Boolean:
+    return "boolean";
+  case express::SimpleKind::Logical:
+    return "logical";
+  case express::SimpleKind::Binary:
+    return "binary";
+  }
+  return "string";
+}
+
+} // namespace stepnc::p28

@@ -1,0 +1,43 @@
+// What the Part 28 reader, writer and XSD generator share: element names,
+// namespaces, and how an EXPRESS type is seen from XML (docs/part28.md).
+#pragma once
+
+#include "frontend/express/Schema.h"
+
+#include <string>
+#include <string_view>
+
+namespace stepnc::p28 {
+
+/// Namespace of the elements common to every schema (root, header, uos,
+/// simple members, nested aggregates).
+inline constexpr std::string_view kCommonNamespace = "urn:oid:1.0.10303.28.2.1.1";
+inline constexpr std::string_view kXsiNamespace = "http://www.w3.org/2001/XMLSchema-instance";
+
+/// Namespace of a schema's elements: "urn:iso10303-28:xs/iso14649_arm".
+std::string schemaNamespace(std::string_view schemaName);
+
+/// XML name of an EXPRESS entity, type or attribute: first letter upper case,
+/// the rest lower case ("machining_workingstep" -> "Machining_workingstep").
+std::string xmlName(std::string_view expressName);
+
+/// A type as the XML mapping sees it: defined types followed to what they
+/// finally are, remembering the outermost declared name (which names the
+/// element of an aggregate member or a SELECT value).
+struct TypeView {
+  enum Kind : uint8_t { Simple, Enumeration, Select, Aggregate, Entity, Unknown };
+  Kind kind = Unknown;
+  express::SimpleKind simple = express::SimpleKind::String;
+  express::DeclTypeId decl = express::kNone;      ///< outermost defined type, if any
+  express::DeclTypeId innerDecl = express::kNone; ///< Enumeration/Select: the declaring type
+  express::TypeId aggregate = express::kNone;     ///< Aggregate: the aggregate type expression
+  express::EntityId entity = express::kNone;      ///< Entity
+};
+
+TypeView viewType(const express::Model &model, express::TypeId type);
+
+/// The common element of a simple member: "double", "long", "string",
+/// "boolean", "logical" or "binary".
+std::string_view simpleMemberName(express::SimpleKind kind);
+
+} // namespace stepnc::p28
