@@ -46,8 +46,9 @@ bool OutputFile::open(const std::string &path, std::string &error) {
     tempPath_.clear();
     return false;
   }
-  static thread_local char buffer[1 << 16];
-  std::setvbuf(file_, buffer, _IOFBF, sizeof buffer);
+  // A buffer of its own: several output files may be open at once.
+  buffer_ = std::make_unique<char[]>(kBufferSize);
+  std::setvbuf(file_, buffer_.get(), _IOFBF, kBufferSize);
   return true;
 }
 

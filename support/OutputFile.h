@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdio>
+#include <memory>
 #include <string>
 #include <string_view>
 
@@ -33,6 +34,8 @@ public:
 private:
   std::string path_;
   std::string tempPath_;
+  static constexpr size_t kBufferSize = 1 << 16;
+  std::unique_ptr<char[]> buffer_;  ///< the stream's buffer; outlives file_
   std::FILE *file_ = nullptr;
   bool isStdout_ = false;
   bool direct_ = false;  ///< writing straight to a device or FIFO

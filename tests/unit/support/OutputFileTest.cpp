@@ -83,3 +83,22 @@ TEST_CASE("a device target is written in place, never replaced", "[support]") {
   CHECK(error.find("is a directory") != std::string::npos);
   fs::remove_all(dir);
 }
+
+TEST_CASE("output files open at the same time keep their own bytes", "[support]") {
+  fs::path dir = scratchDir();
+  // More than one stream buffer each, written alternately.
+  const std::string a(100000, 'a'), b(100000, 'b');
+  std::string error;
+  OutputFile first, second;
+  REQUIRE(first.open((dir / "a.txt").string(), error));
+  REQUIRE(second.open((dir / "b.txt").string(), error));
+  for (size_t i = 0; i < a.size(); i += 1000) {
+    first.write(std::string_view(a).substr(i, 1000));
+    second.write(std::string_view(b).substr(i, 1000));
+  }
+  REQUIRE(first.commit(error));
+  REQUIRE(second.commit(error));
+  CHECK(slurp(dir / "a.txt") == a);
+  CHECK(slurp(dir / "b.txt") == b);
+  fs::remove_all(dir);
+}
