@@ -1,11 +1,12 @@
 // The Part 28 XSD generator: XsdScope decides what the schema XSD declares
 // and which elements each reference or SELECT allows; SchemaXsdWriter writes
 // the declarations in a fixed order (the uos, entities, defined types, then
-// the entity groups that were referred to), names sorted, so the same model
-// always gives the same bytes.
+// the groups and types that attributes share), names sorted, so the same
+// model always gives the same bytes.
 #include "frontend/part28/Xsd.h"
 
 #include <algorithm>
+#include <functional>
 #include <initializer_list>
 #include <map>
 #include <set>
@@ -186,8 +187,8 @@ public:
       writeEntity(e);
     for (DeclTypeId t : scope_.types())
       writeDefinedType(t);
-    for (const auto &[name, entity] : usedGroups_)
-      writeEntityGroup(entity);
+    for (const auto &[name, write] : shared_)
+      write();
     x_.close("xs:schema");
     return x_.take();
   }
@@ -251,35 +252,39 @@ private:
     }
     x_.open("xs:element", {{"name", name}, {"minOccurs", "0"}});
     x_.open("xs:complexType");
-    writeContent(model_.type(typeId));
+    writeAggregateContent(model_.type(typeId));
     x_.close("xs:complexType");
     x_.close("xs:element");
   }
 
-  /// The XSD type of a value of `id` when it has a name; empty for an entity
-  /// reference or an aggregate, whose content is written in place. GENERIC
-  /// (function parameters only, never an attribute) allows anything.
-  std::string namedType(TypeId id) const {
+  /// The XSD type of a value of `id` when it has a name; empty for an
+  /// aggregate of simple values, defined-type values or aggregates, whose
+  /// content is written in place. GENERIC (function parameters only, never an
+  /// attribute) allows anything.
+  std::string namedType(TypeId id) {
     const TypeExpr &t = model_.type(id);
     if (t.kind == TypeExpr::Simple)
       return simpleTypeName(t.simple);
     if (t.kind == TypeExpr::Named && t.declared != kNone)
       return elementName(model_.typeDecl(t.declared).name);
-    if (t.kind == TypeExpr::Aggregate || (t.kind == TypeExpr::Named && t.entity != kNone))
-      return "";
-    return "xs:anyType";
+    if (t.kind == TypeExpr::Named && t.entity != kNone)
+      return useReferenceType(t.entity);
+    if (t.kind != TypeExpr::Aggregate)
+      return "xs:anyType";
+    const TypeExpr &member = model_.type(t.element);
+    if (member.kind == TypeExpr::Named && member.entity != kNone)
+      return useAggregateType(model_.entity(member.entity).name, useGroup(member.entity));
+    if (member.kind == TypeExpr::Named && member.declared != kNone && scope_.isSelect(member.declared))
+      return useAggregateType(model_.typeDecl(member.declared).name, groupName(model_.typeDecl(member.declared).name));
+    return "";
   }
 
-  /// Content of a complex type holding an entity reference or an aggregate.
-  void writeContent(const TypeExpr &t) {
-    if (t.kind == TypeExpr::Aggregate) {
-      x_.open("xs:sequence");
-      writeMember(t.element);
-      x_.close("xs:sequence");
-      x_.leaf("xs:attribute", {{"ref", "exp:cType"}});
-      return;
-    }
-    x_.leaf("xs:group", {{"ref", useGroup(t.entity)}});
+  /// Content of a complex type holding an aggregate.
+  void writeAggregateContent(const TypeExpr &t) {
+    x_.open("xs:sequence");
+    writeMember(t.element);
+    x_.close("xs:sequence");
+    x_.leaf("xs:attribute", {{"ref", "exp:cType"}});
   }
 
   /// One aggregate member particle, repeated any number of times.
@@ -335,12 +340,12 @@ private:
       return;
     }
     x_.open("xs:complexType", {{"name", name}});
-    if (u.kind == TypeExpr::Named && u.declared != kNone) {
+    if (u.kind == TypeExpr::Aggregate) {
+      writeAggregateContent(u);
+    } else { // TYPE a = b (an aggregate type) or TYPE a = some_entity
       x_.open("xs:complexContent");
       x_.leaf("xs:extension", {{"base", namedType(decl.underlying)}});
       x_.close("xs:complexContent");
-    } else {
-      writeContent(u);
     }
     x_.close("xs:complexType");
   }
@@ -368,27 +373,58 @@ private:
     return false;
   }
 
-  /// The group name for references to `entity`; the group is written at the end.
-  std::string useGroup(EntityId entity) {
-    std::string name = groupName(model_.entity(entity).name);
-    usedGroups_.emplace(name, entity);
+  /// Declares `name` once, to be written by `write` after the entities and
+  /// defined types; returns the name.
+  std::string share(std::string name, std::function<void()> write) {
+    shared_.try_emplace(name, std::move(write));
     return name;
   }
 
-  void writeEntityGroup(EntityId entity) {
-    x_.open("xs:group", {{"name", groupName(model_.entity(entity).name)}});
-    x_.open("xs:choice");
-    for (const std::string &element : scope_.entityChoice(entity))
-      x_.leaf("xs:element", {{"ref", element}});
-    x_.close("xs:choice");
-    x_.close("xs:group");
+  /// The group of the elements a reference to `entity` may be.
+  std::string useGroup(EntityId entity) {
+    return share(groupName(model_.entity(entity).name), [this, entity] {
+      x_.open("xs:group", {{"name", groupName(model_.entity(entity).name)}});
+      x_.open("xs:choice");
+      for (const std::string &element : scope_.entityChoice(entity))
+        x_.leaf("xs:element", {{"ref", element}});
+      x_.close("xs:choice");
+      x_.close("xs:group");
+    });
+  }
+
+  // Attributes refer to entities and hold aggregates of entities and SELECTs
+  // through named types rather than types in place: a validator compiles the
+  // content model of a large choice once, not once per attribute.
+
+  /// The type of an attribute referring to `entity`: "<Entity>-ref".
+  std::string useReferenceType(EntityId entity) {
+    std::string group = useGroup(entity);
+    return share(elementName(model_.entity(entity).name) + "-ref", [this, entity, group] {
+      x_.open("xs:complexType", {{"name", elementName(model_.entity(entity).name) + "-ref"}});
+      x_.leaf("xs:group", {{"ref", group}});
+      x_.close("xs:complexType");
+    });
+  }
+
+  /// The type of an aggregate whose members are the choice `group` (of an
+  /// entity or a SELECT named `member`): "<Member>-aggregate".
+  std::string useAggregateType(const std::string &member, std::string group) {
+    std::string name = elementName(member) + "-aggregate";
+    return share(name, [this, name, group] {
+      x_.open("xs:complexType", {{"name", name}});
+      x_.open("xs:sequence");
+      repeated("xs:group", group);
+      x_.close("xs:sequence");
+      x_.leaf("xs:attribute", {{"ref", "exp:cType"}});
+      x_.close("xs:complexType");
+    });
   }
 
   const XsdScope &scope_;
   const express::Model &model_;
   const express::Schema &schema_;
   XmlText x_;
-  std::map<std::string, EntityId> usedGroups_; ///< by group name: written sorted
+  std::map<std::string, std::function<void()>> shared_; ///< by name: written sorted
 };
 
 /// Names two declarations of the scope would both get, as "Name (entity a in

@@ -2,8 +2,10 @@
 // configuration gives for an EXPRESS schema, as docs/part28.md describes it:
 // one XSD for the schema (an element and a complex type per entity, a named
 // type per defined type, a group per entity and SELECT listing the elements a
-// value may be) and the common XSD it imports (root, header, abstract uos,
-// simple and aggregate member elements). The model must be resolved.
+// value may be, named types for references and aggregates of them) and the
+// common XSD it imports (root, header, abstract uos, simple and aggregate
+// member elements, the check that every ref names an id). The model must be
+// resolved.
 #pragma once
 
 #include "frontend/express/Schema.h"
