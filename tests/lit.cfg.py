@@ -33,8 +33,16 @@ else:
         "sample corpus not found at %s: tests that need it are UNSUPPORTED (skipped); "
         "set STEPNC_CORPUS or -DSTEPNC_CORPUS_DIR to run them" % corpus)
 
-# LinuxCNC's standalone interpreter checks the rs274 target's programs.
 import shutil
+
+# libxml2's xmllint validates Part 28 files against the generated XSDs.
+if shutil.which("xmllint"):
+    config.available_features.add("xmllint")
+else:
+    lit_config.warning("xmllint is not installed: the Part 28 XSD checks are UNSUPPORTED (skipped); "
+                       "scripts/install-deps.sh installs it (libxml2-utils)")
+
+# LinuxCNC's standalone interpreter checks the rs274 target's programs.
 if shutil.which("rs274"):
     config.available_features.add("rs274")
 else:

@@ -1,11 +1,16 @@
 // `stepnc schema FILE.exp...`: reads EXPRESS schemas, resolves them together
-// and prints a summary, or an entity's attribute list in Part 21 order.
+// and prints a summary, or an entity's attribute list in Part 21 order; with
+// --xsd, writes the Part 28 XSD of one schema and the common XSD instead.
 #include "frontend/express/Builtin.h"
 #include "frontend/express/SchemaReader.h"
+#include "frontend/part28/Xsd.h"
+#include "support/OutputFile.h"
 #include "tools/stepnc/Driver.h"
 
 #include <CLI/CLI.hpp>
+#include <filesystem>
 #include <iostream>
+#include <set>
 
 namespace stepnc::tool {
 
@@ -15,6 +20,9 @@ struct SchemaOptions {
   std::vector<std::string> files;
   std::vector<std::string> entities;
   bool builtin = false;
+  bool xsd = false;
+  std::string outputDir;   ///< -o, with --xsd
+  std::string schemaName;  ///< --schema-name, with --xsd
   DiagnosticOptions diag;
 };
 
@@ -79,18 +87,113 @@ int printEntities(const express::Model &model, const std::vector<std::string> &n
   return kExitOk;
 }
 
-int runSchema(const SchemaOptions &opts) {
+std::string schemaNames(const std::vector<const express::Schema *> &schemas) {
+  std::string out;
+  for (const express::Schema *s : schemas)
+    out += (out.empty() ? "" : ", ") + s->name;
+  return out;
+}
+
+/// The loaded schemas no other loaded schema interfaces (USE or REFERENCE FROM).
+std::vector<const express::Schema *> topSchemas(const express::Model &model) {
+  std::set<std::string> interfaced;
+  for (const express::Schema &s : model.schemas())
+    for (const express::Interface &i : s.interfaces)
+      if (express::lower(i.schema) != s.name)
+        interfaced.insert(express::lower(i.schema));
+  std::vector<const express::Schema *> tops;
+  for (const express::Schema &s : model.schemas())
+    if (!interfaced.count(s.name))
+      tops.push_back(&s);
+  return tops;
+}
+
+/// The schema to write the XSD of: --schema-name; else for --builtin the ARM
+/// (the schema ISO 14649 files name); else the one top schema.
+const express::Schema *xsdSchema(const express::Model &model, const SchemaOptions &opts) {
+  std::vector<const express::Schema *> all;
+  for (const express::Schema &s : model.schemas())
+    all.push_back(&s);
+  if (!opts.schemaName.empty()) {
+    const express::Schema *s = model.findSchema(opts.schemaName);
+    if (!s)
+      printToolError("no schema '" + opts.schemaName + "' among the loaded schemas (" + schemaNames(all) + ")");
+    return s;
+  }
+  if (opts.builtin)
+    return express::builtinSchemaFor("ISO14649_ARM");
+  std::vector<const express::Schema *> tops = topSchemas(model);
+  if (tops.size() == 1)
+    return tops.front();
+  printToolError("the loaded schemas (" + schemaNames(all) + ") have " + std::to_string(tops.size()) +
+                 " schemas that no other uses; choose one with --schema-name");
+  return nullptr;
+}
+
+/// Writes DIR/<schema>.xsd and DIR/iso_10303_28_common.xsd; neither when
+/// either cannot be created.
+int writeXsd(const express::Model &model, const SchemaOptions &opts) {
+  const express::Schema *schema = xsdSchema(model, opts);
+  if (!schema)
+    return kExitUsage;
+  std::string text, error;
+  if (!part28::schemaXsd(model, *schema, text, error)) {
+    printToolError(error);
+    return kExitDiagnostics;
+  }
+  const std::filesystem::path dir(opts.outputDir);
+  OutputFile schemaFile, commonFile;
+  if (!schemaFile.open((dir / (schema->name + ".xsd")).string(), error) ||
+      !commonFile.open((dir / part28::kCommonXsdFileName).string(), error)) {
+    printToolError(error + "; no XSD written");
+    return kExitUsage;
+  }
+  schemaFile.write(text);
+  commonFile.write(part28::commonXsd());
+  if (!schemaFile.commit(error) || !commonFile.commit(error)) {
+    printToolError(error);
+    return kExitUsage;
+  }
+  return kExitOk;
+}
+
+int checkUsage(const SchemaOptions &opts) {
   if (opts.builtin != opts.files.empty()) {
     printToolError("give EXPRESS files or --builtin, not both");
     return kExitUsage;
   }
-  if (opts.builtin) {
-    const express::Model &model = express::builtinModel();
-    printSummary(model);
-    int status = printEntities(model, opts.entities);
-    std::cout.flush();
-    return status;
+  if (!opts.xsd && (!opts.outputDir.empty() || !opts.schemaName.empty())) {
+    printToolError("-o and --schema-name go with --xsd");
+    return kExitUsage;
   }
+  if (opts.xsd && opts.outputDir.empty()) {
+    printToolError("--xsd needs -o DIR, the folder to write the XSD files into");
+    return kExitUsage;
+  }
+  if (opts.xsd && !opts.entities.empty()) {
+    printToolError("--entity does not go with --xsd");
+    return kExitUsage;
+  }
+  return kExitOk;
+}
+
+/// What the command does with a resolved model: the XSD, or the summary and
+/// the --entity lists. `status` is the loading's exit status.
+int report(const express::Model &model, const SchemaOptions &opts, int status) {
+  if (opts.xsd)
+    return writeXsd(model, opts);
+  printSummary(model);
+  if (int s = printEntities(model, opts.entities))
+    return s;
+  std::cout.flush();
+  return status;
+}
+
+int runSchema(const SchemaOptions &opts) {
+  if (int status = checkUsage(opts))
+    return status;
+  if (opts.builtin)
+    return report(express::builtinModel(), opts, kExitOk);
   DiagnosticSession session(opts.diag);
   DiagnosticEngine &diags = session.engine();
   express::Model model;
@@ -109,11 +212,11 @@ int runSchema(const SchemaOptions &opts) {
     return kExitUsage;
   if (!diags.hasErrors())
     model.resolve(diags);
-  printSummary(model);
-  if (int status = printEntities(model, opts.entities))
-    return status;
-  std::cout.flush();
-  return diags.hasErrors() ? kExitDiagnostics : kExitOk;
+  if (opts.xsd && diags.hasErrors()) {
+    printToolError("the EXPRESS schemas have errors; no XSD written");
+    return kExitDiagnostics;
+  }
+  return report(model, opts, diags.hasErrors() ? kExitDiagnostics : kExitOk);
 }
 
 } // namespace
@@ -123,10 +226,16 @@ void registerSchema(CLI::App &app, std::function<void(int)> setResult) {
   CLI::App *cmd = app.add_subcommand(
       "schema", "Read EXPRESS (ISO 10303-11) schemas, resolve them together (USE/REFERENCE FROM\n"
                 "across the files given) and print a summary; --entity prints an entity's\n"
-                "attributes in Part 21 order. --builtin shows the built-in ISO 14649 ARM.");
+                "attributes in Part 21 order. --builtin shows the built-in ISO 14649 ARM.\n"
+                "--xsd -o DIR writes the Part 28 XML Schema of a schema instead.");
   cmd->add_option("files", opts->files, "EXPRESS files (.exp)");
   cmd->add_flag("--builtin", opts->builtin, "Use the built-in ISO 14649 ARM schema instead of files");
   cmd->add_option("--entity", opts->entities, "Print this entity's Part 21 attribute list (repeatable)");
+  cmd->add_flag("--xsd", opts->xsd,
+                "Write the Part 28 XSD of a schema (<schema>.xsd) and iso_10303_28_common.xsd into -o DIR");
+  cmd->add_option("-o,--output", opts->outputDir, "With --xsd: the folder to write into");
+  cmd->add_option("--schema-name", opts->schemaName,
+                  "With --xsd: the schema (default: iso14649_arm for --builtin, else the one no other uses)");
   addDiagnosticOptions(*cmd, opts->diag);
   cmd->callback([opts, setResult] { setResult(runSchema(*opts)); });
 }
