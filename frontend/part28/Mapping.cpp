@@ -1,5 +1,7 @@
 #include "frontend/part28/Mapping.h"
 
+#include <map>
+
 namespace stepnc::p28 {
 
 std::string schemaNamespace(std::string_view schemaName) { return "urn:iso10303-28:xs/" + express::lower(schemaName); }
@@ -9,6 +11,20 @@ std::string xmlName(std::string_view expressName) {
   if (!s.empty() && s[0] >= 'a' && s[0] <= 'z')
     s[0] = static_cast<char>(s[0] - 'a' + 'A');
   return s;
+}
+
+std::vector<std::string> attributeElementNames(const express::Model &model, express::EntityId entity) {
+  const std::vector<express::Slot> &slots = model.entity(entity).slots;
+  std::map<std::string, int> explicitCount;
+  for (const express::Slot &s : slots)
+    if (!s.derived)
+      ++explicitCount[s.name];
+  std::vector<std::string> names;
+  for (const express::Slot &s : slots) {
+    const bool repeated = !s.derived && explicitCount[s.name] > 1;
+    names.push_back(repeated ? xmlName(model.entity(s.owner).name) + "." + xmlName(s.name) : xmlName(s.name));
+  }
+  return names;
 }
 
 TypeView viewType(const express::Model &model, express::TypeId type) {

@@ -6,6 +6,7 @@
 
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace stepnc::p28 {
 
@@ -20,6 +21,13 @@ std::string schemaNamespace(std::string_view schemaName);
 /// XML name of an EXPRESS entity, type or attribute: first letter upper case,
 /// the rest lower case ("machining_workingstep" -> "Machining_workingstep").
 std::string xmlName(std::string_view expressName);
+
+/// The element name of each of an entity's slots, in Part 21 order:
+/// xmlName(slot name), except where two explicit slots have the same name
+/// (attributes of the same name inherited from two supertypes): each of those
+/// is "<Declaring entity>.<Attribute>" ("Representation_item.Name"), since a
+/// repeated element in the entity's sequence would be ambiguous.
+std::vector<std::string> attributeElementNames(const express::Model &model, express::EntityId entity);
 
 /// A type as the XML mapping sees it: defined types followed to what they
 /// finally are, remembering the outermost declared name (which names the

@@ -112,6 +112,7 @@ struct Building {
   p21::InstanceId id = 0;
   std::vector<EntityId> records;                    ///< one entity, or the records of a complex instance
   std::vector<std::pair<EntityId, uint32_t>> slots; ///< (record entity, slot index in that entity)
+  std::vector<std::string> elements;                ///< each slot's element name
   std::vector<std::optional<Piece>> values;
   bool isReference = false;
   uint64_t at = 0;
@@ -424,11 +425,14 @@ void Translator::openInstance(Frame &frame, std::string_view local, int nbAttrib
   for (EntityId e : b.records) {
     const express::Entity &entity = model_->entity(e);
     if (b.records.size() == 1) {
+      b.elements = attributeElementNames(*model_, e);
       for (uint32_t s = 0; s < entity.slots.size(); ++s)
         b.slots.emplace_back(e, s);
     } else {
-      for (uint32_t s : entity.ownSlots)
+      for (uint32_t s : entity.ownSlots) {
         b.slots.emplace_back(e, s);
+        b.elements.push_back(xmlName(entity.slots[s].name));
+      }
     }
   }
   b.values.resize(b.slots.size());
@@ -480,11 +484,9 @@ void Translator::openInstance(Frame &frame, std::string_view local, int nbAttrib
 }
 
 int Translator::findSlot(const Building &b, std::string_view local) const {
-  for (size_t i = 0; i < b.slots.size(); ++i) {
-    const auto &[entity, index] = b.slots[i];
-    if (sameName(model_->entity(entity).slots[index].name, local))
+  for (size_t i = 0; i < b.slots.size(); ++i)
+    if (sameName(b.elements[i], local))
       return static_cast<int>(i);
-  }
   return -1;
 }
 
@@ -510,9 +512,9 @@ void Translator::openAttribute(Frame &frame, Frame &parent, std::string_view loc
   const int slot = findSlot(b, local);
   if (slot < 0) {
     std::string names;
-    for (const auto &[entity, index] : b.slots)
-      if (!model_->entity(entity).slots[index].derived)
-        names += (names.empty() ? "" : ", ") + xmlName(model_->entity(entity).slots[index].name);
+    for (size_t i = 0; i < b.slots.size(); ++i)
+      if (!model_->entity(b.slots[i].first).slots[b.slots[i].second].derived)
+        names += (names.empty() ? "" : ", ") + b.elements[i];
     error(frame.at, "<" + std::string(local) + "> is not an attribute of " + model_->entity(b.records.back()).name)
         .note(names.empty() ? "it has no attributes" : "its attributes are " + names);
     frame.kind = Frame::Skipped;

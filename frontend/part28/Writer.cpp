@@ -75,9 +75,9 @@ private:
   void processingInstruction(std::string_view target, std::string_view text);
   void section(const p21::DataSection &section, size_t number, const std::string &express);
   void instance(size_t index);
-  void record(const express::Entity &entity, const std::vector<uint32_t> &slots, std::span<const Value> values,
-              int indent);
-  void attribute(const express::Slot &slot, const Value &v, int indent);
+  void record(const express::Entity &entity, const std::vector<uint32_t> &slots, const std::vector<std::string> &names,
+              std::span<const Value> values, int indent);
+  void attribute(const express::Slot &slot, const std::string &element, const Value &v, int indent);
   void content(TypeId declared, const Value &v);
   void member(TypeId elementType, const Value &v);
   void reference(const Value &v);
@@ -359,10 +359,9 @@ void Writer::member(TypeId elementType, const Value &v) {
   buf_ += '>';
 }
 
-void Writer::attribute(const express::Slot &slot, const Value &v, int indent) {
+void Writer::attribute(const express::Slot &slot, const std::string &element, const Value &v, int indent) {
   if (v.kind == ValueKind::Unset || v.kind == ValueKind::Derived)
     return;
-  const std::string element = xmlName(slot.name);
   buf_.append(static_cast<size_t>(indent), ' ');
   buf_ += '<';
   buf_ += element;
@@ -379,15 +378,15 @@ void Writer::attribute(const express::Slot &slot, const Value &v, int indent) {
   buf_ += ">\n";
 }
 
-void Writer::record(const express::Entity &entity, const std::vector<uint32_t> &slots, std::span<const Value> values,
-                    int indent) {
+void Writer::record(const express::Entity &entity, const std::vector<uint32_t> &slots,
+                    const std::vector<std::string> &names, std::span<const Value> values, int indent) {
   if (values.size() != slots.size()) {
     fail(std::to_string(values.size()) + " values where " + entity.name + " has " + std::to_string(slots.size()) +
          " attributes");
     return;
   }
   for (size_t i = 0; i < slots.size(); ++i)
-    attribute(entity.slots[slots[i]], values[i], indent);
+    attribute(entity.slots[slots[i]], names[slots[i]], values[i], indent);
 }
 
 void Writer::instance(size_t index) {
@@ -413,12 +412,14 @@ void Writer::instance(size_t index) {
   buf_ += " id=\"i";
   buf_ += std::to_string(e.id);
   buf_ += "\">\n";
+  const size_t contentStart = buf_.size();
   const auto records = arena_.records();
   if (e.name() != p21::kComplexInstance) {
-    const express::Entity &entity = model_.entity(bound_.entity(index));
+    const express::EntityId id = bound_.entity(index);
+    const express::Entity &entity = model_.entity(id);
     std::vector<uint32_t> all(entity.slots.size());
     std::iota(all.begin(), all.end(), 0u);
-    record(entity, all, arena_.params(records[0]), 6);
+    record(entity, all, attributeElementNames(model_, id), arena_.params(records[0]), 6);
   } else {
     for (const p21::Record &r : records) {
       const express::EntityId id = model_.findEntity(bound_.schema(), express::lower(file_.names().name(r.name)));
@@ -427,8 +428,15 @@ void Writer::instance(size_t index) {
              "'");
         return;
       }
-      record(model_.entity(id), model_.entity(id).ownSlots, arena_.params(r), 6);
+      std::vector<std::string> names;
+      for (const express::Slot &slot : model_.entity(id).slots)
+        names.push_back(xmlName(slot.name));
+      record(model_.entity(id), model_.entity(id).ownSlots, names, arena_.params(r), 6);
     }
+  }
+  if (buf_.size() == contentStart) { // no attribute written: an empty element
+    buf_.replace(contentStart - 2, 2, "/>\n");
+    return;
   }
   buf_ += "    </";
   buf_ += element;

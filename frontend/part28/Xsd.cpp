@@ -12,7 +12,7 @@
 #include <set>
 #include <utility>
 
-namespace stepnc::part28 {
+namespace stepnc::p28 {
 
 using express::AggregateKind;
 using express::DeclTypeId;
@@ -22,37 +22,13 @@ using express::SimpleKind;
 using express::TypeExpr;
 using express::TypeId;
 
-std::string schemaNamespace(std::string_view schemaName) { return "urn:iso10303-28:xs/" + express::lower(schemaName); }
-
-std::string elementName(std::string_view expressName) {
-  std::string out = express::lower(expressName);
-  if (!out.empty() && out[0] >= 'a' && out[0] <= 'z')
-    out[0] = static_cast<char>(out[0] - 32);
-  return out;
-}
-
-std::vector<std::string> attributeElementNames(const express::Model &model, EntityId entity) {
-  const std::vector<express::Slot> &slots = model.entity(entity).slots;
-  std::map<std::string, int> explicitCount;
-  for (const express::Slot &s : slots)
-    if (!s.derived)
-      ++explicitCount[s.name];
-  std::vector<std::string> names;
-  for (const express::Slot &s : slots) {
-    const bool repeated = !s.derived && explicitCount[s.name] > 1;
-    names.push_back(repeated ? elementName(model.entity(s.owner).name) + "." + elementName(s.name)
-                             : elementName(s.name));
-  }
-  return names;
-}
-
 namespace {
 
 /// Guards the walks along TYPE a = b chains, which resolution does not check
 /// for cycles.
 constexpr int kMaxTypeChain = 64;
 
-std::string groupName(std::string_view expressName) { return elementName(expressName) + "-group"; }
+std::string groupName(std::string_view expressName) { return xmlName(expressName) + "-group"; }
 
 const char *simpleTypeName(SimpleKind k) {
   switch (k) {
@@ -216,7 +192,7 @@ private:
     x_.open("xs:extension", {{"base", "exp:uos"}});
     x_.open("xs:choice", {{"minOccurs", "0"}, {"maxOccurs", "unbounded"}});
     for (EntityId e : scope_.entities())
-      x_.leaf("xs:element", {{"ref", elementName(model_.entity(e).name)}});
+      x_.leaf("xs:element", {{"ref", xmlName(model_.entity(e).name)}});
     x_.close("xs:choice");
     x_.close("xs:extension");
     x_.close("xs:complexContent");
@@ -228,7 +204,7 @@ private:
   /// attribute in Part 21 order (derived ones are never written).
   void writeEntity(EntityId id) {
     const express::Entity &e = model_.entity(id);
-    const std::string name = elementName(e.name);
+    const std::string name = xmlName(e.name);
     x_.leaf("xs:element", {{"name", name}, {"type", name}, {"nillable", "true"}});
     x_.open("xs:complexType", {{"name", name}});
     bool any = std::any_of(e.slots.begin(), e.slots.end(), [](const express::Slot &s) { return !s.derived; });
@@ -266,7 +242,7 @@ private:
     if (t.kind == TypeExpr::Simple)
       return simpleTypeName(t.simple);
     if (t.kind == TypeExpr::Named && t.declared != kNone)
-      return elementName(model_.typeDecl(t.declared).name);
+      return xmlName(model_.typeDecl(t.declared).name);
     if (t.kind == TypeExpr::Named && t.entity != kNone)
       return useReferenceType(t.entity);
     if (t.kind != TypeExpr::Aggregate)
@@ -300,7 +276,7 @@ private:
       const std::string &name = model_.typeDecl(t.declared).name;
       if (scope_.isSelect(t.declared))
         return repeated("xs:group", groupName(name));
-      return repeated("xs:element", elementName(name));
+      return repeated("xs:element", xmlName(name));
     }
     x_.leaf("xs:any", {{"processContents", "lax"}, {"minOccurs", "0"}, {"maxOccurs", "unbounded"}});
   }
@@ -314,7 +290,7 @@ private:
   /// typed SELECT values and aggregate members) and a simple or complex type.
   void writeDefinedType(DeclTypeId id) {
     const express::TypeDecl &decl = model_.typeDecl(id);
-    const std::string name = elementName(decl.name);
+    const std::string name = xmlName(decl.name);
     if (scope_.isSelect(id)) {
       x_.open("xs:group", {{"name", groupName(decl.name)}});
       x_.open("xs:choice");
@@ -351,7 +327,7 @@ private:
   }
 
   void writeEnumeration(DeclTypeId id) {
-    x_.open("xs:simpleType", {{"name", elementName(model_.typeDecl(id).name)}});
+    x_.open("xs:simpleType", {{"name", xmlName(model_.typeDecl(id).name)}});
     x_.open("xs:restriction", {{"base", "xs:string"}});
     for (const std::string &value : scope_.enumerationValues(id))
       x_.leaf("xs:enumeration", {{"value", value}});
@@ -399,8 +375,8 @@ private:
   /// The type of an attribute referring to `entity`: "<Entity>-ref".
   std::string useReferenceType(EntityId entity) {
     std::string group = useGroup(entity);
-    return share(elementName(model_.entity(entity).name) + "-ref", [this, entity, group] {
-      x_.open("xs:complexType", {{"name", elementName(model_.entity(entity).name) + "-ref"}});
+    return share(xmlName(model_.entity(entity).name) + "-ref", [this, entity, group] {
+      x_.open("xs:complexType", {{"name", xmlName(model_.entity(entity).name) + "-ref"}});
       x_.leaf("xs:group", {{"ref", group}});
       x_.close("xs:complexType");
     });
@@ -409,7 +385,7 @@ private:
   /// The type of an aggregate whose members are the choice `group` (of an
   /// entity or a SELECT named `member`): "<Member>-aggregate".
   std::string useAggregateType(const std::string &member, std::string group) {
-    std::string name = elementName(member) + "-aggregate";
+    std::string name = xmlName(member) + "-aggregate";
     return share(name, [this, name, group] {
       x_.open("xs:complexType", {{"name", name}});
       x_.open("xs:sequence");
@@ -433,9 +409,9 @@ std::string nameClashes(const XsdScope &scope) {
   const express::Model &m = scope.model();
   std::map<std::string, std::vector<std::string>> owners;
   for (EntityId e : scope.entities())
-    owners[elementName(m.entity(e).name)].push_back("entity " + m.entity(e).name + " in schema " + m.entity(e).schema);
+    owners[xmlName(m.entity(e).name)].push_back("entity " + m.entity(e).name + " in schema " + m.entity(e).schema);
   for (DeclTypeId t : scope.types())
-    owners[elementName(m.typeDecl(t).name)].push_back("type " + m.typeDecl(t).name + " in schema " +
+    owners[xmlName(m.typeDecl(t).name)].push_back("type " + m.typeDecl(t).name + " in schema " +
                                                       m.typeDecl(t).schema);
   std::string out;
   for (const auto &[name, what] : owners) {
@@ -566,7 +542,7 @@ void XsdScope::collectSubtree(EntityId entity, std::vector<std::string> &out, st
     return;
   seen[entity] = true;
   if (entityIn_[entity])
-    out.push_back(elementName(model_.entity(entity).name));
+    out.push_back(xmlName(model_.entity(entity).name));
   for (EntityId sub : model_.entity(entity).subtypes)
     collectSubtree(sub, out, seen);
 }
@@ -595,7 +571,7 @@ void XsdScope::collectSelect(DeclTypeId type, std::vector<std::string> &out, std
       collectSelect(id, out, seenTypes, seenEntities);
     else if (!seenTypes[id]) {
       seenTypes[id] = true;
-      out.push_back(elementName(model_.typeDecl(id).name));
+      out.push_back(xmlName(model_.typeDecl(id).name));
     }
   }
 }
@@ -705,4 +681,4 @@ bool schemaXsd(const express::Model &model, const express::Schema &schema, std::
   return true;
 }
 
-} // namespace stepnc::part28
+} // namespace stepnc::p28

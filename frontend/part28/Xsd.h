@@ -9,31 +9,16 @@
 #pragma once
 
 #include "frontend/express/Schema.h"
+#include "frontend/part28/Mapping.h"
 
 #include <string>
 #include <string_view>
 #include <vector>
 
-namespace stepnc::part28 {
+namespace stepnc::p28 {
 
-/// The namespace of the common elements (exp:iso_10303_28, exp:double ...).
-inline constexpr std::string_view kCommonNamespace = "urn:oid:1.0.10303.28.2.1.1";
 /// The file name the schema XSDs import the common XSD from.
 inline constexpr std::string_view kCommonXsdFileName = "iso_10303_28_common.xsd";
-
-/// "urn:iso10303-28:xs/<schema name, lower case>".
-std::string schemaNamespace(std::string_view schemaName);
-
-/// The XML element name of an EXPRESS entity, type or attribute: first
-/// letter upper case, the rest lower case ("Machining_workingstep").
-std::string elementName(std::string_view expressName);
-
-/// The element name of each of an entity's slots, in Part 21 order:
-/// elementName(slot name), except where two explicit slots have the same name
-/// (attributes of the same name inherited from two supertypes): each of those
-/// is "<Declaring entity>.<Attribute>" ("Representation_item.Name"), since a
-/// repeated element in the entity's sequence would be ambiguous.
-std::vector<std::string> attributeElementNames(const express::Model &model, express::EntityId entity);
 
 /// The entities and defined types an XSD declares: every one visible in the
 /// schema (declared or interfaced) and, transitively, every one their
@@ -86,4 +71,4 @@ std::string commonXsd();
 /// element name (entities or types of the same name in different schemas).
 bool schemaXsd(const express::Model &model, const express::Schema &schema, std::string &out, std::string &error);
 
-} // namespace stepnc::part28
+} // namespace stepnc::p28

@@ -137,19 +137,19 @@ int writeXsd(const express::Model &model, const SchemaOptions &opts) {
   if (!schema)
     return kExitUsage;
   std::string text, error;
-  if (!part28::schemaXsd(model, *schema, text, error)) {
+  if (!p28::schemaXsd(model, *schema, text, error)) {
     printToolError(error);
     return kExitDiagnostics;
   }
   const std::filesystem::path dir(opts.outputDir);
   OutputFile schemaFile, commonFile;
   if (!schemaFile.open((dir / (schema->name + ".xsd")).string(), error) ||
-      !commonFile.open((dir / part28::kCommonXsdFileName).string(), error)) {
+      !commonFile.open((dir / p28::kCommonXsdFileName).string(), error)) {
     printToolError(error + "; no XSD written");
     return kExitUsage;
   }
   schemaFile.write(text);
-  commonFile.write(part28::commonXsd());
+  commonFile.write(p28::commonXsd());
   if (!schemaFile.commit(error) || !commonFile.commit(error)) {
     printToolError(error);
     return kExitUsage;

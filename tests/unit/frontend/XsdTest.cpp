@@ -8,7 +8,7 @@
 
 using namespace stepnc;
 using namespace stepnc::express;
-using namespace stepnc::part28;
+using namespace stepnc::p28;
 
 namespace {
 
@@ -50,8 +50,8 @@ END_SCHEMA;
 } // namespace
 
 TEST_CASE("xsd: element names are the EXPRESS name with the first letter upper case") {
-  CHECK(elementName("machining_workingstep") == "Machining_workingstep");
-  CHECK(elementName("TWO5D_MILLING_STRATEGY") == "Two5d_milling_strategy");
+  CHECK(xmlName("machining_workingstep") == "Machining_workingstep");
+  CHECK(xmlName("TWO5D_MILLING_STRATEGY") == "Two5d_milling_strategy");
   CHECK(schemaNamespace("ISO14649_ARM") == "urn:iso10303-28:xs/iso14649_arm");
 }
 
