@@ -283,11 +283,13 @@ std::vector<KindSpec> makeTable() {
           {"travel_length", T::Length}},
          {}});
 
-  // Explicit toolpaths (freeform operations).
+  // Explicit toolpaths (freeform operations). `rapid`: the toolpath's speed
+  // is the ISO 14649 speed name `rapid` (its moves are rapids).
   add({"toolpath", "toolpath", Sigil::None, false,
        {{"role", T::Word, true, "approach lift connect non_contact contact trajectory_path"},
         {"required", T::Flag, true},
         {"speed_ratio", T::Ratio},
+        {"rapid", T::Flag},
         {"reversed", T::Flag}},
        "curve technology machine_functions"});
 

@@ -374,6 +374,7 @@ private:
     for (const Node *tp : op.childrenOf("toolpath")) {
       const Node *tech = tp->child("technology");
       const double feed = tech && tech->number("feed") ? *tech->number("feed") : p.feed;
+      const ExplicitKind kind = explicitKind(*tp);
       for (const Node &curve : tp->children) {
         if (ir::findKind(curve.kind) == nullptr || ir::findKind(curve.kind)->category != "curve")
           continue;
@@ -391,26 +392,58 @@ private:
           }
         }
         for (const CurvePiece &c : cr.pieces)
-          explicitPiece(frame, c, feed, p.clearanceZ, e);
+          explicitPiece(frame, c, kind, feed, p.clearanceZ, e);
       }
     }
     e.retract();
   }
 
+  /// How the moves of an explicit toolpath are made: rapid or at feed, and
+  /// the role they get. ISO 14649 types a toolpath by what it does; its
+  /// speed name `rapid` makes its moves rapids. A `trajectory_path` says no
+  /// more than that it is followed: at feed it cuts.
+  struct ExplicitKind {
+    bool rapid = false;
+    const char *role = "cut";
+  };
+
+  static ExplicitKind explicitKind(const Node &tp) {
+    const bool rapid = tp.flag("rapid").value_or(false);
+    const std::string type = tp.text("role").value_or("trajectory_path");
+    struct Row {
+      const char *type, *rapidRole, *feedRole;
+    };
+    static constexpr Row kRoles[] = {{"non_contact", "position", "position"}, {"approach", "approach", "plunge"},
+                                     {"contact", "cut", "cut"},               {"connect", "link", "link"},
+                                     {"lift", "retract", "retract"},          {"trajectory_path", "position", "cut"}};
+    for (const Row &r : kRoles)
+      if (type == r.type)
+        return {rapid, rapid ? r.rapidRole : r.feedRole};
+    return {rapid, rapid ? "position" : "cut"};
+  }
+
   /// One piece of an explicit toolpath, mapped from the feature's frame.
-  void explicitPiece(const PlaneFrame &f, const CurvePiece &c, double feed, double clearanceZ, Emitter &e) {
+  void explicitPiece(const PlaneFrame &f, const CurvePiece &c, const ExplicitKind &kind, double feed,
+                     double clearanceZ, Emitter &e) {
     const Vec3 from = at(f.map(c.from.head<2>()), f.z + c.from.z());
     const Vec3 to = at(f.map(c.to.head<2>()), f.z + c.to.z());
     if (!e.positioned() || (e.position() - from).norm() > 1e-6) {
       // Reach the start: over it at the security plane, down in free space to
-      // the clearance height at most, then at feed.
-      e.travel(from.head<2>(), std::max(from.z(), std::min(clearanceZ, e.secplane())));
-      e.linear(from, feed, "plunge");
+      // the clearance height at most, then at feed. A start at or above the
+      // security plane, or of rapids, is reached by rapids alone.
+      if (kind.rapid) {
+        e.travel(from.head<2>(), from.z());
+      } else {
+        e.travel(from.head<2>(), std::max(from.z(), std::min(clearanceZ, e.secplane())));
+        e.linear(from, feed, "plunge");
+      }
     }
-    if (!c.arc)
-      e.linear(to, feed, "cut");
+    if (kind.rapid)
+      e.rapid(to, kind.role);
+    else if (!c.arc)
+      e.linear(to, feed, kind.role);
     else
-      e.arc(to, f.map(c.center.head<2>()), c.ccw != f.mirrored(), c.turns, feed, "cut");
+      e.arc(to, f.map(c.center.head<2>()), c.ccw != f.mirrored(), c.turns, feed, kind.role);
   }
 
   void rapidMovement(Node &rm, const std::string &setup) {

@@ -340,8 +340,10 @@ void Lowerer::toolpaths(const Instance &list, Node &parent) {
     n.set("required", Value::boolean(tp.boolean("its_priority").value_or(true)));
     if (auto r = tp.real("its_speed"))
       n.set("speed_ratio", Value::ratio(*r));
+    else if (tp.enumeration("its_speed") == "rapid")
+      n.set("rapid", Value::boolean(true));
     else if (tp.attr("its_speed") && !tp.attr("its_speed")->isUnset())
-      unsupported(tp, "toolpath speed profile other than a ratio");
+      unsupported(tp, "toolpath speed profile other than a ratio or rapid");
     if (auto dir = tp.boolean("its_direction"))
       n.set("reversed", Value::boolean(!*dir));
     if (Instance tech = tp.ref("its_technology"))
