@@ -219,6 +219,7 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
     step.executable = p.exec;
     step.movesNode = p.moves;
     step.operation = operationKind(*p.exec);
+    step.asWritten = runsAsWritten(*p.exec);
     if (auto t = out.tools.find(p.moves->text("tool").value_or("")); t != out.tools.end())
       step.tool = &t->second;
     const double spindle = p.moves->number("spindle").value_or(0);
@@ -301,7 +302,7 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
       if (!m.isFeed() || !m.from || radius <= 0)
         continue;
       const std::vector<geom::Seg> segs = m.planar();
-      if (model && !m.changesHeight() && !segs.empty()) {
+      if (model && !step.asWritten && !m.changesHeight() && !segs.empty()) {
         cm.measured = true;
         cm.fz = m.feed / (cutter.flutes * step.spindle);
         const cutting::CuttingCoefficients k = material->coefficients();

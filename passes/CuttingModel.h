@@ -78,6 +78,9 @@ struct CutStep {
   const cutting::Material *material = nullptr;
   double spindle = 0; ///< rev/min, unsigned
   std::string operation;
+  /// Its moves are the file's required toolpaths (runsAsWritten): cut into
+  /// the stock, never measured, so the cutting passes leave them as written.
+  bool asWritten = false;
   std::vector<CutMove> moves;
 
   /// The move of `moves` whose node is `node`, searching on from `cursor`

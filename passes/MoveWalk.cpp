@@ -9,6 +9,9 @@
 // A change of height spreads evenly over the angle: a helix.
 #include "passes/MoveWalk.h"
 
+#include "ir/Kinds.h"
+
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -147,6 +150,17 @@ std::vector<Move> walkMoves(const ir::Node &moves, std::optional<ir::Vec3> start
     out.push_back(std::move(m));
   }
   return out;
+}
+
+bool runsAsWritten(const ir::Node &executable) {
+  for (const ir::Node &c : executable.children)
+    if (const ir::KindSpec *spec = ir::findKind(c.kind); spec && spec->category == "operation") {
+      const std::vector<const ir::Node *> toolpaths = c.childrenOf("toolpath");
+      return !toolpaths.empty() && std::all_of(toolpaths.begin(), toolpaths.end(), [](const ir::Node *tp) {
+        return tp->flag("required").value_or(true);
+      });
+    }
+  return false;
 }
 
 } // namespace stepnc::passes

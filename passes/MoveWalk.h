@@ -59,4 +59,11 @@ std::vector<Move> walkMoves(const ir::Node &moves, std::optional<ir::Vec3> start
 /// module's workplans, nested workplans flattened where they stand.
 std::vector<const ir::Node *> programOrder(const ir::Module &module);
 
+/// Whether an executable's moves are its operation's explicit toolpaths,
+/// every one of them required (ISO 14649 `its_priority`): they run as the
+/// file writes them: no pass changes their path, and adapt-feed changes a
+/// feed only to what the machine reaches on the move (which changes nothing
+/// the machine does).
+bool runsAsWritten(const ir::Node &executable);
+
 } // namespace stepnc::passes

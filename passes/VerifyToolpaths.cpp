@@ -614,6 +614,15 @@ private:
       gouges.push_back(std::move(g));
     }
     s.figures.gouge = totalArea(gouges);
+    // Required toolpaths run as the file writes them: where they enter a
+    // wall (a finishing path compensated for tool deflection does, by its
+    // offset), stepnc warns but does not refuse the file.
+    if (runsAsWritten(*s.exec)) {
+      for (Offence &o : offences)
+        o.message += " (a required toolpath of the file, run as written)";
+      report(s, offences, "gouges of required toolpaths", /*warning=*/true);
+      return;
+    }
     report(s, offences, "gouge errors");
   }
 

@@ -33,7 +33,8 @@ const char *const kFiles[] = {
     "jucsr__sanssouci/STEP-NC_Slot1 File.p21",
     "jucsr__sanssouci/oneHoleOneSlotOneStepOnePoket.p21",
     "unseenlaser__iso-14649-toolkit/ex1.stp",
-    "unseenlaser__iso-14649-toolkit/ex1E.stp",
+    // Not ex1E.stp: its explicit toolpaths are required (its_priority), so
+    // the cutting passes leave them as written (passes::runsAsWritten).
 };
 
 /// How close to the chip target adapt-feed comes where the chip limits the
