@@ -18,6 +18,8 @@ packages=(
   libcli11-dev libtomlplusplus-dev libxml2-dev libxml2-utils
   # tests: Catch2 unit tests, lit + FileCheck golden tests, LinuxCNC's rs274 interpreter
   catch2 llvm-14-tools linuxcnc-uspace
+  # tests: Open CASCADE's STEP reader reads the STEP-NC stepnc writes back
+  libocct-data-exchange-dev
   # benchmarks
   libbenchmark-dev
 )

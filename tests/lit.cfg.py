@@ -51,6 +51,14 @@ else:
 config.substitutions.append(("%check-rs274", "python3 %s --stepnc %s" % (
     os.path.join(config.test_source_root, "backends", "check-rs274.py"),
     os.path.join(config.stepnc_tools_dir, "stepnc"))))
+# Open CASCADE's STEP reader reads the STEP-NC that compile --emit=stepnc writes.
+occt_read_step = os.path.join(config.stepnc_tools_dir, "stepnc-occt-read-step")
+if config.occt_available == "ON" and os.path.exists(occt_read_step):
+    config.available_features.add("occt")
+else:
+    lit_config.warning("Open CASCADE is not installed: reading written STEP-NC with its STEP reader is "
+                       "UNSUPPORTED (skipped); scripts/install-deps.sh installs it (libocct-data-exchange-dev)")
+config.substitutions.append(("%occt-read-step", occt_read_step))
 config.substitutions.append(("%stepnc", os.path.join(config.stepnc_tools_dir, "stepnc")))
 config.substitutions.append(("%corpus", corpus))
 config.substitutions.append(("%inputs", os.path.join(config.test_source_root, "Inputs")))

@@ -6,9 +6,11 @@
 // atomically.
 #include "backends/Backend.h"
 #include "backends/common/ToolTable.h"
+#include "backends/step-nc/OptimisedFile.h"
 #include "frontend/binding/Binder.h"
 #include "frontend/lowering/Lowering.h"
 #include "frontend/part21/Part21File.h"
+#include "frontend/part21/Writer.h"
 #include "ir/Parser.h"
 #include "ir/Printer.h"
 #include "ir/Verifier.h"
@@ -19,6 +21,7 @@
 #include "tools/stepnc/SchemaSelection.h"
 
 #include "support/Format.h"
+#include "support/OutputFile.h"
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -82,6 +85,63 @@ std::string optionsText(const CompileOptions &opts) {
   return text;
 }
 
+/// What FILE_DESCRIPTION says about how an optimised file was made.
+std::vector<std::string> optimisedDescription(const CompileOptions &opts, const std::string &pipeline,
+                                              const std::vector<std::string> &reports) {
+  std::vector<std::string> lines = {
+      "machine-optimised STEP-NC written by stepnc compile --emit=stepnc from " +
+          std::filesystem::path(opts.input).filename().string(),
+      "kept: every instance of the input with its id and values; changed: the its_toolpath of each expanded "
+      "operation, now a TOOLPATH_LIST of required CUTTER_LOCATION_TRAJECTORY in the frame of the feature; "
+      "added: the instances above the largest id of the input",
+      "machine: " + (opts.machine.empty() ? std::string("none given") : opts.machine),
+      "passes: " + pipeline,
+      opts.noAdaptFeed ? std::string("feeds: as programmed (--no-adapt-feed)")
+                       : "feeds: adapted by adapt-feed, per toolpath segment: each trajectory has a "
+                         "MILLING_TECHNOLOGY with its feed" +
+                             std::string(opts.allowFeedIncrease ? " (--allow-feed-increase)" : ""),
+      opts.noCompensateDeflection ? std::string("finishing walls: nominal path (--no-compensate-deflection)")
+                                  : std::string("finishing walls: compensated for tool deflection where "
+                                                "compensate-deflection reports it"),
+  };
+  if (!opts.cuttingData.empty())
+    lines.push_back("cutting data: " + opts.cuttingData + " on top of the shipped data");
+  for (const std::string &r : reports)
+    lines.push_back(r);
+  return lines;
+}
+
+/// Writes the machine-optimised STEP-NC file (Part 21, canonical, atomically).
+int writeOptimised(const CompileOptions &opts, const p21::Part21File &input, const ir::Module &module,
+                   const std::string &pipeline, const std::vector<std::string> &reports, DiagnosticEngine &diags) {
+  backends::OptimisedFileOptions options;
+  options.description = optimisedDescription(opts, pipeline, reports);
+  std::unique_ptr<SourceFile> text;
+  auto file = backends::buildOptimisedFile(input, module, options, text, diags);
+  if (!file) {
+    std::cerr << "stepnc: cannot write optimised STEP-NC for " << opts.input << "; nothing written\n";
+    return kExitDiagnostics;
+  }
+  OutputFile out;
+  std::string error;
+  if (!out.open(opts.output, error)) {
+    printToolError(error);
+    return kExitUsage;
+  }
+  if (!p21::writePart21(*file, out, diags)) {
+    std::cerr << "stepnc: cannot write optimised STEP-NC for " << opts.input << "; nothing written\n";
+    return kExitDiagnostics;
+  }
+  if (!out.commit(error)) {
+    printToolError(error);
+    return kExitUsage;
+  }
+  if (opts.output != "-")
+    std::cerr << "stepnc: wrote " << opts.output << " (machine-optimised STEP-NC, " << file->entries().size()
+              << " instances)\n";
+  return kExitOk;
+}
+
 int runCompile(const CompileOptions &opts) {
   const std::string emit = !opts.emit.empty() ? opts.emit : opts.target.empty() ? "feature-ir" : "program";
   std::unique_ptr<backends::Backend> backend;
@@ -108,6 +168,11 @@ int runCompile(const CompileOptions &opts) {
       return kExitUsage;
     }
   }
+  if (emit == "stepnc" && std::filesystem::path(opts.output).extension() == ".stpx") {
+    printToolError("compile: --emit=stepnc to Part 28 XML (" + opts.output +
+                   ") is not yet supported: write Part 21 (.stp)");
+    return kExitUsage;
+  }
   const bool needsMotion = emit == "motion-ir" || opts.target == "native";
   if (needsMotion && opts.machine.empty()) {
     std::string names;
@@ -126,9 +191,10 @@ int runCompile(const CompileOptions &opts) {
   bool usage = false;
   if (!schemas.load(diags, usage))
     return usage ? kExitUsage : kExitDiagnostics;
+  std::unique_ptr<p21::Part21File> file;
   std::unique_ptr<ir::Module> module;
   if (schemas.readAsPart21(source, diags))
-    module = loadModule(*source, schemas, diags, usage);
+    module = loadModule(*source, schemas, diags, usage, emit == "stepnc" ? &file : nullptr);
   if (module && !ir::verifyModule(*module, diags))
     module.reset();
   if (!module) {
@@ -136,6 +202,10 @@ int runCompile(const CompileOptions &opts) {
       return kExitUsage;
     std::cerr << "stepnc: " << opts.input << " has errors; nothing written\n";
     return kExitDiagnostics;
+  }
+  if (emit == "stepnc" && !file) {
+    printToolError("compile: --emit=stepnc writes a STEP-NC file back: give a STEP-NC input, not IR text");
+    return kExitUsage;
   }
   // The toolpath IR is the feature IR after the passes that make and check
   // moves; a program is written from the toolpath IR.
@@ -149,8 +219,10 @@ int runCompile(const CompileOptions &opts) {
   std::string pipelineText = emit != "feature-ir" && opts.passes.empty() ? toolpathPipeline(toolpath) : opts.passes;
   if (opts.passes.empty() && needsMotion)
     pipelineText += "," + planMotionPipeline(opts.machine, opts.tolerance);
+  std::vector<std::string> reports;
   if (!pipelineText.empty()) {
     PipelineRun run;
+    run.reports = &reports;
     run.verifyEach = opts.verifyEach;
     run.printAfterAll = opts.printAfterAll;
     run.printAfter = opts.printAfter;
@@ -161,6 +233,8 @@ int runCompile(const CompileOptions &opts) {
       return rc;
     }
   }
+  if (emit == "stepnc")
+    return writeOptimised(opts, *file, *module, pipelineText, reports, diags);
   if (backend) {
     std::optional<backends::ToolTable> table;
     std::unique_ptr<SourceFile> tableFile;
@@ -234,7 +308,7 @@ void addCommonOptions(CLI::App &cmd, const std::shared_ptr<CompileOptions> &opts
 } // namespace
 
 std::unique_ptr<ir::Module> loadModule(const SourceFile &source, const SchemaSelection &schemas,
-                                       DiagnosticEngine &diags, bool &usage) {
+                                       DiagnosticEngine &diags, bool &usage, std::unique_ptr<p21::Part21File> *keep) {
   std::string_view text = source.text();
   while (!text.empty() && (text[0] == ' ' || text[0] == '\n' || text[0] == '\r' || text[0] == '\t'))
     text.remove_prefix(1);
@@ -263,6 +337,8 @@ std::unique_ptr<ir::Module> loadModule(const SourceFile &source, const SchemaSel
   auto module = lowering::lowerToFeatureIR(*bound, diags);
   if (!module || diags.hasErrors())
     return nullptr;
+  if (keep)
+    *keep = std::move(file);
   return module;
 }
 
@@ -315,6 +391,10 @@ int runPipeline(ir::Module &module, const std::string &text, const PipelineRun &
       for (const std::string &line : lines)
         std::cerr << "report: " << pass << ": " << line << '\n';
   }
+  if (run.reports)
+    for (const auto &[pass, lines] : manager.reports())
+      for (const std::string &line : lines)
+        run.reports->push_back(std::string(pass) + ": " + line);
   return ok ? kExitOk : kExitDiagnostics;
 }
 
@@ -356,8 +436,9 @@ void registerCompile(CLI::App &app, std::function<void(int)> setResult) {
   cmd->add_option("--emit", opts->emit,
                   "What to write: program (with --target, the default then), feature-ir (the lowered\n"
                   "process IR; the default without --target), toolpath-ir (with moves, verified) or\n"
-                  "motion-ir (with the motion planned on --machine)")
-      ->check(CLI::IsMember({"feature-ir", "toolpath-ir", "motion-ir", "program"}));
+                  "motion-ir (with the motion planned on --machine) or stepnc (the input written back\n"
+                  "as machine-optimised STEP-NC with the computed toolpaths and feeds, docs/feedback.md)")
+      ->check(CLI::IsMember({"feature-ir", "toolpath-ir", "motion-ir", "program", "stepnc"}));
   cmd->add_option("--machine", opts->machine,
                   "Machine to plan the motion on, for --target=native and --emit=motion-ir: a TOML\n"
                   "file (docs/machine-model.md) or a shipped machine (hsc-3axis, conventional-3axis);\n"

@@ -2,6 +2,7 @@
 // running a pass pipeline over it.
 #pragma once
 
+#include "frontend/part21/Part21File.h"
 #include "ir/Node.h"
 #include "support/Diagnostics.h"
 #include "support/SourceFile.h"
@@ -34,14 +35,18 @@ std::string planMotionPipeline(const std::string &machine, std::optional<double>
 /// Reads `source` as IR text (a file that starts with the IR's comment line
 /// or `project`) or as STEP-NC, which is checked and lowered. Returns null
 /// after reporting errors; `usage` is set when the command line is at fault.
+/// `file`, when given, receives the Part 21 file read (null for IR text).
 std::unique_ptr<ir::Module> loadModule(const SourceFile &source, const SchemaSelection &schemas,
-                                       DiagnosticEngine &diags, bool &usage);
+                                       DiagnosticEngine &diags, bool &usage,
+                                       std::unique_ptr<p21::Part21File> *file = nullptr);
 
 struct PipelineRun {
   bool verifyEach = false;
   bool printAfterAll = false;
   std::vector<std::string> printAfter;
   bool stats = false;  ///< print each pass's counters to stderr
+  /// When given, receives each pass's report lines as "pass: line".
+  std::vector<std::string> *reports = nullptr;
 };
 
 /// Runs the pipeline `text` over `module`. Returns the exit code: kExitOk,

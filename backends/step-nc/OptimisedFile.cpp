@@ -1,0 +1,492 @@
+// Machine-optimised STEP-NC (see OptimisedFile.h): the input's canonical Part
+// 21 text, one line per instance, patched line by line (FILE_DESCRIPTION, the
+// operations that get a toolpath) with the new instances appended to the last
+// DATA section.
+//
+// Values must read back bit for bit, so that lowering the written file makes
+// the same moves: points are written in the feature's frame as the local
+// coordinates whose mapping back gives the workpiece coordinates exactly (a
+// few units in the last place are searched; exact for frames along the axes),
+// and feeds and spindle speeds as the speed measures whose conversion by
+// lowering gives them exactly (the canonical writer writes shortest
+// round-trip reals).
+#include "backends/step-nc/OptimisedFile.h"
+
+#include "frontend/lowering/Lowering.h"
+#include "frontend/part21/Writer.h"
+#include "ir/Kinds.h"
+#include "passes/FeatureShape.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <optional>
+#include <set>
+
+namespace stepnc::backends {
+
+namespace {
+
+using ir::Node;
+using ir::Vec3;
+using p21::InstanceId;
+using passes::PlaneFrame;
+
+constexpr double kTwoPi = 2 * std::numbers::pi;
+/// Units in the last place searched either side of a first guess for a value
+/// that reads back exactly.
+constexpr int kUlpSearch = 4;
+
+/// The double near `guess` for which `forward` gives exactly `target`; the
+/// guess when none within kUlpSearch units in the last place does.
+template <class Forward> double preimage(double target, double guess, Forward forward) {
+  double down = guess, up = guess;
+  for (int i = 0; i <= kUlpSearch; ++i) {
+    if (forward(up) == target)
+      return up;
+    if (forward(down) == target)
+      return down;
+    up = std::nextafter(up, INFINITY);
+    down = std::nextafter(down, -INFINITY);
+  }
+  return guess;
+}
+
+/// Candidates within kUlpSearch units in the last place of `x`, nearest first.
+std::vector<double> around(double x) {
+  std::vector<double> out{x};
+  double up = x, down = x;
+  for (int i = 0; i < kUlpSearch; ++i) {
+    up = std::nextafter(up, INFINITY);
+    down = std::nextafter(down, -INFINITY);
+    out.push_back(up);
+    out.push_back(down);
+  }
+  return out;
+}
+
+/// `p` (workpiece coordinates) in the frame `f`: the local point that
+/// expand-strategies maps back to exactly `p` where one is found.
+Vec3 localPoint(const PlaneFrame &f, const Vec3 &p) {
+  const geom::Vec2 d = p.head<2>() - f.origin;
+  const double lx = d.dot(f.x), ly = d.dot(f.y);
+  const double lz = preimage(p.z(), p.z() - f.z, [&](double z) { return f.z + z; });
+  for (double x : around(lx))
+    for (double y : around(ly))
+      if (f.map(geom::Vec2(x, y)) == p.head<2>())
+        return {x, y, lz};
+  return {lx, ly, lz};
+}
+
+/// New instances, numbered from the first free id, as canonical Part 21 lines.
+class Instances {
+public:
+  explicit Instances(InstanceId first) : next_(first) {}
+
+  InstanceId add(std::string_view entity, std::string_view params) {
+    const InstanceId id = next_++;
+    text_ += '#' + std::to_string(id) + '=' + std::string(entity) + '(' + std::string(params) + ");\n";
+    return id;
+  }
+
+  InstanceId point(const Vec3 &p) {
+    return shared(points_, {p.x(), p.y(), p.z()}, [&] { return add("CARTESIAN_POINT", "''," + reals(p)); });
+  }
+
+  InstanceId direction(const Vec3 &d) {
+    return shared(directions_, {d.x(), d.y(), d.z()}, [&] { return add("DIRECTION", "''," + reals(d)); });
+  }
+
+  /// An axis2_placement_3d at `at` with the frame's own axes.
+  InstanceId placement(const Vec3 &at) {
+    const InstanceId location = point(at);
+    return add("AXIS2_PLACEMENT_3D",
+               "''," + ref(location) + ',' + ref(direction(Vec3::UnitZ())) + ',' + ref(direction(Vec3::UnitX())));
+  }
+
+  static std::string ref(InstanceId id) { return '#' + std::to_string(id); }
+  static std::string real(double v) {
+    std::string s;
+    p21::appendReal(s, v);
+    return s;
+  }
+  static std::string reals(const Vec3 &v) { return '(' + real(v.x()) + ',' + real(v.y()) + ',' + real(v.z()) + ')'; }
+
+  InstanceId firstFree() const { return next_; }
+  const std::string &text() const { return text_; }
+
+private:
+  using Key = std::array<double, 3>;
+  template <class Make> InstanceId shared(std::map<Key, InstanceId> &pool, const Key &key, Make make) {
+    if (auto it = pool.find(key); it != pool.end())
+      return it->second;
+    const InstanceId id = make();
+    pool.emplace(key, id);
+    return id;
+  }
+
+  InstanceId next_;
+  std::string text_;
+  std::map<Key, InstanceId> points_, directions_;
+};
+
+/// The ISO 14649 toolpath type that gives a move of `role` back on lowering
+/// (expand-strategies reads the pair type, rapid); empty when none does.
+std::string_view toolpathType(std::string_view role, bool rapid) {
+  struct Row {
+    std::string_view role, rapidType, feedType;
+  };
+  static constexpr Row kTypes[] = {{"position", "NON_CONTACT", "NON_CONTACT"},
+                                   {"approach", "APPROACH", ""},
+                                   {"plunge", "", "APPROACH"},
+                                   {"cut", "CONTACT", "CONTACT"},
+                                   {"link", "CONNECT", "CONNECT"},
+                                   {"retract", "LIFT", "LIFT"}};
+  for (const Row &r : kTypes)
+    if (r.role == role)
+      return rapid ? r.rapidType : r.feedType;
+  return {};
+}
+
+/// Writes the moves of workingsteps as toolpath lists.
+class ToolpathWriter {
+public:
+  ToolpathWriter(Instances &out, DiagnosticEngine &diags) : out_(out), diags_(diags) {}
+
+  /// The TOOLPATH_LIST of `ws`'s `moves`, in the frame of its feature; none
+  /// (after an error) when a move cannot be written, or (silently) when the
+  /// moves are a single positioning.
+  std::optional<InstanceId> write(const Node &ws, const Node &moves, const PlaneFrame &frame,
+                                  const std::string &feedReference) {
+    ws_ = &ws;
+    frame_ = &frame;
+    spindle_ = moves.number("spindle").value_or(0);
+    feedReference_ = feedReference;
+    trajectories_.clear();
+    run_ = {};
+    bool smooth = false;
+    std::optional<Vec3> at;
+    for (const Node &m : moves.children) {
+      const Vec3 to = *m.vec("to");
+      const std::string role = m.text("role").value_or(m.kind == "rapid" ? "position" : "cut");
+      smooth = smooth || m.flag("smooth").value_or(false);
+      if (!at) {
+        // The first move takes the tool to the first point of the first
+        // toolpath: lowering makes it again, from wherever the tool is.
+        if (m.kind != "rapid" || role != "position" || to.z() != moves.number("secplane").value_or(0)) {
+          fail(m, "the first move is not a rapid to the security plane");
+          return std::nullopt;
+        }
+        at = to;
+        continue;
+      }
+      const bool rapid = m.kind == "rapid";
+      const double feed = rapid ? 0 : m.number("feed").value_or(0);
+      const std::string_view type = toolpathType(role, rapid);
+      if (type.empty()) {
+        fail(m, "a " + m.kind + " move with role " + role + " has no ISO 14649 toolpath type");
+        return std::nullopt;
+      }
+      if (m.kind == "arc") {
+        flush();
+        if (!arc(*at, m, type, feed))
+          return std::nullopt;
+      } else {
+        if (run_.points.empty() || run_.rapid != rapid || run_.type != type || run_.feed != feed) {
+          flush();
+          run_ = {rapid, std::string(type), feed, {*at}};
+        }
+        run_.points.push_back(to);
+      }
+      at = to;
+    }
+    flush();
+    if (smooth)
+      diags_
+          .warning(ws.origin.loc, "workingstep " + ws.symbol +
+                                      ": the chords of its smooth curves are written as polylines; a target "
+                                      "with splines writes them as lines when this file is compiled")
+          .entity(ws.origin.entityId);
+    if (trajectories_.empty())
+      return std::nullopt;
+    std::string list = "(";
+    for (size_t i = 0; i < trajectories_.size(); ++i)
+      list += (i ? "," : "") + Instances::ref(trajectories_[i]);
+    return out_.add("TOOLPATH_LIST", list + ')');
+  }
+
+  bool failed() const { return failed_; }
+
+private:
+  /// A run of straight moves of one kind, type and feed: one polyline.
+  struct Run {
+    bool rapid = false;
+    std::string type;
+    double feed = 0;
+    std::vector<Vec3> points; ///< workpiece coordinates, from the run's start
+  };
+
+  void fail(const Node &move, const std::string &why) {
+    diags_
+        .error(ws_->origin.loc, "workingstep " + ws_->symbol + ": cannot write its toolpath as STEP-NC: " + why + " (" +
+                                    move.kind + " to " + formatPoint(*move.vec("to")) + ")")
+        .entity(ws_->origin.entityId);
+    failed_ = true;
+  }
+
+  static std::string formatPoint(const Vec3 &p) {
+    return '(' + Instances::real(p.x()) + ',' + Instances::real(p.y()) + ',' + Instances::real(p.z()) + ')';
+  }
+
+  void flush() {
+    if (run_.points.size() < 2)
+      return;
+    std::string points = "(";
+    for (size_t i = 0; i < run_.points.size(); ++i)
+      points += (i ? "," : "") + Instances::ref(out_.point(localPoint(*frame_, run_.points[i])));
+    const InstanceId curve = out_.add("POLYLINE", "''," + points + ')');
+    trajectory(run_.type, run_.rapid, run_.feed, curve);
+    run_ = {};
+  }
+
+  /// An arc from `from` as a trimmed circle, or a trimmed helix when it changes height.
+  bool arc(const Vec3 &from, const Node &m, std::string_view type, double feed) {
+    const PlaneFrame &f = *frame_;
+    const Vec3 a = localPoint(f, from), b = localPoint(f, *m.vec("to"));
+    const Vec3 centre = *m.vec("center");
+    const Vec3 c = localPoint(f, Vec3(centre.x(), centre.y(), from.z()));
+    const bool ccw = (m.text("dir") == "ccw") != f.mirrored();
+    const int64_t turns = m.count("turns").value_or(0);
+    const double radius = std::hypot(a.x() - c.x(), a.y() - c.y());
+    if (!(radius > 0)) {
+      fail(m, "an arc of radius 0");
+      return false;
+    }
+    InstanceId basis = 0;
+    if (b.z() == a.z()) {
+      if (turns > 0) {
+        fail(m, "a flat arc of more than one turn");
+        return false;
+      }
+      basis = out_.add("CIRCLE", "''," + Instances::ref(out_.placement(c)) + ',' + Instances::real(radius));
+    } else {
+      // The pitch that gives back the turns: lowering counts them from the
+      // rise, the pitch and the last partial arc (passes/Curves.cpp).
+      double partial = std::atan2(b.y() - c.y(), b.x() - c.x()) - std::atan2(a.y() - c.y(), a.x() - c.x());
+      partial = std::fmod(std::fmod(partial, kTwoPi) + kTwoPi, kTwoPi);
+      if (!ccw && partial > 0)
+        partial = kTwoPi - partial;
+      if (partial < 1e-9)
+        partial = kTwoPi;
+      const double pitch = std::abs(b.z() - a.z()) / (static_cast<double>(turns) + partial / kTwoPi);
+      // The pitch is positive (the IR's rule); the trimming points say which way the arc rises.
+      basis = out_.add("HELIX", "''," + Instances::ref(out_.placement(c)) + ',' + Instances::real(radius) + ',' +
+                                    Instances::real(pitch));
+    }
+    const InstanceId curve =
+        out_.add("TRIMMED_CURVE", "''," + Instances::ref(basis) + ",(" + Instances::ref(out_.point(a)) + "),(" +
+                                      Instances::ref(out_.point(b)) + ")," + (ccw ? ".T." : ".F.") + ",.CARTESIAN.");
+    trajectory(type, false, feed, curve);
+    return true;
+  }
+
+  void trajectory(std::string_view type, bool rapid, double feed, InstanceId curve) {
+    const std::string speed = rapid ? "SPEED_NAME(.RAPID.)" : "$";
+    const std::string technology = rapid ? "$" : Instances::ref(this->technology(feed));
+    trajectories_.push_back(out_.add("CUTTER_LOCATION_TRAJECTORY", ".T.,." + std::string(type) + ".," + speed + ',' +
+                                                                       technology + ",$,$," + Instances::ref(curve) +
+                                                                       ",$,$"));
+  }
+
+  /// A milling technology with `feed` (mm/min) and the workingstep's spindle,
+  /// shared by every toolpath that has both.
+  InstanceId technology(double feed) {
+    const lowering::UnitConventions units;
+    const auto key = std::make_tuple(feed, spindle_, feedReference_);
+    if (auto it = technologies_.find(key); it != technologies_.end())
+      return it->second;
+    const double speed =
+        preimage(feed, feed / units.speedToMmPerMin, [&](double v) { return v * units.speedToMmPerMin; });
+    const double spindle = preimage(spindle_, spindle_ / units.rotSpeedToRevPerMin,
+                                    [&](double v) { return v * units.rotSpeedToRevPerMin; });
+    const InstanceId id = out_.add("MILLING_TECHNOLOGY", Instances::real(speed) + ",." + feedReference_ + ".,$," +
+                                                             Instances::real(spindle) + ",$,.F.,.F.,.F.,$");
+    technologies_.emplace(key, id);
+    return id;
+  }
+
+  Instances &out_;
+  DiagnosticEngine &diags_;
+  const Node *ws_ = nullptr;
+  const PlaneFrame *frame_ = nullptr;
+  double spindle_ = 0;
+  std::string feedReference_;
+  Run run_;
+  std::vector<InstanceId> trajectories_;
+  std::map<std::tuple<double, double, std::string>, InstanceId> technologies_;
+  bool failed_ = false;
+};
+
+const Node *operationOf(const Node &ws) {
+  for (const Node &c : ws.children)
+    if (const ir::KindSpec *k = ir::findKind(c.kind); k && k->category == "operation")
+      return &c;
+  return nullptr;
+}
+
+/// Every machining workingstep with moves, in program order.
+void workingsteps(const Node &n, std::vector<const Node *> &out) {
+  for (const Node &c : n.children)
+    if (c.kind == "workplan")
+      workingsteps(c, out);
+    else if (c.kind == "workingstep" && c.child("moves"))
+      out.push_back(&c);
+}
+
+InstanceId largestId(const p21::Part21File &file) {
+  InstanceId largest = 0;
+  for (const p21::InstanceEntry &e : file.entries())
+    largest = std::max(largest, e.id);
+  for (const p21::ExternalReference &r : file.references())
+    largest = std::max(largest, r.id);
+  return largest;
+}
+
+/// `#id=NAME(first,...` with its first parameter replaced by `value`; empty
+/// when the line has no such shape (a complex instance).
+std::string withFirstParameter(std::string_view line, std::string_view value) {
+  const size_t open = line.find('(');
+  const size_t eq = line.find('=');
+  if (open == std::string_view::npos || eq == std::string_view::npos || open == eq + 1)
+    return {};
+  size_t end = open + 1;
+  if (end < line.size() && line[end] == '$')
+    ++end;
+  else if (end < line.size() && line[end] == '#')
+    for (++end; end < line.size() && std::isdigit(static_cast<unsigned char>(line[end]));)
+      ++end;
+  else
+    return {};
+  return std::string(line.substr(0, open + 1)) + std::string(value) + std::string(line.substr(end));
+}
+
+/// FILE_DESCRIPTION with `lines` first, then the input's own description.
+/// Quotes in `lines` become double quotes: Open CASCADE 7.6's STEP reader
+/// fails on a doubled quote followed by ',' or ')' inside a string.
+std::string fileDescription(const p21::Part21File &input, const std::vector<std::string> &lines) {
+  std::vector<std::string> all = lines;
+  for (std::string &line : all)
+    std::replace(line.begin(), line.end(), '\'', '"');
+  std::string level = "2;1";
+  if (const p21::HeaderEntity *h = input.headerEntity("FILE_DESCRIPTION")) {
+    const auto params = input.metadata().params(h->record);
+    if (!params.empty() && params[0].kind == p21::ValueKind::List)
+      for (const p21::Value &v : input.metadata().children(params[0]))
+        if (v.kind == p21::ValueKind::String)
+          all.push_back("input: " + std::string(v.str()));
+    if (params.size() > 1 && params[1].kind == p21::ValueKind::String)
+      level = std::string(params[1].str());
+  }
+  std::string out = "FILE_DESCRIPTION((";
+  for (size_t i = 0; i < all.size(); ++i) {
+    if (i)
+      out += ',';
+    p21::appendString(out, all[i]);
+  }
+  out += "),";
+  p21::appendString(out, level);
+  return out + ");";
+}
+
+} // namespace
+
+std::string writeOptimisedPart21(const p21::Part21File &input, const ir::Module &module,
+                                 const OptimisedFileOptions &options, DiagnosticEngine &diags) {
+  bool ok = true;
+  const std::string canonical = p21::writePart21ToString(input, diags, &ok);
+  if (!ok)
+    return {};
+  Instances out(largestId(input) + 1);
+  ToolpathWriter writer(out, diags);
+  std::map<InstanceId, InstanceId> toolpathOf; // operation -> its new toolpath list
+  std::map<InstanceId, const Node *> writtenBy;
+  std::vector<const Node *> steps;
+  workingsteps(module.root, steps);
+  for (const Node *ws : steps) {
+    const Node *op = operationOf(*ws);
+    const Node *feature = passes::findFeature(module, ws->text("feature").value_or(""));
+    if (!op || !feature || op->origin.entityId == 0)
+      continue;
+    if (auto [it, fresh] = writtenBy.emplace(op->origin.entityId, ws); !fresh) {
+      diags
+          .error(ws->origin.loc, "workingstep " + ws->symbol + " shares its operation #" +
+                                     std::to_string(op->origin.entityId) + " with " + it->second->symbol +
+                                     ": one its_toolpath cannot hold the toolpaths of both")
+          .entity(ws->origin.entityId);
+      ok = false;
+      continue;
+    }
+    const passes::FrameResult frame = passes::planeFrame(*feature);
+    if (!frame.frame) {
+      diags.error(ws->origin.loc, "workingstep " + ws->symbol + ": " + frame.error).entity(ws->origin.entityId);
+      ok = false;
+      continue;
+    }
+    const Node *tech = op->child("technology");
+    const std::string reference = tech && tech->text("feed_reference") == "ccp" ? "CCP" : "TCP";
+    if (auto list = writer.write(*ws, *ws->child("moves"), *frame.frame, reference))
+      toolpathOf[op->origin.entityId] = *list;
+  }
+  if (!ok || writer.failed())
+    return {};
+
+  // Patch the canonical text: one header entity or instance per line.
+  const std::string description = fileDescription(input, options.description);
+  const bool hasDescription = input.headerEntity("FILE_DESCRIPTION") != nullptr;
+  const size_t lastEndsec = canonical.rfind("ENDSEC;\n");
+  std::string text;
+  text.reserve(canonical.size() + out.text().size() + description.size());
+  for (size_t pos = 0, eol; pos < canonical.size(); pos = eol + 1) {
+    eol = canonical.find('\n', pos);
+    const std::string_view line(canonical.data() + pos, eol - pos);
+    if (pos == lastEndsec)
+      text += out.text();
+    std::string patched(line);
+    if (line.starts_with("FILE_DESCRIPTION(")) {
+      patched = description;
+    } else if (line == "HEADER;" && !hasDescription) {
+      patched += "\n" + description;
+    } else if (line.starts_with("#")) {
+      const InstanceId id = std::stoull(std::string(line.substr(1, line.find('=') - 1)));
+      if (auto it = toolpathOf.find(id); it != toolpathOf.end()) {
+        patched = withFirstParameter(line, Instances::ref(it->second));
+        if (patched.empty()) {
+          diags.error({}, "operation #" + std::to_string(id) +
+                              " is a complex instance: stepnc cannot set its "
+                              "its_toolpath");
+          return {};
+        }
+      }
+    }
+    text += patched;
+    text += '\n';
+  }
+  return text;
+}
+
+std::unique_ptr<p21::Part21File> buildOptimisedFile(const p21::Part21File &input, const ir::Module &module,
+                                                    const OptimisedFileOptions &options,
+                                                    std::unique_ptr<SourceFile> &text, DiagnosticEngine &diags) {
+  std::string written = writeOptimisedPart21(input, module, options, diags);
+  if (written.empty())
+    return nullptr;
+  text = SourceFile::fromString(std::string(input.source().name()) + " (optimised)", written);
+  auto file = p21::readPart21(*text, diags);
+  if (diags.hasErrors())
+    return nullptr;
+  return file;
+}
+
+} // namespace stepnc::backends
