@@ -64,6 +64,10 @@ TypeView viewType(const express::Model &model, express::TypeId type) {
     }
     case express::TypeExpr::Select:
     case express::TypeExpr::Enumeration:
+      // Reached from a TYPE declaration's underlying type (the type of a
+      // SELECT value `SPEED_NAME(.RAPID.)`): the declaration is not known here.
+      view.kind = t.kind == express::TypeExpr::Select ? TypeView::Select : TypeView::Enumeration;
+      return view;
     case express::TypeExpr::Generic:
       return view;
     }

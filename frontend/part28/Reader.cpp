@@ -578,7 +578,10 @@ std::string Translator::expectation(TypeId declared) const {
   case TypeView::Entity:
     return "expected <" + xmlName(model_->entity(view.entity).name) + "> or the element of one of its subtypes";
   case TypeView::Select:
-    return "expected the element of an entity or type that select " + model_->typeDecl(view.innerDecl).name + " allows";
+    if (view.innerDecl == kNone)
+      return "expected the element of an entity or type the select allows";
+    return "expected the element of an entity or type that select " + model_->typeDecl(view.innerDecl).name +
+           " allows";
   case TypeView::Simple:
   case TypeView::Enumeration:
   case TypeView::Aggregate: {

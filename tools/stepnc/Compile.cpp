@@ -111,9 +111,11 @@ std::vector<std::string> optimisedDescription(const CompileOptions &opts, const 
   return lines;
 }
 
-/// Writes the machine-optimised STEP-NC file (Part 21, canonical, atomically).
-int writeOptimised(const CompileOptions &opts, const p21::Part21File &input, const ir::Module &module,
-                   const std::string &pipeline, const std::vector<std::string> &reports, DiagnosticEngine &diags) {
+/// Writes the machine-optimised STEP-NC file atomically: canonical Part 21, or
+/// Part 28 XML when the output ends in .stpx or .xml.
+int writeOptimised(const CompileOptions &opts, const SchemaSelection &schemas, const p21::Part21File &input,
+                   const ir::Module &module, const std::string &pipeline, const std::vector<std::string> &reports,
+                   DiagnosticEngine &diags) {
   backends::OptimisedFileOptions options;
   options.description = optimisedDescription(opts, pipeline, reports);
   std::unique_ptr<SourceFile> text;
@@ -128,9 +130,11 @@ int writeOptimised(const CompileOptions &opts, const p21::Part21File &input, con
     printToolError(error);
     return kExitUsage;
   }
-  if (!p21::writePart21(*file, out, diags)) {
+  const std::string extension = std::filesystem::path(opts.output).extension().string();
+  const bool xml = extension == ".stpx" || extension == ".xml";
+  if (xml ? !schemas.writeAsPart28(*file, out, diags) : !p21::writePart21(*file, out, diags)) {
     std::cerr << "stepnc: cannot write optimised STEP-NC for " << opts.input << "; nothing written\n";
-    return kExitDiagnostics;
+    return diags.hasErrors() ? kExitDiagnostics : kExitUsage;
   }
   if (!out.commit(error)) {
     printToolError(error);
@@ -167,11 +171,6 @@ int runCompile(const CompileOptions &opts) {
       printToolError("compile: " + error);
       return kExitUsage;
     }
-  }
-  if (emit == "stepnc" && std::filesystem::path(opts.output).extension() == ".stpx") {
-    printToolError("compile: --emit=stepnc to Part 28 XML (" + opts.output +
-                   ") is not yet supported: write Part 21 (.stp)");
-    return kExitUsage;
   }
   const bool needsMotion = emit == "motion-ir" || opts.target == "native";
   if (needsMotion && opts.machine.empty()) {
@@ -234,7 +233,7 @@ int runCompile(const CompileOptions &opts) {
     }
   }
   if (emit == "stepnc")
-    return writeOptimised(opts, *file, *module, pipelineText, reports, diags);
+    return writeOptimised(opts, schemas, *file, *module, pipelineText, reports, diags);
   if (backend) {
     std::optional<backends::ToolTable> table;
     std::unique_ptr<SourceFile> tableFile;

@@ -2,10 +2,8 @@
 // form, or as Part 28 XML when OUT ends in .stpx or .xml; the input may be
 // either. Nothing is written when the input has errors; the output appears
 // atomically (temporary file + rename).
-#include "frontend/binding/Binder.h"
 #include "frontend/part21/Part21File.h"
 #include "frontend/part21/Writer.h"
-#include "frontend/part28/Writer.h"
 #include "support/OutputFile.h"
 #include "tools/stepnc/Driver.h"
 #include "tools/stepnc/SchemaSelection.h"
@@ -35,29 +33,6 @@ bool hasSuffix(const std::string &s, std::string_view suffix) {
       return false;
   }
   return true;
-}
-
-/// Writes `file` as Part 28 through its schema. The schema check itself is
-/// `stepnc check`'s business: binding here only names each instance's entity,
-/// and only what the mapping cannot express is an error.
-bool writeXml(const p21::Part21File &file, const SchemaSelection &schemas, OutputFile &out, DiagnosticEngine &diags) {
-  const express::Model *model = nullptr;
-  const express::Schema *schema = schemas.find(file.schemaNames(), model);
-  if (!schema) {
-    std::string listed;
-    for (const std::string &n : file.schemaNames())
-      listed += (listed.empty() ? "" : ", ") + n;
-    printToolError("writing Part 28 needs the file's schema, and " +
-                   (listed.empty() ? std::string("FILE_SCHEMA names none") : "schema " + listed + " is not built in") +
-                   ": give its EXPRESS file with --schema FILE.exp");
-    return false;
-  }
-  DiagnosticCollector ignored;
-  DiagnosticEngine bindDiags(ignored);
-  binding::BindOptions lenient;
-  lenient.lenient = true;
-  auto bound = binding::bind(file, *model, *schema, bindDiags, lenient);
-  return p28::writePart28(*bound, [&out](std::string_view chunk) { out.write(chunk); }, diags);
 }
 
 int runConvert(const ConvertOptions &opts) {
@@ -90,7 +65,7 @@ int runConvert(const ConvertOptions &opts) {
     p21::checkInstances(*file, diags);  // syntax and references, as the Part 21 writer checks them
     if (diags.hasErrors())
       return nothingWritten();
-    if (!writeXml(*file, schemas, out, diags))
+    if (!schemas.writeAsPart28(*file, out, diags))
       return diags.hasErrors() ? nothingWritten() : kExitUsage;
   } else if (!p21::writePart21(*file, out, diags, {.checkReferences = true})) {
     // One pass: decode, check references and write; on any error `out`

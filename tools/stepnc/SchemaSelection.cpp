@@ -2,7 +2,9 @@
 
 #include "frontend/express/Builtin.h"
 #include "frontend/express/SchemaReader.h"
+#include "frontend/binding/Binder.h"
 #include "frontend/part28/Reader.h"
+#include "frontend/part28/Writer.h"
 #include "tools/stepnc/Driver.h"
 
 #include <CLI/CLI.hpp>
@@ -92,6 +94,26 @@ bool SchemaSelection::readAsPart21(std::unique_ptr<SourceFile> &source, Diagnost
     return false;
   source = std::move(translation);
   return true;
+}
+
+bool SchemaSelection::writeAsPart28(const p21::Part21File &file, OutputFile &out, DiagnosticEngine &diags) const {
+  const express::Model *model = nullptr;
+  const express::Schema *schema = find(file.schemaNames(), model);
+  if (!schema) {
+    std::string listed;
+    for (const std::string &n : file.schemaNames())
+      listed += (listed.empty() ? "" : ", ") + n;
+    printToolError("writing Part 28 needs the file's schema, and " +
+                   (listed.empty() ? std::string("FILE_SCHEMA names none") : "schema " + listed + " is not built in") +
+                   ": give its EXPRESS file with --schema FILE.exp");
+    return false;
+  }
+  DiagnosticCollector ignored;
+  DiagnosticEngine bindDiags(ignored);
+  binding::BindOptions lenient;
+  lenient.lenient = true;
+  auto bound = binding::bind(file, *model, *schema, bindDiags, lenient);
+  return p28::writePart28(*bound, [&out](std::string_view chunk) { out.write(chunk); }, diags);
 }
 
 } // namespace stepnc::tool

@@ -6,6 +6,7 @@
 
 #include "frontend/express/Schema.h"
 #include "frontend/part21/Part21File.h"
+#include "support/OutputFile.h"
 
 #include <string>
 #include <vector>
@@ -47,6 +48,13 @@ public:
   /// lines and columns); Part 21 is left as it is. Returns false after
   /// reporting when XML cannot be translated.
   bool readAsPart21(std::unique_ptr<SourceFile> &source, DiagnosticEngine &diags) const;
+
+  /// Writes `file` as Part 28 through its schema. The schema check itself is
+  /// `stepnc check`'s business: binding here only names each instance's
+  /// entity, and only what the mapping cannot express is an error. Returns
+  /// false after reporting (a schema that is not known is a usage error,
+  /// printed, with no diagnostic counted).
+  bool writeAsPart28(const p21::Part21File &file, OutputFile &out, DiagnosticEngine &diags) const;
 
 private:
   const SchemaOptions &opts_;

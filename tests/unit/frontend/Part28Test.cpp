@@ -131,6 +131,7 @@ DATA;
 #4=LINE('l',#1,#5);
 #5=VECTOR('v',#3,10.);
 #6=TRIMMED_CURVE('t',#4,(#1,PARAMETER_VALUE(0.)),(PARAMETER_VALUE(1.5)),.T.,.PARAMETER.);
+#8=CUTTER_LOCATION_TRAJECTORY(.T.,.APPROACH.,SPEED_NAME(.RAPID.),$,$,$,#6,$,$);
 #7=(B_SPLINE_SURFACE(1,1,((#1,#2),(#1,#2)),.PLANE_SURF.,.F.,.T.,.U.)BOUNDED_SURFACE()GEOMETRIC_REPRESENTATION_ITEM()RATIONAL_B_SPLINE_SURFACE(((1.,2.5),(3.,4.)))REPRESENTATION_ITEM()SURFACE('s'));
 ENDSEC;
 DATA('second',('MILLING_SCHEMA'));
@@ -157,6 +158,7 @@ TEST_CASE("Part 21 -> Part 28 -> Part 21 keeps every kind of value", "[part28]")
   CHECK(xml.find("<Control_points_list exp:cType=\"list\"><exp:list><Cartesian_point ref=\"i1\"") != std::string::npos);
   CHECK(xml.find("<Weights_data exp:cType=\"list\"><exp:list><exp:double>1.</exp:double>") != std::string::npos);
   CHECK(xml.find("<Self_intersect>unknown</Self_intersect>") != std::string::npos);
+  CHECK(xml.find("<Its_speed><Speed_name>rapid</Speed_name></Its_speed>") != std::string::npos);
   CHECK(xml.find("<Sense_agreement>true</Sense_agreement>") != std::string::npos);
   CHECK(xml.find("<Master_representation>parameter</Master_representation>") != std::string::npos);
   CHECK(xml.find("&#9;tab ]]&gt; &quot;q&quot;") != std::string::npos);

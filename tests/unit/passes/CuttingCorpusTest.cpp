@@ -34,7 +34,8 @@ const char *const kFiles[] = {
     "jucsr__sanssouci/oneHoleOneSlotOneStepOnePoket.p21",
     "unseenlaser__iso-14649-toolkit/ex1.stp",
     // Not ex1E.stp: its explicit toolpaths are required (its_priority), so
-    // the cutting passes leave them as written (passes::runsAsWritten).
+    // the cutting passes leave them as written (passes::runsAsWritten;
+    // tests/passes/adapt-feed/required-toolpaths.test checks that).
 };
 
 /// How close to the chip target adapt-feed comes where the chip limits the
