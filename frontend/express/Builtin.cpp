@@ -34,14 +34,6 @@ namespace {
 
 constexpr std::string_view kExtensionName = "STEPNC_PATTERN_STRATEGIES";
 
-std::string upper(std::string_view name) {
-  std::string out(name);
-  for (char &c : out)
-    if (c >= 'a' && c <= 'z')
-      c = static_cast<char>(c - 32);
-  return out;
-}
-
 } // namespace
 
 const std::vector<std::string_view> &builtinSchemaNames() {

@@ -13,6 +13,14 @@ std::string lower(std::string_view s) {
   return out;
 }
 
+std::string upper(std::string_view s) {
+  std::string out(s);
+  for (char &c : out)
+    if (c >= 'a' && c <= 'z')
+      c = static_cast<char>(c - 'a' + 'A');
+  return out;
+}
+
 const char *simpleKindName(SimpleKind k) {
   switch (k) {
   case SimpleKind::Binary: return "BINARY";

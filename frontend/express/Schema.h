@@ -224,5 +224,7 @@ private:
 
 /// Lower-cases ASCII.
 std::string lower(std::string_view s);
+/// Upper-cases ASCII.
+std::string upper(std::string_view s);
 
 } // namespace stepnc::express

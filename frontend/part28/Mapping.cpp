@@ -75,6 +75,40 @@ TypeView viewType(const express::Model &model, express::TypeId type) {
   return view;
 }
 
+bool appendEscaped(std::string &out, std::string_view text) {
+  for (char ch : text) {
+    const auto c = static_cast<unsigned char>(ch);
+    switch (c) {
+    case '&':
+      out += "&amp;";
+      break;
+    case '<':
+      out += "&lt;";
+      break;
+    case '>':
+      out += "&gt;";
+      break;
+    case '"':
+      out += "&quot;";
+      break;
+    case '\t':
+      out += "&#9;";
+      break;
+    case '\n':
+      out += "&#10;";
+      break;
+    case '\r':
+      out += "&#13;";
+      break;
+    default:
+      if (c < 0x20 || c == 0x7F)
+        return false;
+      out.push_back(ch);
+    }
+  }
+  return true;
+}
+
 std::string_view simpleMemberName(express::SimpleKind kind) {
   switch (kind) {
   case express::SimpleKind::Real:

@@ -29,6 +29,13 @@ std::string xmlName(std::string_view expressName);
 /// repeated element in the entity's sequence would be ambiguous.
 std::vector<std::string> attributeElementNames(const express::Model &model, express::EntityId entity);
 
+/// Appends `text` escaped for element content or a double-quoted XML
+/// attribute (`&amp;` `&lt;` `&gt;` `&quot;`, and tab, line feed and carriage
+/// return as character references so they survive attribute normalisation).
+/// Returns false, having appended the rest, on a control character XML 1.0
+/// cannot carry.
+bool appendEscaped(std::string &out, std::string_view text);
+
 /// A type as the XML mapping sees it: defined types followed to what they
 /// finally are, remembering the outermost declared name (which names the
 /// element of an aggregate member or a SELECT value).

@@ -18,6 +18,7 @@ namespace stepnc::p28 {
 using express::EntityId;
 using express::kNone;
 using express::TypeId;
+using express::upper;
 
 bool isXml(std::string_view text) {
   if (text.starts_with("\xEF\xBB\xBF"))
@@ -75,14 +76,6 @@ bool sameName(std::string_view a, std::string_view b) {
   return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
            return (x >= 'A' && x <= 'Z' ? x + 32 : x) == (y >= 'A' && y <= 'Z' ? y + 32 : y);
          });
-}
-
-std::string upper(std::string_view s) {
-  std::string u(s);
-  for (char &c : u)
-    if (c >= 'a' && c <= 'z')
-      c = static_cast<char>(c - 32);
-  return u;
 }
 
 bool isIntegerText(std::string_view s) {

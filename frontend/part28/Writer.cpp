@@ -14,42 +14,6 @@ using p21::ValueKind;
 
 namespace {
 
-/// Appends text escaped for element content or a double-quoted attribute.
-/// Returns false on a control character XML 1.0 cannot carry.
-bool appendEscaped(std::string &out, std::string_view text) {
-  for (char ch : text) {
-    const auto c = static_cast<unsigned char>(ch);
-    switch (c) {
-    case '&':
-      out += "&amp;";
-      break;
-    case '<':
-      out += "&lt;";
-      break;
-    case '>':
-      out += "&gt;";
-      break;
-    case '"':
-      out += "&quot;";
-      break;
-    case '\t':
-      out += "&#9;";
-      break;
-    case '\n':
-      out += "&#10;";
-      break;
-    case '\r':
-      out += "&#13;";
-      break;
-    default:
-      if (c < 0x20 || c == 0x7F)
-        return false;
-      out.push_back(ch);
-    }
-  }
-  return true;
-}
-
 /// A FILE_NAME or FILE_DESCRIPTION parameter the header elements can carry:
 /// a string, or a list of strings.
 bool isString(const Value &v) { return v.kind == ValueKind::String; }

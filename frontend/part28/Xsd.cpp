@@ -83,26 +83,6 @@ const char *aggregateMemberElement(AggregateKind k) {
   return "exp:list";
 }
 
-std::string escapeAttribute(std::string_view s) {
-  std::string out;
-  for (char c : s) {
-    switch (c) {
-    case '&':
-      out += "&amp;";
-      break;
-    case '<':
-      out += "&lt;";
-      break;
-    case '"':
-      out += "&quot;";
-      break;
-    default:
-      out += c;
-    }
-  }
-  return out;
-}
-
 /// Indented XML text, one element tag per line.
 class XmlText {
 public:
@@ -141,7 +121,7 @@ private:
       out_ += ' ';
       out_ += name;
       out_ += "=\"";
-      out_ += escapeAttribute(value);
+      appendEscaped(out_, value);
       out_ += '"';
     }
   }

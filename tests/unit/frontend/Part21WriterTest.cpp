@@ -39,22 +39,6 @@ std::string canonical(const Part21File &f) {
   return text;
 }
 
-// A Part 21 file starts with ISO-10303-21 after white space and comments.
-bool looksLikePart21(std::string_view t) {
-  size_t i = 0;
-  for (;;) {
-    while (i < t.size() && std::isspace(static_cast<unsigned char>(t[i])))
-      ++i;
-    if (t.substr(i, 2) != "/*")
-      break;
-    size_t end = t.find("*/", i + 2);
-    if (end == std::string_view::npos)
-      return false;
-    i = end + 2;
-  }
-  return t.substr(i).starts_with("ISO-10303-21");
-}
-
 } // namespace
 
 TEST_CASE("the canonical form sorts ids and normalises layout", "[part21][writer]") {
@@ -131,16 +115,11 @@ TEST_CASE("every corpus Part 21 file round-trips", "[part21][writer][corpus]") {
     return;
   }
   size_t files = 0;
-  std::vector<fs::path> paths;
-  for (const auto &entry : fs::recursive_directory_iterator(corpus))
-    if (entry.is_regular_file())
-      paths.push_back(entry.path());
-  std::sort(paths.begin(), paths.end());
-  for (const fs::path &path : paths) {
+  for (const fs::path &path : test::filesBelow(corpus)) {
     std::string error;
     auto source = SourceFile::open(path.string(), error);
     REQUIRE(source);
-    if (!looksLikePart21(source->text()))
+    if (!test::looksLikePart21(source->text()))
       continue;  // schemas, tool tables, notes
     INFO(path.string());
     DiagnosticCollector c;
