@@ -1,6 +1,7 @@
 #include "frontend/express/Builtin.h"
 #include "frontend/express/SchemaIO.h"
 #include "frontend/express/SchemaReader.h"
+#include "ExpressTestSupport.h"
 #include "../TestSupport.h"
 
 #include <catch2/catch.hpp>
@@ -11,20 +12,7 @@ using namespace stepnc::express;
 
 namespace {
 
-struct Loaded {
-  Model model;
-  DiagnosticCollector diags;
-  bool ok = false;
-};
-
-std::unique_ptr<Loaded> load(std::string_view text) {
-  auto l = std::make_unique<Loaded>();
-  DiagnosticEngine engine(l->diags);
-  l->ok = readExpress(SourceFile::fromString("t.exp", text), l->model, engine);
-  if (l->ok)
-    l->ok = l->model.resolve(engine);
-  return l;
-}
+std::unique_ptr<test::LoadedExpress> load(std::string_view text) { return test::loadExpress(text); }
 
 std::vector<std::string> slotNames(const Model &m, std::string_view entity) {
   std::vector<std::string> out;

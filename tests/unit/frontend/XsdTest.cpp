@@ -3,6 +3,7 @@
 // scope of a schema's XSD holds, and the refusal of clashing names.
 #include "frontend/part28/Xsd.h"
 #include "frontend/express/SchemaReader.h"
+#include "ExpressTestSupport.h"
 
 #include <catch2/catch.hpp>
 
@@ -12,20 +13,7 @@ using namespace stepnc::p28;
 
 namespace {
 
-struct Loaded {
-  Model model;
-  DiagnosticCollector diags;
-  bool ok = false;
-};
-
-std::unique_ptr<Loaded> load(std::string_view text) {
-  auto l = std::make_unique<Loaded>();
-  DiagnosticEngine engine(l->diags);
-  l->ok = readExpress(SourceFile::fromString("t.exp", text), l->model, engine);
-  if (l->ok)
-    l->ok = l->model.resolve(engine);
-  return l;
-}
+std::unique_ptr<test::LoadedExpress> load(std::string_view text) { return test::loadExpress(text); }
 
 using Names = std::vector<std::string>;
 
