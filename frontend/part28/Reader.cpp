@@ -128,7 +128,9 @@ public:
   void doctype();
 
 private:
-  uint64_t tagStart() const;
+  /// Offset of the markup the parser has just read: a tag ("<") or a
+  /// processing instruction ("<?").
+  uint64_t markupStart(std::string_view opener) const;
   SourceLoc loc(uint64_t offset) const { return {&xml_, offset}; }
   InFlightDiagnostic error(uint64_t at, const std::string &message);
   bool chooseSchema(const std::string &express, uint64_t at);
@@ -198,13 +200,14 @@ InFlightDiagnostic Translator::error(uint64_t at, const std::string &message) {
   return d;
 }
 
-uint64_t Translator::tagStart() const {
+uint64_t Translator::markupStart(std::string_view opener) const {
+  // The parser has just read past the markup; it begins at the last opener
+  // before that point (attribute values and PI text cannot hold '<').
   const long consumed = xmlByteConsumed(ctxt_);
-  uint64_t end = consumed > 0 ? std::min<uint64_t>(static_cast<uint64_t>(consumed), xml_.text().size()) : 0;
   const std::string_view text = xml_.text();
-  while (end > 0 && text[end - 1] != '<')
-    --end;
-  return end > 0 ? end - 1 : 0;
+  const uint64_t end = consumed > 0 ? std::min<uint64_t>(static_cast<uint64_t>(consumed), text.size()) : 0;
+  const size_t at = text.substr(0, end).rfind(opener);
+  return at == std::string_view::npos ? 0 : at;
 }
 
 bool Translator::isCommon(std::string_view local, const xmlChar *uri) const {
@@ -293,7 +296,7 @@ std::optional<p21::InstanceId> Translator::idOf(std::string_view text, uint64_t 
 }
 
 void Translator::doctype() {
-  error(tagStart(), "a document type declaration (<!DOCTYPE>) is not read in Part 28 documents");
+  error(markupStart("<"), "a document type declaration (<!DOCTYPE>) is not read in Part 28 documents");
   xmlStopParser(ctxt_);
 }
 
@@ -324,7 +327,7 @@ void Translator::startElement(const xmlChar *localName, const xmlChar *uri, int 
   const std::string_view local(reinterpret_cast<const char *>(localName));
   Frame frame;
   frame.name = std::string(local);
-  frame.at = tagStart();
+  frame.at = markupStart("<");
   auto attribute = [&](std::string_view name) -> std::optional<std::string> {
     for (int i = 0; i < nbAttributes; ++i) {
       const xmlChar **a = attributes + 5 * i;
@@ -830,13 +833,7 @@ void Translator::processingInstruction(const xmlChar *targetName, const xmlChar 
   const std::string data = dataText ? reinterpret_cast<const char *>(dataText) : "";
   if (!target.starts_with("stepnc-p21"))
     return;
-  const long consumed = xmlByteConsumed(ctxt_);
-  uint64_t at = consumed > 0 ? static_cast<uint64_t>(consumed) : 0;
-  const std::string_view text = xml_.text();
-  at = std::min<uint64_t>(at, text.size());
-  while (at > 1 && !(text[at - 2] == '<' && text[at - 1] == '?'))
-    --at;
-  at = at >= 2 ? at - 2 : 0;
+  const uint64_t at = markupStart("<?");
   Piece line;
   line.mark(at);
   if (target == "stepnc-p21") {

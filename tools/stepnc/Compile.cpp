@@ -130,9 +130,7 @@ int writeOptimised(const CompileOptions &opts, const SchemaSelection &schemas, c
     printToolError(error);
     return kExitUsage;
   }
-  const std::string extension = std::filesystem::path(opts.output).extension().string();
-  const bool xml = extension == ".stpx" || extension == ".xml";
-  if (xml ? !schemas.writeAsPart28(*file, out, diags) : !p21::writePart21(*file, out, diags)) {
+  if (isPart28Path(opts.output) ? !schemas.writeAsPart28(*file, out, diags) : !p21::writePart21(*file, out, diags)) {
     std::cerr << "stepnc: cannot write optimised STEP-NC for " << opts.input << "; nothing written\n";
     return diags.hasErrors() ? kExitDiagnostics : kExitUsage;
   }

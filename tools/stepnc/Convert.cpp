@@ -22,21 +22,8 @@ struct ConvertOptions {
   DiagnosticOptions diag;
 };
 
-bool hasSuffix(const std::string &s, std::string_view suffix) {
-  if (s.size() < suffix.size())
-    return false;
-  for (size_t i = 0; i < suffix.size(); ++i) {
-    char c = s[s.size() - suffix.size() + i];
-    if (c >= 'A' && c <= 'Z')
-      c = static_cast<char>(c + 32);
-    if (c != suffix[i])
-      return false;
-  }
-  return true;
-}
-
 int runConvert(const ConvertOptions &opts) {
-  const bool toXml = hasSuffix(opts.output, ".stpx") || hasSuffix(opts.output, ".xml");
+  const bool toXml = isPart28Path(opts.output);
   auto source = openInput(opts.input);
   if (!source)
     return kExitUsage;

@@ -51,6 +51,22 @@ int writeText(const std::string &path, const std::string &text) {
   return kExitOk;
 }
 
+bool isPart28Path(std::string_view path) {
+  auto endsWith = [&](std::string_view suffix) {
+    if (path.size() < suffix.size())
+      return false;
+    for (size_t i = 0; i < suffix.size(); ++i) {
+      char c = path[path.size() - suffix.size() + i];
+      if (c >= 'A' && c <= 'Z')
+        c = static_cast<char>(c - 'A' + 'a');
+      if (c != suffix[i])
+        return false;
+    }
+    return true;
+  };
+  return endsWith(".stpx") || endsWith(".xml");
+}
+
 std::unique_ptr<SourceFile> openInput(const std::string &path) {
   std::string error;
   auto file = SourceFile::open(path, error);

@@ -7,6 +7,7 @@
 
 #include <memory>
 #include <string>
+#include <string_view>
 
 namespace CLI {
 class App;
@@ -41,6 +42,10 @@ private:
   std::unique_ptr<DiagnosticConsumer> consumer_;
   std::unique_ptr<DiagnosticEngine> engine_;
 };
+
+/// True if an output path asks for Part 28 XML: it ends in .stpx or .xml
+/// (any case).
+bool isPart28Path(std::string_view path);
 
 /// Opens an input file; on failure prints "stepnc: error: ..." and returns null.
 std::unique_ptr<SourceFile> openInput(const std::string &path);
