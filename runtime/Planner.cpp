@@ -413,55 +413,82 @@ void preferHugePages(const std::vector<T> &v) {
 #endif
 }
 
-/// The speed cap and the path acceleration and jerk for a segment whose
-/// demand() is d.
-void limitsFor(const AxisDemand &d, double feed, const Machine &machine, SegmentInfo &info) {
-  double v = kInf;
-  SpeedLimit by = SpeedLimit::Feed;
-  auto cap = [&](double value, SpeedLimit why) {
-    if (value < v) {
-      v = value;
-      by = why;
-    }
-  };
-  if (feed > 0) {
-    cap(feed, SpeedLimit::Feed);
+/// The machine's axis limits as the speed caps use them, taken from the
+/// Machine once per plan: its axes are a list of named entries, and the
+/// caps are asked for every segment.
+class SpeedBudget {
+public:
+  explicit SpeedBudget(const Machine &machine) : count_(std::min<size_t>(3, machine.axes.size())) {
     if (machine.maxFeed)
-      cap(*machine.maxFeed / 60, SpeedLimit::MachineFeed);
-  }
-  const size_t n = std::min<size_t>(3, machine.axes.size());
-  for (size_t k = 0; k < n; ++k) {
-    const Axis &ax = machine.axes[k];
-    if (d.r1[k] > 0)
-      cap(ax.velocity / 60 / d.r1[k], SpeedLimit::AxisVelocity);
-    if (d.r2[k] > 0)
-      cap(std::sqrt(kCurveAccel * ax.acceleration / d.r2[k]), SpeedLimit::Acceleration);
-    if (d.r3[k] > 0) {
-      // The cube root only where it may be the lower: above (1 + 1e-12) v^3
-      // its root exceeds v by far more than cbrt's and the cube's rounding.
-      const double jerkRoom = kCurveJerk * ax.jerk / d.r3[k];
-      if (!(jerkRoom > v * v * v * (1 + 1e-12)))
-        cap(std::cbrt(jerkRoom), SpeedLimit::Jerk);
+      maxFeed_ = *machine.maxFeed / 60;
+    for (size_t k = 0; k < count_; ++k) {
+      const Axis &ax = machine.axes[k];
+      axes_[k] = {ax.velocity / 60, ax.acceleration, ax.jerk, kCurveAccel * ax.acceleration, kCurveJerk * ax.jerk,
+                  kCouplingJerk * ax.jerk};
     }
   }
-  double a = kInf, jerk = kInf;
-  for (size_t k = 0; k < n; ++k) {
-    const Axis &ax = machine.axes[k];
-    if (d.r1[k] <= 0)
-      continue;
-    double ak = (ax.acceleration - v * v * d.r2[k]) / d.r1[k];
-    if (d.r2[k] > 0 && v > 0)
-      ak = std::min(ak, kCouplingJerk * ax.jerk / (3 * v * d.r2[k]));
-    a = std::min(a, ak);
+
+  /// The speed cap and the path acceleration and jerk for a segment whose
+  /// demand() is d (the same operations as on the Machine's values).
+  void limitsFor(const AxisDemand &d, double feed, SegmentInfo &info) const {
+    double v = kInf;
+    SpeedLimit by = SpeedLimit::Feed;
+    auto cap = [&](double value, SpeedLimit why) {
+      if (value < v) {
+        v = value;
+        by = why;
+      }
+    };
+    if (feed > 0) {
+      cap(feed, SpeedLimit::Feed);
+      cap(maxFeed_, SpeedLimit::MachineFeed);
+    }
+    for (size_t k = 0; k < count_; ++k) {
+      const AxisBudget &ax = axes_[k];
+      if (d.r1[k] > 0)
+        cap(ax.velocity / d.r1[k], SpeedLimit::AxisVelocity);
+      if (d.r2[k] > 0)
+        cap(std::sqrt(ax.curveAccel / d.r2[k]), SpeedLimit::Acceleration);
+      if (d.r3[k] > 0) {
+        // The cube root only where it may be the lower: above (1 + 1e-12) v^3
+        // its root exceeds v by far more than cbrt's and the cube's rounding.
+        const double jerkRoom = ax.curveJerk / d.r3[k];
+        if (!(jerkRoom > v * v * v * (1 + 1e-12)))
+          cap(std::cbrt(jerkRoom), SpeedLimit::Jerk);
+      }
+    }
+    double a = kInf, jerk = kInf;
+    for (size_t k = 0; k < count_; ++k) {
+      const AxisBudget &ax = axes_[k];
+      if (d.r1[k] <= 0)
+        continue;
+      double ak = (ax.acceleration - v * v * d.r2[k]) / d.r1[k];
+      if (d.r2[k] > 0 && v > 0)
+        ak = std::min(ak, ax.couplingJerk / (3 * v * d.r2[k]));
+      a = std::min(a, ak);
+    }
+    for (size_t k = 0; k < count_; ++k) {
+      const AxisBudget &ax = axes_[k];
+      if (d.r1[k] > 0)
+        jerk = std::min(jerk, (ax.jerk - v * v * v * d.r3[k] - 3 * v * a * d.r2[k]) / d.r1[k]);
+    }
+    info.limits = {v, a, jerk};
+    info.limitedBy = by;
   }
-  for (size_t k = 0; k < n; ++k) {
-    const Axis &ax = machine.axes[k];
-    if (d.r1[k] > 0)
-      jerk = std::min(jerk, (ax.jerk - v * v * v * d.r3[k] - 3 * v * a * d.r2[k]) / d.r1[k]);
-  }
-  info.limits = {v, a, jerk};
-  info.limitedBy = by;
-}
+
+private:
+  struct AxisBudget {
+    double velocity = 0;      ///< mm/s
+    double acceleration = 0;  ///< mm/s^2
+    double jerk = 0;          ///< mm/s^3
+    double curveAccel = 0;    ///< what curvature may take of the acceleration (kCurveAccel)
+    double curveJerk = 0;     ///< and of the jerk (kCurveJerk)
+    double couplingJerk = 0;  ///< the coupling term's share of the jerk (kCouplingJerk)
+  };
+  size_t count_;
+  std::array<AxisBudget, 3> axes_{};
+  double maxFeed_ = kInf;  ///< mm/s, the controller's max_feed
+};
 
 /// The curvature vector of the circle through the vertex between lines a and
 /// b and the vertices before and after it; zero when either is not a line.
@@ -601,14 +628,20 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   out.info.reserve(count);
   preferHugePages(out.segments);
   preferHugePages(out.info);
+  // The segments' lengths again, packed: the steps below read them for every
+  // segment, and a Segment is 336 bytes.
+  std::vector<double> lengths;
+  lengths.reserve(count);
   // d is the last segment's demand().
+  const SpeedBudget budget(machine);
   auto push = [&](double feed, uint32_t move, uint32_t next, StopReason stop, const AxisDemand &d) {
+    lengths.push_back(out.segments.back().length);
     SegmentInfo &info = out.info.emplace_back();
     info.feed = feed;
     info.move = move;
     info.nextMove = next;
     info.stop = stop;
-    limitsFor(d, feed, machine, info);
+    budget.limitsFor(d, feed, info);
   };
   StopReason stop = StopReason::Start;
   {
@@ -656,14 +689,14 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   };
   auto isShort = [&](size_t k) {
     const PathLimits &l = out.info[k].limits;
-    return out.segments[k].length < rampDistance(0, l.v, l.a, l.j);
+    return lengths[k] < rampDistance(0, l.v, l.a, l.j);
   };
   std::vector<Run> runs;
   runs.reserve(n);
   for (size_t k = 0; k < n;) {
     Run r;
     r.first = r.last = uint32_t(k);
-    r.length = out.segments[k].length;
+    r.length = lengths[k];
     r.limits = out.info[k].limits;
     double highest = r.limits.v;
     if (isShort(k)) {
@@ -672,7 +705,7 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
         if (std::min(r.limits.v, l.v) < kRunCapSpread * std::max(highest, l.v))
           break;
         ++r.last;
-        r.length += out.segments[r.last].length;
+        r.length += lengths[r.last];
         highest = std::max(highest, l.v);
         r.limits = {std::min(r.limits.v, l.v), std::min(r.limits.a, l.a), std::min(r.limits.j, l.j)};
       }
@@ -707,7 +740,7 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
     }
     double t0 = 0, along = 0;
     for (size_t k = run.first; k <= run.last; ++k) {
-      along += out.segments[k].length;
+      along += lengths[k];
       const double t1 = k == run.last ? whole.duration() : whole.timeAt(along);
       out.profiles.push_back(whole.slice(t0, t1));
       out.info[k].limits = run.limits;

@@ -75,21 +75,30 @@ double Profile::timeAt(double target) const {
       continue;
     const double sEnd = s + v * d + a * d * d / 2 + j * d * d * d / 6;
     if (target <= sEnd) {
-      // s is non-decreasing here: Newton inside a shrinking bracket.
+      // s is non-decreasing here: Newton inside a shrinking bracket, until
+      // the bracket or Newton's step is below 1e-15 of the time (Newton
+      // converges from one side, where the bracket would shrink from that
+      // side alone: by bisection, in many more steps).
+      const double resolution = 1e-15 * (t + d);
       double lo = 0, hi = d, x = v > 0 ? std::min(d, (target - s) / v) : d / 2;
-      for (int it = 0; it < 100 && hi - lo > 1e-15 * (t + d); ++it) {
+      for (int it = 0; it < 100 && hi - lo > resolution; ++it) {
         const double f = s + v * x + a * x * x / 2 + j * x * x * x / 6 - target;
         if (f < 0)
           lo = x;
         else
           hi = x;
         const double df = v + a * x + j * x * x / 2;
-        double next = df > 0 ? x - f / df : (lo + hi) / 2;
-        if (!(next > lo && next < hi))
-          next = (lo + hi) / 2;
         if (f == 0)
           break;
+        const double next = df > 0 ? x - f / df : (lo + hi) / 2;
+        if (!(next > lo && next < hi)) {
+          x = (lo + hi) / 2;
+          continue;
+        }
+        const bool converged = std::abs(next - x) <= resolution;
         x = next;
+        if (converged)
+          break;
       }
       return t + x;
     }
@@ -134,11 +143,23 @@ double reachableSpeed(double v0, double length, double a, double j) {
   const double dvFull = a * a / j;  // the change at which acceleration first reaches a
   if (rampDistance(v0, v0 + dvFull, a, j) >= length) {
     // (2 v0 + dv) sqrt(dv / j) = L: with x = sqrt(dv), x^3 + p x - q = 0,
-    // p = 2 v0 >= 0, q = L sqrt(j): one real root, in the hyperbolic form
-    // that stays accurate when p is large.
+    // p = 2 v0 >= 0, q = L sqrt(j): one real root. Cardano's x = A + B with
+    // A = cbrt(q/2 + sqrt(q^2/4 + p^3/27)) and B = -p / (3 A) loses digits
+    // to cancellation where p is large; written as
+    // (A^3 + B^3) / (A^2 - A B + B^2) = q / (A^2 + p/3 + (p / (3 A))^2)
+    // every term is positive. (One cube root, where the hyperbolic form
+    // needs an inverse hyperbolic sine and a hyperbolic sine.)
     const double p = 2 * v0, q = length * std::sqrt(j);
-    double x = p <= 0 ? std::cbrt(q)
-                      : 2 * std::sqrt(p / 3) * std::sinh(std::asinh(1.5 * q / p * std::sqrt(3 / p)) / 3);
+    double x;
+    if (p <= 0) {
+      x = std::cbrt(q);
+    } else {
+      const double big = std::cbrt(q / 2 + std::sqrt(q * q / 4 + p * p * p / 27)), small = p / (3 * big);
+      if (std::isfinite(big))
+        x = q / (big * big + p / 3 + small * small);
+      else  // p^3 or q^2 beyond a double: the hyperbolic form
+        x = 2 * std::sqrt(p / 3) * std::sinh(std::asinh(1.5 * q / p * std::sqrt(3 / p)) / 3);
+    }
     x -= (x * x * x + p * x - q) / (3 * x * x + p);  // one Newton step polishes rounding
     return v0 + std::max(0.0, x * x);
   }

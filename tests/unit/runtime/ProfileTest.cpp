@@ -6,6 +6,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 using namespace stepnc::runtime;
@@ -57,6 +58,30 @@ TEST_CASE("reachable speed inverts the ramp distance in both regimes", "[profile
     const double v1 = reachableSpeed(v0, length, 6000, 80000);
     REQUIRE(v1 >= v0);
     CHECK(rampDistance(v0, v1, 6000, 80000) == Approx(length).epsilon(1e-9));
+  }
+}
+
+TEST_CASE("reachable speed keeps its digits where the start speed dwarfs the change", "[profile]") {
+  // Short lengths from high speeds: the change is tiny beside v0 (the
+  // cubic's p large beside q^(2/3)), where Cardano's form as usually
+  // written cancels. Log-uniform over many decades; checked on the change
+  // itself, not on v1, whose digits v0 would hide.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> decades(-9, 4);
+  for (int i = 0; i < 20000; ++i) {
+    const double v0 = i % 10 == 0 ? 0 : std::pow(10.0, decades(rng)), length = std::pow(10.0, decades(rng));
+    const double a = std::pow(10.0, 2 + decades(rng) / 4), j = std::pow(10.0, 4 + decades(rng) / 4);
+    const double v1 = reachableSpeed(v0, length, a, j);
+    REQUIRE(v1 >= v0);
+    const double dv = v1 - v0;
+    // The ramp of dv covers the length: (v0 + dv/2) T(dv) = L, to 1e-12
+    // and to what rounding v1 to a double (a few units of v1's last place
+    // in dv) does to the distance, through its slope in dv.
+    const double time = rampTime(dv, a, j);
+    const double covered = (v0 + dv / 2) * time;
+    const double slope = time / 2 + (v0 + dv / 2) * (dv >= a * a / j ? 1 / a : 1 / std::sqrt(j * dv));
+    const double rounding = 4 * std::numeric_limits<double>::epsilon() * v1 * slope;
+    CHECK(std::abs(covered - length) <= 1e-12 * length + rounding);
   }
 }
 
@@ -117,4 +142,44 @@ TEST_CASE("a profile too short to cruise peaks at the highest speed that fits", 
     ++checked;
   }
   CHECK(checked > 1000);
+}
+
+TEST_CASE("timeAt finds the time a distance is covered, in profiles and their slices", "[profile]") {
+  // The planner cuts a run's profile where its segments end: timeAt must
+  // give the time at which the profile has covered each distance, to a
+  // rounding of the clock, wherever the root lies (ramps, cruises,
+  // slices that start with an acceleration).
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> lengths(1e-3, 200), unit(0, 1), limitsV(1, 500);
+  const double a = 6000, j = 80000;
+  int checked = 0;
+  for (int i = 0; i < 300; ++i) {
+    const double length = lengths(rng);
+    const PathLimits limits{limitsV(rng), a, j};
+    double v0 = unit(rng) * limits.v;
+    double v1 = std::min(unit(rng) * limits.v, reachableSpeed(v0, length, a, j));
+    v0 = std::min(v0, reachableSpeed(v1, length, a, j));
+    const Profile whole = planProfile(v0, v1, length, limits);
+    // A slice from a random time: it starts with the whole's acceleration.
+    const double t0 = unit(rng) * whole.duration() / 2;
+    for (const Profile &p : {whole, whole.slice(t0, whole.duration())}) {
+      const double total = p.at(p.duration()).s;
+      double last = 0;
+      for (int k = 0; k <= 40; ++k) {
+        const double s = total * k / 40;
+        const double t = p.timeAt(s);
+        INFO("profile " << i << " s " << s << " of " << total << " t " << t << " of " << p.duration());
+        REQUIRE(t >= last);
+        REQUIRE(t <= p.duration());
+        // The distance at t: s within the distance the speed there covers
+        // in a few units of the clock's last place.
+        const PathState st = p.at(t);
+        const double clockRounding = 8 * std::numeric_limits<double>::epsilon() * p.duration();
+        CHECK(std::abs(st.s - s) <= 1e-12 * total + (st.v + std::abs(st.a) * p.duration()) * clockRounding + 1e-15);
+        last = t;
+        ++checked;
+      }
+    }
+  }
+  CHECK(checked == 300 * 2 * 41);
 }
