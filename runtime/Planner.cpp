@@ -64,6 +64,10 @@ struct Piece {
   /// for `stopReason`; neither when tangent and curvature already agree.
   bool blendBefore = false;
   StopReason stopReason = StopReason::None;
+  /// The blend before it as join made it (ends of zero curvature on lines):
+  /// at most this far from the two pieces at blendDeviation's samples
+  /// (mm), for smoothChains' bound.
+  double joinDeviation = 0;
 
   Piece(const Segment &s, uint32_t moveIndex)
       : length(s.length), centerX(s.center.x()), centerY(s.center.y()), radius(s.radius), startAngle(s.startAngle),
@@ -159,9 +163,16 @@ public:
     rise_ = rise;
     if (rise == 0) {
       kind_ = Kind::PlaneArc;
-      const double a0 = startAngle_ + sigma_ * t0_, a1 = startAngle_ + sigma_ * t1_;
-      e0_ = Eigen::Vector2d(std::cos(a0), std::sin(a0));
-      e1_ = Eigen::Vector2d(std::cos(a1), std::sin(a1));
+      // The ends' directions from the axis: from the end points, which are
+      // on the circle (to rounding), without a sine and cosine each; from
+      // the angles where a point is too near the axis to give one.
+      auto direction = [&](const Vec3 &p, double angle) {
+        const Eigen::Vector2d w(p.x() - centre_.x(), p.y() - centre_.y());
+        const double r = w.norm();
+        return r > radius_ / 2 ? Eigen::Vector2d(w / r) : Eigen::Vector2d(std::cos(angle), std::sin(angle));
+      };
+      e0_ = direction(first, startAngle_ + sigma_ * t0_);
+      e1_ = direction(last, startAngle_ + sigma_ * t1_);
       whole_ = t1_ - t0_ >= 2 * std::numbers::pi;
       wide_ = t1_ - t0_ > std::numbers::pi;
     }
@@ -352,8 +363,9 @@ void join(Piece &a, const Segment &sa, Piece &b, const Segment &sb, double toler
   // (the other half belongs to the blend at its other end).
   const double target = tolerance * kToleranceShare;
   double l = std::min(sa.length / 2, sb.length / 2);
-  auto blendHere = [&] {
+  auto blendHere = [&](double deviation) {
     b.blendBefore = true;
+    b.joinDeviation = deviation;
     a.cutEnd = l;
     b.cutStart = l;
   };
@@ -361,7 +373,10 @@ void join(Piece &a, const Segment &sa, Piece &b, const Segment &sb, double toler
   if (linear) {
     // Between two lines the blend is symmetric about the corner's bisector
     // and the same shape at every size: its deviation is its middle's
-    // distance from the lines, proportional to l.
+    // distance from the lines, proportional to l. (Its largest at
+    // blendDeviation's samples, too: the middle is one of them, and no other
+    // point is farther from the lines, which a scan of turns from 0 to 179
+    // degrees in steps of 1e-4 degree, at 2000 points each, confirmed.)
     const QuinticCurve curve(blendPoints(sa, l, sb, l));
     const Vec3 mid = curve.point(0.5), &dir = ea.r1;  // a line's direction, as at(0) would give it
     const Vec3 off = mid - sa.end;
@@ -369,7 +384,7 @@ void join(Piece &a, const Segment &sa, Piece &b, const Segment &sb, double toler
     if (dev > target)
       l *= target / dev;
     if (l >= kTinyBlend) {
-      blendHere();
+      blendHere(std::min(dev, target));
       return;
     }
   }
@@ -378,7 +393,7 @@ void join(Piece &a, const Segment &sa, Piece &b, const Segment &sb, double toler
     const std::array<Vec3, 6> ctrl = blendPoints(sa, l, sb, l);
     const double dev = blendDeviation(ctrl, sa, l, sb, l, bs.p);
     if (dev <= target) {
-      blendHere();
+      blendHere(dev);
       return;
     }
     // The deviation grows like l^p near the junction, p between 1 (a
@@ -561,6 +576,20 @@ void smoothChains(const PathInput &input, std::vector<Piece> &pieces, double tol
       Piece &a = pieces[j - 1], &b = pieces[j];
       if (!a.hasMidCurvature && !b.hasMidCurvature)
         continue;  // zero-curvature ends again: the blend join() made and checked
+      // The remade blend differs from join's only in the curvature at a
+      // smoothed middle: blendPoints moves its control point P2 by
+      // (k' - k) m^2 / 20 and P3 likewise, m the chord, which is at most the
+      // path length between the blend's ends. Every point of the curve then
+      // moves by at most b2(u) |dP2| + b3(u) |dP3|, with the Bernstein
+      // weights b2 and b3 at most 0.3456 each and 0.625 together; a blend
+      // whose join deviation plus that stays within the target needs no
+      // samples (with a margin far above rounding: the samples would pass).
+      const double reach = a.cutEnd + b.cutStart, spread = reach * reach / 20;
+      const double moveP2 = a.hasMidCurvature ? a.midCurvature.norm() * spread : 0;
+      const double moveP3 = b.hasMidCurvature ? b.midCurvature.norm() * spread : 0;
+      const double moved = std::min(0.3456 * (moveP2 + moveP3), 0.625 * std::max(moveP2, moveP3));
+      if (b.joinDeviation + moved <= target * (1 - 1e-6))
+        continue;
       a.segment(input, sa);
       b.segment(input, sb);
       if (blendDeviation(blendBetween(a, sa, b, sb), sa, a.cutEnd, sb, b.cutStart, sb.at(0).p) <= target)
