@@ -377,10 +377,14 @@ void join(Piece &a, const Segment &sa, Piece &b, const Segment &sb, double toler
     // blendDeviation's samples, too: the middle is one of them, and no other
     // point is farther from the lines, which a scan of turns from 0 to 179
     // degrees in steps of 1e-4 degree, at 2000 points each, confirmed.)
-    const QuinticCurve curve(blendPoints(sa, l, sb, l));
-    const Vec3 mid = curve.point(0.5), &dir = ea.r1;  // a line's direction, as at(0) would give it
-    const Vec3 off = mid - sa.end;
-    const double dev = (off - dir * off.dot(dir)).norm();
+    // With the corner at E and the lines' directions t0 and t1, blendPoints
+    // gives P0 = E - l t0, P5 = E + l t1, the chord m = l |t0 + t1|,
+    // P1 = P0 + t0 m/5, P2 = P0 + 2 t0 m/5 and mirrored P4, P3; the middle,
+    // sum C(5,i) P_i / 32, is E + (l/2 - 5m/32)(t1 - t0), whose distance
+    // from the line through E along t0 is |l/2 - 5m/32| |t1 - t0 cos(turn)|.
+    const Vec3 &t0 = ea.r1, &t1 = bs.r1;
+    const double m = l * (t0 + t1).norm();
+    const double dev = std::abs(l / 2 - 5 * m / 32) * (t1 - t0 * cosTurn).norm();
     if (dev > target)
       l *= target / dev;
     if (l >= kTinyBlend) {
@@ -748,14 +752,18 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   std::vector<double> vj(m + 1, 0.0);
   for (size_t r = 1; r < m; ++r)
     vj[r] = out.info[runs[r].first].stop != StopReason::None ? 0 : std::min(runs[r - 1].limits.v, runs[r].limits.v);
-  // reachableSpeed(v, ...) is at least v: a bound no higher than that
-  // speed keeps its value without it.
+  // A run's far end bounds its near end by the speed reachable from it over
+  // the run (reachableSpeed), which binds only where the change between the
+  // two does not fit in the run's length: where it fits (or the near end is
+  // the slower), the bound keeps its value without the cubic's root.
+  auto bound = [&](double &near, double far, const Run &run) {
+    if (near > far && rampDistance(far, near, run.limits.a, run.limits.j) > run.length)
+      near = std::min(near, reachableSpeed(far, run.length, run.limits.a, run.limits.j));
+  };
   for (size_t r = m; r-- > 0;)
-    if (vj[r] > vj[r + 1])
-      vj[r] = std::min(vj[r], reachableSpeed(vj[r + 1], runs[r].length, runs[r].limits.a, runs[r].limits.j));
+    bound(vj[r], vj[r + 1], runs[r]);
   for (size_t r = 0; r < m; ++r)
-    if (vj[r + 1] > vj[r])
-      vj[r + 1] = std::min(vj[r + 1], reachableSpeed(vj[r], runs[r].length, runs[r].limits.a, runs[r].limits.j));
+    bound(vj[r + 1], vj[r], runs[r]);
 
   // 6. Profiles: one per run, cut at its members' ends.
   out.profiles.reserve(n);

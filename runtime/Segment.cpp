@@ -300,13 +300,23 @@ Segment Segment::line(const Vec3 &from, const Vec3 &to) {
   return s;
 }
 
+namespace {
+
+/// An arc's sweep and the length it gives (the rise per radian from its ends).
+void setSweep(Segment &s, double sweep) {
+  s.sweep = sweep;
+  const double rise = sweep > 0 ? (s.end.z() - s.start.z()) / sweep : 0;
+  s.length = sweep * std::sqrt(s.radius * s.radius + rise * rise);
+}
+
+} // namespace
+
 Segment Segment::arc(const Vec3 &from, const Vec3 &to, const Vec3 &center, bool ccw, double sweep) {
   Segment s;
   s.kind = SegmentKind::Arc;
   s.start = from;
   s.end = to;
   s.ccw = ccw;
-  s.sweep = sweep;
   Eigen::Vector2d f = from.head<2>(), t = to.head<2>(), c = center.head<2>();
   const Eigen::Vector2d chord = t - f;
   if (chord.norm() > 1e-9) {
@@ -323,8 +333,7 @@ Segment Segment::arc(const Vec3 &from, const Vec3 &to, const Vec3 &center, bool 
   s.center = Vec3(c.x(), c.y(), 0);
   s.radius = (f - c).norm();
   s.startAngle = std::atan2(f.y() - c.y(), f.x() - c.x());
-  const double rise = sweep > 0 ? (to.z() - from.z()) / sweep : 0;
-  s.length = sweep * std::sqrt(s.radius * s.radius + rise * rise);
+  setSweep(s, sweep);
   return s;
 }
 
@@ -337,7 +346,9 @@ Segment Segment::arcTurns(const Vec3 &from, const Vec3 &to, const Vec3 &center, 
     d += 2 * kPi;
   if ((to.head<2>() - from.head<2>()).norm() <= 1e-9)
     d = 2 * kPi;  // over the start: the last arc is a whole turn
-  return arc(from, to, center, ccw, d + 2 * kPi * double(std::max<int64_t>(turns, 0)));
+  // The centre, radius and start angle do not depend on the sweep.
+  setSweep(s, d + 2 * kPi * double(std::max<int64_t>(turns, 0)));
+  return s;
 }
 
 Segment Segment::part(double s0, double s1) const {
