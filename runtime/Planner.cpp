@@ -193,19 +193,17 @@ public:
       }
       return;
     case Kind::PlaneArc: {
-      // Every point's distance from the axis first, in a loop of its own
-      // (Eigen's square root takes several at a time; a plain loop would
-      // not, for errno), then the choice without branches, in a loop for
-      // each kind of part, so that the compiler takes several points at a
-      // time: the same values as taking the root only where the nearest
-      // point lies on the part.
+      // Every point's distance from the axis first, in a loop of its own,
+      // then the choice without branches, in a loop for each kind of part,
+      // so that the compiler takes several points at a time (square roots
+      // included: the runtime is built without errno for them): the same
+      // values as taking the root only where the nearest point lies on the
+      // part.
       Squares fromAxis;
       for (size_t i = 0; i < n; ++i) {
         const double wx = pts.x[i] - centre_.x(), wy = pts.y[i] - centre_.y();
-        fromAxis[i] = wx * wx + wy * wy;
+        fromAxis[i] = std::sqrt(wx * wx + wy * wy);
       }
-      Eigen::Map<Eigen::Array<double, n, 1>> roots(fromAxis.data());
-      roots = roots.sqrt();
       // Turning the part's way, the angle from its start to a point's
       // direction w from the axis is at most pi where fromStart >= 0, and
       // from w to its end where toEnd >= 0; the part holds the angles

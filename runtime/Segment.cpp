@@ -6,9 +6,6 @@
 #include <limits>
 #include <type_traits>
 
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 
 namespace stepnc::runtime {
 
@@ -96,11 +93,8 @@ template <int D>
       const double d1 = (((a[k][4] * t + a[k][3]) * t + a[k][2]) * t + a[k][1]) * t + a[k][0];
       squared = k == 0 ? d1 * d1 : squared + d1 * d1;
     }
-    speed[p] = squared;
+    speed[p] = std::sqrt(squared);  // as many at a time as the version's vectors hold (no errno: CMakeLists.txt)
   }
-  // Eigen's square root takes two at a time; a plain loop would not (errno).
-  Eigen::Map<Eigen::Array<double, kPoints, 1>> roots(speed.data());
-  roots = roots.sqrt();
   table[0] = 0;
   for (size_t j = 0; j < kIntervals; ++j) {
     double sum = 0;
@@ -124,6 +118,12 @@ using PairBits = int64_t __attribute__((vector_size(16)));
 using QuadBits = int64_t __attribute__((vector_size(32)));
 using OctBits = int64_t __attribute__((vector_size(64)));
 
+/// m = max(m, x) element by element, as std::max gives it.
+template <class V>
+[[gnu::always_inline]] inline void raise(V &m, const V &x) {
+  m = m < x ? x : m;
+}
+
 /// m = max(m, |x|) element by element, as std::max and std::abs give them
 /// (|x| by clearing the sign bit).
 template <class V>
@@ -135,37 +135,18 @@ template <class V>
   m = m < a ? a : m;
 }
 
-/// The square roots of the elements, correctly rounded as std::sqrt gives
-/// them: two at a time with SSE2, which every x86-64 has (the wider
-/// square-root intrinsics would need this template compiled for AVX); else
-/// one at a time (generic vectors have no square root).
-template <class V>
-[[gnu::always_inline]] inline void squareRoots(const V &x, V &root) {
-#if defined(__SSE2__)
-  if constexpr (sizeof(V) == sizeof(Pair)) {
-    root = _mm_sqrt_pd(x);
-  } else if constexpr (sizeof(V) == sizeof(Quad)) {
-    const __m128d lo = _mm_sqrt_pd(__builtin_shufflevector(x, x, 0, 1));
-    const __m128d hi = _mm_sqrt_pd(__builtin_shufflevector(x, x, 2, 3));
-    root = __builtin_shufflevector(lo, hi, 0, 1, 2, 3);
-  } else {
-    const Quad lo = {x[0], x[1], x[2], x[3]}, hi = {x[4], x[5], x[6], x[7]};
-    Quad rootLo, rootHi;
-    squareRoots(lo, rootLo);
-    squareRoots(hi, rootHi);
-    root = __builtin_shufflevector(rootLo, rootHi, 0, 1, 2, 3, 4, 5, 6, 7);
-  }
-#else
-  for (size_t l = 0; l < sizeof(V) / sizeof(double); ++l)
-    root[l] = std::sqrt(x[l]);
-#endif
-}
-
 /// The blend's largest |r1|, |r2|, |r3| per axis over the samples u = i / 32,
-/// i = 0..32 (fromParameter's formulas, with one division per sample instead
-/// of many; the results agree to rounding), as many samples at a time as V
-/// holds (the last group takes u = 1 again). D = 2 leaves out z when it is
-/// zero.
+/// i = 0..32, as many samples at a time as V holds (the last group takes
+/// u = 1 again). D = 2 leaves out z when it is zero.
+///
+/// fromParameter's formulas, rearranged so that a sample needs one division
+/// and no square root: with q = |d1|, b = d12 / q^2 and
+/// g = (d22 + d13) / q^2 - 4 b^2,
+///   r1 = d1 / q,  r2 = (d2 - b d1) / q^2,  r3 = (d3 - 3 b d2 - g d1) / q^3,
+/// so r1^2 and r3^2 need only 1 / q^2; their largest values' square roots
+/// are taken once at the end (the root is monotone, so that is the largest
+/// root). The results agree with fromParameter's to rounding; where q = 0
+/// fromParameter gives zeros, and so do these with 1/q^2 := 0.
 template <int D, class V>
 [[gnu::always_inline]] inline void sampleBlendDemand(const QuinticCurve &q, AxisDemand &d) {
   static constexpr int kSamples = 32, kLanes = sizeof(V) / sizeof(double), kGroups = kSamples / kLanes + 1;
@@ -184,7 +165,7 @@ template <int D, class V>
     a3[k][0] = 6 * q.c[3][k], a3[k][1] = 24 * q.c[4][k], a3[k][2] = 60 * q.c[5][k];
   }
   const V zero{};
-  V m1[D], m2[D], m3[D];
+  V m1[D], m2[D], m3[D];  // the largest r1^2, |r2| and r3^2
   for (int k = 0; k < D; ++k)
     m1[k] = m2[k] = m3[k] = zero;
   for (int i = 0; i < kGroups; ++i) {
@@ -201,19 +182,13 @@ template <int D, class V>
       d22 += d2[k] * d2[k];
       d13 += d1[k] * d3[k];
     }
-    // With q = |d1|: r1 = d1 / q, r2 = (d2 - d1 d12 / q^2) / q^2 and
-    // r3 = d3 / q^3 - d2 3 d12 / q^5 - d1 ((d22 + d13) / q^5 - 4 d12^2 / q^7);
-    // where q = 0 fromParameter gives zeros, and so do these with 1/q := 0.
-    V speed;
-    squareRoots(q2, speed);
-    const V iq = q2 > 0 ? 1 / speed : zero;
-    const V iq2 = iq * iq, iq5 = iq2 * iq2 * iq;
-    const V b2 = d12 * iq2;
-    const V e3 = iq2 * iq, f3 = 3 * d12 * iq5, g3 = (d22 + d13) * iq5 - 4 * d12 * d12 * iq5 * iq2;
+    const V iq2 = q2 > 0 ? 1 / q2 : zero;
+    const V b = d12 * iq2, g = (d22 + d13) * iq2 - 4 * b * b, iq6 = iq2 * iq2 * iq2;
     for (int k = 0; k < D; ++k) {
-      raiseToAbs(m1[k], d1[k] * iq);
-      raiseToAbs(m2[k], (d2[k] - d1[k] * b2) * iq2);
-      raiseToAbs(m3[k], e3 * d3[k] - f3 * d2[k] - g3 * d1[k]);
+      raise(m1[k], d1[k] * d1[k] * iq2);
+      raiseToAbs(m2[k], (d2[k] - b * d1[k]) * iq2);
+      const V r3q3 = d3[k] - 3 * b * d2[k] - g * d1[k];
+      raise(m3[k], r3q3 * r3q3 * iq6);
     }
   }
   // All lanes hold values >= +0 and no NaN (a NaN never raises m): their
@@ -225,6 +200,8 @@ template <int D, class V>
       d.r2[k] = std::max(d.r2[k], m2[k][l]);
       d.r3[k] = std::max(d.r3[k], m3[k][l]);
     }
+    d.r1[k] = std::sqrt(d.r1[k]);
+    d.r3[k] = std::sqrt(d.r3[k]);
   }
 }
 
