@@ -715,6 +715,7 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   const size_t n = out.segments.size();
   struct Run {
     uint32_t first = 0, last = 0;  ///< segments (a trajectory's segment count fits, as its moves' do)
+    bool fromRest = false;         ///< its first segment starts at rest
     double length = 0;
     PathLimits limits;
   };
@@ -727,6 +728,7 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   for (size_t k = 0; k < n;) {
     Run r;
     r.first = r.last = uint32_t(k);
+    r.fromRest = out.info[k].stop != StopReason::None;
     r.length = lengths[k];
     r.limits = out.info[k].limits;
     double highest = r.limits.v;
@@ -749,7 +751,7 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   const size_t m = runs.size();
   std::vector<double> vj(m + 1, 0.0);
   for (size_t r = 1; r < m; ++r)
-    vj[r] = out.info[runs[r].first].stop != StopReason::None ? 0 : std::min(runs[r - 1].limits.v, runs[r].limits.v);
+    vj[r] = runs[r].fromRest ? 0 : std::min(runs[r - 1].limits.v, runs[r].limits.v);
   // A run's far end bounds its near end by the speed reachable from it over
   // the run (reachableSpeed), which binds only where the change between the
   // two does not fit in the run's length: where it fits (or the near end is

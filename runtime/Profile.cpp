@@ -218,24 +218,39 @@ Profile planProfile(double v0, double v1, double length, const PathLimits &limit
     // one, finer than the bracket's 1e-12 (which bisection still ensures
     // where Newton fails), in far fewer steps than shrinking the bracket.
     const double dvFull = a * a / j;
-    auto slope = [&](double v, double x, double time) {
-      const double dv = x - v;
+    // One side's T as rampTime gives it, and its distance's slope; below a
+    // full ramp T = 2 sqrt(dv / j) and dT/dx = 1 / (j sqrt(dv / j)): one
+    // square root for both.
+    auto ramp = [&](double v, double x, double &time, double &slope) {
+      const double dv = std::abs(x - v);
+      time = slope = 0;
       if (dv <= 0)
-        return 0.0;
-      const double dT = dv >= dvFull ? 1 / a : 1 / std::sqrt(j * dv);
-      return time / 2 + (v + x) / 2 * dT;
+        return;
+      double dT;
+      if (dv >= dvFull) {
+        time = dv / a + a / j;
+        dT = 1 / a;
+      } else {
+        const double root = std::sqrt(dv / j);
+        time = 2 * root;
+        dT = 1 / (j * root);
+      }
+      if (x > v)
+        slope = time / 2 + (v + x) / 2 * dT;
     };
     constexpr double kConverged = 4e-14;
     double lo = low, hi = std::min(vp, reachableSpeed(std::min(v0, v1), length, a, j));
     double x = hi;
     for (int it = 0; it < 60 && hi - lo > 1e-12 * hi; ++it) {
-      const double rise = rampTime(std::abs(x - v0), a, j), fall = rampTime(std::abs(x - v1), a, j);
+      double rise, riseSlope, fall, fallSlope;
+      ramp(v0, x, rise, riseSlope);
+      ramp(v1, x, fall, fallSlope);
       const double f = ((v0 + x) / 2 * rise + (x + v1) / 2 * fall) - length;
       if (f <= 0)
         lo = x;
       else
         hi = x;
-      const double df = slope(v0, x, rise) + slope(v1, x, fall);
+      const double df = riseSlope + fallSlope;
       double step = f / df;  // not finite where df is 0: bisection below
       if (std::abs(step) <= kConverged * x) {
         if (f <= 0)
