@@ -5,16 +5,15 @@
 //  - BM_Simulate: the reference player sampling a trajectory of about one
 //    hour at 1 kHz, with every check on; the time per run is the time to
 //    simulate that hour.
+#include "bench/DensePath.h"
 #include "runtime/Planner.h"
 #include "runtime/Player.h"
 
 #include <benchmark/benchmark.h>
 
-#include <cmath>
-#include <random>
-
 using namespace stepnc;
 using namespace stepnc::runtime;
+using stepnc::bench::densePath;
 
 namespace {
 
@@ -23,44 +22,6 @@ Machine hsc() {
   DiagnosticCollector collector;
   DiagnosticEngine diags(collector);
   return *loadMachine("hsc-3axis", file, diags);
-}
-
-/// `n` moves wandering in a 400 x 300 mm field: lines of 0.2 to 2 mm that
-/// turn by up to 10 degrees, every 20th a sharp corner, every 7th a tangent arc.
-PathInput densePath(int n, double feed) {
-  std::mt19937 rng(1);
-  std::uniform_real_distribution<double> len(0.2, 2), turn(-0.17, 0.17), unit(0, 1);
-  PathInput p;
-  Vec3 at(200, 150, 0);
-  double heading = 0;
-  p.start = at;
-  for (int i = 0; i < n; ++i) {
-    PathMove m;
-    m.feed = feed;
-    const double l = len(rng);
-    if (i % 7 == 3) {
-      // A tangent arc of radius l turning by up to 90 degrees.
-      const bool ccw = unit(rng) < 0.5;
-      const double side = ccw ? 1 : -1;
-      const Vec3 centre = at + l * Vec3(-std::sin(heading) * side, std::cos(heading) * side, 0);
-      const double sweep = 1.5 * unit(rng) + 0.1;
-      const double a0 = std::atan2(at.y() - centre.y(), at.x() - centre.x()) + side * sweep;
-      m.kind = PathMove::Kind::Arc;
-      m.center = centre;
-      m.ccw = ccw;
-      at = centre + l * Vec3(std::cos(a0), std::sin(a0), 0);
-      heading += side * sweep;
-    } else {
-      heading += i % 20 == 0 ? 1.5 : turn(rng);
-      at += l * Vec3(std::cos(heading), std::sin(heading), 0);
-    }
-    // Stay in the field: turn back towards its middle.
-    if (at.x() < 0 || at.x() > 400 || at.y() < 0 || at.y() > 300)
-      heading = std::atan2(150 - at.y(), 200 - at.x());
-    m.to = at;
-    p.moves.push_back(m);
-  }
-  return p;
 }
 
 void BM_Plan(benchmark::State &state) {
