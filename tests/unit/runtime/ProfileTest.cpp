@@ -85,17 +85,33 @@ TEST_CASE("reachable speed keeps its digits where the start speed dwarfs the cha
   }
 }
 
+namespace {
+
+/// A profile the planner could ask for: a length of 1e-3 to 200 mm, a speed
+/// limit of 1 to 500 mm/s, and end speeds the look-ahead could hand over
+/// (reachable from each other).
+struct ProfileCase {
+  double length = 0, v0 = 0, v1 = 0;
+  PathLimits limits;
+};
+ProfileCase randomProfileCase(std::mt19937 &rng, double a, double j) {
+  std::uniform_real_distribution<double> lengths(1e-3, 200), unit(0, 1), limitsV(1, 500);
+  ProfileCase c;
+  c.length = lengths(rng);
+  c.limits = {limitsV(rng), a, j};
+  c.v0 = unit(rng) * c.limits.v;
+  c.v1 = std::min(unit(rng) * c.limits.v, reachableSpeed(c.v0, c.length, a, j));
+  c.v0 = std::min(c.v0, reachableSpeed(c.v1, c.length, a, j));
+  return c;
+}
+
+} // namespace
+
 TEST_CASE("profiles cover their length, keep their limits and end at rest acceleration", "[profile]") {
   std::mt19937 rng(11);
-  std::uniform_real_distribution<double> lengths(1e-3, 200), speeds(0, 1), limitsV(1, 500);
   const double a = 6000, j = 80000;
   for (int i = 0; i < 300; ++i) {
-    const double length = lengths(rng);
-    const PathLimits limits{limitsV(rng), a, j};
-    // End speeds the look-ahead could hand over: reachable from each other.
-    double v0 = speeds(rng) * limits.v;
-    double v1 = std::min(speeds(rng) * limits.v, reachableSpeed(v0, length, a, j));
-    v0 = std::min(v0, reachableSpeed(v1, length, a, j));
+    const auto [length, v0, v1, limits] = randomProfileCase(rng, a, j);
     const Profile p = planProfile(v0, v1, length, limits);
     const Walk w = integrate(p);
     INFO("v0 " << v0 << " v1 " << v1 << " length " << length << " vmax " << limits.v);
@@ -150,15 +166,11 @@ TEST_CASE("timeAt finds the time a distance is covered, in profiles and their sl
   // rounding of the clock, wherever the root lies (ramps, cruises,
   // slices that start with an acceleration).
   std::mt19937 rng(13);
-  std::uniform_real_distribution<double> lengths(1e-3, 200), unit(0, 1), limitsV(1, 500);
+  std::uniform_real_distribution<double> unit(0, 1);
   const double a = 6000, j = 80000;
   int checked = 0;
   for (int i = 0; i < 300; ++i) {
-    const double length = lengths(rng);
-    const PathLimits limits{limitsV(rng), a, j};
-    double v0 = unit(rng) * limits.v;
-    double v1 = std::min(unit(rng) * limits.v, reachableSpeed(v0, length, a, j));
-    v0 = std::min(v0, reachableSpeed(v1, length, a, j));
+    const auto [length, v0, v1, limits] = randomProfileCase(rng, a, j);
     const Profile whole = planProfile(v0, v1, length, limits);
     // A slice from a random time: it starts with the whole's acceleration.
     const double t0 = unit(rng) * whole.duration() / 2;
