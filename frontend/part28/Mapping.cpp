@@ -128,4 +128,20 @@ std::string_view simpleMemberName(express::SimpleKind kind) {
   return "string";
 }
 
+std::string commonElement(express::SimpleKind kind) { return "exp:" + std::string(simpleMemberName(kind)); }
+
+std::string commonElement(express::AggregateKind kind) {
+  return "exp:" + express::lower(express::aggregateKindName(kind));
+}
+
+std::string memberElement(const express::Model &model, const TypeView &view) {
+  if (view.kind != TypeView::Simple && view.kind != TypeView::Enumeration && view.kind != TypeView::Aggregate)
+    return {};
+  if (view.decl != express::kNone)
+    return xmlName(model.typeDecl(view.decl).name);
+  if (view.kind == TypeView::Aggregate)
+    return commonElement(model.type(view.aggregate).aggregate);
+  return commonElement(view.simple);
+}
+
 } // namespace stepnc::p28

@@ -55,4 +55,15 @@ TypeView viewType(const express::Model &model, express::TypeId type);
 /// "boolean", "logical" or "binary".
 std::string_view simpleMemberName(express::SimpleKind kind);
 
+/// The common element, with its prefix, of a member of a simple type
+/// ("exp:double") or of a nested aggregate without a defined type ("exp:list").
+std::string commonElement(express::SimpleKind kind);
+std::string commonElement(express::AggregateKind kind);
+
+/// The element of an aggregate member seen as `view` (Simple, Enumeration or
+/// Aggregate): its defined type's, else the common one with its prefix
+/// ("exp:double", "exp:list"); empty for references and SELECT values,
+/// which are written as the element of what they hold.
+std::string memberElement(const express::Model &model, const TypeView &view);
+
 } // namespace stepnc::p28

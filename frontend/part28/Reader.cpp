@@ -582,13 +582,7 @@ std::string Translator::expectation(TypeId declared) const {
   case TypeView::Enumeration:
   case TypeView::Aggregate: {
     // An aggregate member: the element of its defined type, else a common one.
-    std::string element;
-    if (view.decl != kNone)
-      element = xmlName(model_->typeDecl(view.decl).name);
-    else if (view.kind == TypeView::Simple)
-      element = "exp:" + std::string(simpleMemberName(view.simple));
-    else if (view.kind == TypeView::Aggregate)
-      element = "exp:" + express::lower(express::aggregateKindName(model_->type(view.aggregate).aggregate));
+    const std::string element = memberElement(*model_, view);
     return element.empty() ? "expected " + model_->typeText(declared)
                            : "expected <" + element + "> (" + model_->typeText(declared) + ")";
   }

@@ -292,7 +292,6 @@ void Writer::member(TypeId elementType, const Value &v) {
     fail("'$' inside an aggregate cannot be written in Part 28");
     return;
   }
-  std::string element;
   switch (view.kind) {
   case TypeView::Entity:
     content(elementType, v);
@@ -301,19 +300,14 @@ void Writer::member(TypeId elementType, const Value &v) {
     typedValue(v);
     return;
   case TypeView::Aggregate:
-    element = view.decl != express::kNone
-                  ? xmlName(model_.typeDecl(view.decl).name)
-                  : "exp:" + express::lower(express::aggregateKindName(model_.type(view.aggregate).aggregate));
-    break;
   case TypeView::Simple:
   case TypeView::Enumeration:
-    element = view.decl != express::kNone ? xmlName(model_.typeDecl(view.decl).name)
-                                          : "exp:" + std::string(simpleMemberName(view.simple));
     break;
   case TypeView::Unknown:
     fail("an aggregate member of a type the mapping does not know");
     return;
   }
+  const std::string element = memberElement(model_, view);
   buf_ += '<';
   buf_ += element;
   buf_ += '>';

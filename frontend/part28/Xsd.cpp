@@ -49,40 +49,6 @@ const char *simpleTypeName(SimpleKind k) {
   return "xs:string";
 }
 
-/// The common element holding an aggregate member of a simple type.
-const char *simpleMemberElement(SimpleKind k) {
-  switch (k) {
-  case SimpleKind::Binary:
-    return "exp:binary";
-  case SimpleKind::Boolean:
-    return "exp:boolean";
-  case SimpleKind::Integer:
-    return "exp:long";
-  case SimpleKind::Logical:
-    return "exp:logical";
-  case SimpleKind::Number:
-  case SimpleKind::Real:
-    return "exp:double";
-  case SimpleKind::String:
-    return "exp:string";
-  }
-  return "exp:string";
-}
-
-const char *aggregateMemberElement(AggregateKind k) {
-  switch (k) {
-  case AggregateKind::Array:
-    return "exp:array";
-  case AggregateKind::Bag:
-    return "exp:bag";
-  case AggregateKind::List:
-    return "exp:list";
-  case AggregateKind::Set:
-    return "exp:set";
-  }
-  return "exp:list";
-}
-
 /// Indented XML text, one element tag per line.
 class XmlText {
 public:
@@ -247,9 +213,9 @@ private:
   void writeMember(TypeId id) {
     const TypeExpr &t = model_.type(id);
     if (t.kind == TypeExpr::Simple)
-      return repeated("xs:element", simpleMemberElement(t.simple));
+      return repeated("xs:element", commonElement(t.simple));
     if (t.kind == TypeExpr::Aggregate)
-      return repeated("xs:element", aggregateMemberElement(t.aggregate));
+      return repeated("xs:element", commonElement(t.aggregate));
     if (t.kind == TypeExpr::Named && t.entity != kNone)
       return repeated("xs:group", useGroup(t.entity));
     if (t.kind == TypeExpr::Named && t.declared != kNone) {
