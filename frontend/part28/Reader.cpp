@@ -10,6 +10,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <map>
 #include <optional>
 #include <unordered_map>
 
@@ -100,12 +101,19 @@ struct Frame {
   size_t instance = 0; ///< Instance and Attribute: index into the instance stack
 };
 
+/// The slots of an instance of one entity, or of one combination of records
+/// (a complex instance), with their element names: the same for every
+/// instance of it, so made once per document.
+struct Layout {
+  std::vector<std::pair<EntityId, uint32_t>> slots; ///< (record entity, slot index in that entity)
+  std::vector<std::string> elements;                ///< each slot's element name
+};
+
 /// An instance being read: its entity records and the values of its slots.
 struct Building {
   p21::InstanceId id = 0;
-  std::vector<EntityId> records;                    ///< one entity, or the records of a complex instance
-  std::vector<std::pair<EntityId, uint32_t>> slots; ///< (record entity, slot index in that entity)
-  std::vector<std::string> elements;                ///< each slot's element name
+  std::vector<EntityId> records; ///< one entity, or the records of a complex instance
+  const Layout *layout = nullptr;
   std::vector<std::optional<Piece>> values;
   bool isReference = false;
   uint64_t at = 0;
@@ -140,6 +148,7 @@ private:
   void openChildValue(Frame &frame, const Frame &parent, std::string_view local, const xmlChar *uri);
   void openAttribute(Frame &frame, Frame &parent, std::string_view local);
   bool entityRecords(std::string_view local, std::vector<EntityId> &records) const;
+  const Layout &layoutOf(const std::vector<EntityId> &records);
   std::string expectation(TypeId declared) const;
   int findSlot(const Building &b, std::string_view local) const;
   void setSlot(size_t instance, int slot, Piece value, uint64_t at);
@@ -168,6 +177,7 @@ private:
 
   std::vector<Frame> frames_;
   std::vector<Building> instances_;
+  std::map<std::vector<EntityId>, Layout> layouts_;
 
   // Header.
   std::vector<std::pair<std::string, std::string>> headerFields_;
@@ -253,6 +263,27 @@ bool Translator::entityRecords(std::string_view local, std::vector<EntityId> &re
     start = dash + 1;
   }
   return !records.empty();
+}
+
+const Layout &Translator::layoutOf(const std::vector<EntityId> &records) {
+  auto [it, added] = layouts_.try_emplace(records);
+  Layout &layout = it->second;
+  if (!added)
+    return layout;
+  for (EntityId e : records) {
+    const express::Entity &entity = model_->entity(e);
+    if (records.size() == 1) {
+      layout.elements = attributeElementNames(*model_, e);
+      for (uint32_t s = 0; s < entity.slots.size(); ++s)
+        layout.slots.emplace_back(e, s);
+    } else {
+      for (uint32_t s : entity.ownSlots) {
+        layout.slots.emplace_back(e, s);
+        layout.elements.push_back(xmlName(entity.slots[s].name));
+      }
+    }
+  }
+  return layout;
 }
 
 p21::InstanceId Translator::freshId() {
@@ -418,20 +449,8 @@ void Translator::openInstance(Frame &frame, std::string_view local, int nbAttrib
     frame.kind = Frame::Skipped;
     return;
   }
-  for (EntityId e : b.records) {
-    const express::Entity &entity = model_->entity(e);
-    if (b.records.size() == 1) {
-      b.elements = attributeElementNames(*model_, e);
-      for (uint32_t s = 0; s < entity.slots.size(); ++s)
-        b.slots.emplace_back(e, s);
-    } else {
-      for (uint32_t s : entity.ownSlots) {
-        b.slots.emplace_back(e, s);
-        b.elements.push_back(xmlName(entity.slots[s].name));
-      }
-    }
-  }
-  b.values.resize(b.slots.size());
+  b.layout = &layoutOf(b.records);
+  b.values.resize(b.layout->slots.size());
   std::optional<std::string> id, ref;
   std::vector<std::pair<std::string, std::string>> terse;
   for (int i = 0; i < nbAttributes; ++i) {
@@ -473,15 +492,15 @@ void Translator::openInstance(Frame &frame, std::string_view local, int nbAttrib
       error(frame.at, "<" + std::string(local) + "> has no attribute '" + express::lower(name) + "'");
       continue;
     }
-    const auto &[entity, index] = instances_.back().slots[static_cast<size_t>(slot)];
+    const auto &[entity, index] = instances_.back().layout->slots[static_cast<size_t>(slot)];
     if (auto v = fromText(model_->entity(entity).slots[index].type, value, frame.at))
       setSlot(frame.instance, slot, std::move(*v), frame.at);
   }
 }
 
 int Translator::findSlot(const Building &b, std::string_view local) const {
-  for (size_t i = 0; i < b.slots.size(); ++i)
-    if (sameName(b.elements[i], local))
+  for (size_t i = 0; i < b.layout->slots.size(); ++i)
+    if (sameName(b.layout->elements[i], local))
       return static_cast<int>(i);
   return -1;
 }
@@ -490,7 +509,7 @@ void Translator::setSlot(size_t instance, int slot, Piece value, uint64_t at) {
   Building &b = instances_[instance];
   auto &target = b.values[static_cast<size_t>(slot)];
   if (target) {
-    const auto &[entity, index] = b.slots[static_cast<size_t>(slot)];
+    const auto &[entity, index] = b.layout->slots[static_cast<size_t>(slot)];
     error(at,
           "#" + std::to_string(b.id) + ": attribute '" + model_->entity(entity).slots[index].name + "' is given twice");
     return;
@@ -508,15 +527,16 @@ void Translator::openAttribute(Frame &frame, Frame &parent, std::string_view loc
   const int slot = findSlot(b, local);
   if (slot < 0) {
     std::string names;
-    for (size_t i = 0; i < b.slots.size(); ++i)
-      if (!model_->entity(b.slots[i].first).slots[b.slots[i].second].derived)
-        names += (names.empty() ? "" : ", ") + b.elements[i];
+    const Layout &layout = *b.layout;
+    for (size_t i = 0; i < layout.slots.size(); ++i)
+      if (!model_->entity(layout.slots[i].first).slots[layout.slots[i].second].derived)
+        names += (names.empty() ? "" : ", ") + layout.elements[i];
     error(frame.at, "<" + std::string(local) + "> is not an attribute of " + model_->entity(b.records.back()).name)
         .note(names.empty() ? "it has no attributes" : "its attributes are " + names);
     frame.kind = Frame::Skipped;
     return;
   }
-  const auto &[entity, index] = b.slots[static_cast<size_t>(slot)];
+  const auto &[entity, index] = b.layout->slots[static_cast<size_t>(slot)];
   frame.kind = Frame::Attribute;
   frame.type = model_->entity(entity).slots[index].type;
   frame.slot = static_cast<uint32_t>(slot);
@@ -756,7 +776,7 @@ void Translator::closeInstance() {
           p.append(*b.values[slot]);
         } else {
           p.mark(b.at); // a missing value is reported at its instance's element
-          p.text += entity.slots[b.slots[slot].second].derived ? '*' : '$';
+          p.text += entity.slots[b.layout->slots[slot].second].derived ? '*' : '$';
         }
       }
       p.text += ')';

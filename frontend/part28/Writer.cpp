@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <map>
 #include <numeric>
+#include <unordered_map>
 
 namespace stepnc::p28 {
 
@@ -39,8 +40,9 @@ private:
   void processingInstruction(std::string_view target, std::string_view text);
   void section(const p21::DataSection &section, size_t number, const std::string &express);
   void instance(size_t index);
-  void record(const express::Entity &entity, const std::vector<uint32_t> &slots, const std::vector<std::string> &names,
+  void record(const express::Entity &entity, std::span<const uint32_t> slots, const std::vector<std::string> &names,
               std::span<const Value> values, int indent);
+  const std::vector<std::string> &elementNames(express::EntityId entity);
   void attribute(const express::Slot &slot, const std::string &element, const Value &v, int indent);
   void content(TypeId declared, const Value &v);
   void member(TypeId elementType, const Value &v);
@@ -60,6 +62,9 @@ private:
   p21::ValueArena arena_;
   size_t current_ = 0; ///< entry being written, for diagnostics
   bool ok_ = true;
+  /// attributeElementNames of each entity written, made once.
+  std::unordered_map<express::EntityId, std::vector<std::string>> elementNames_;
+  std::vector<uint32_t> allSlots_; ///< 0, 1, 2, ...: every slot of an entity
   /// Names written differently from the file (aliases): name -> (first entry, count).
   std::map<std::string, std::pair<size_t, size_t>, std::less<>> renamed_;
 };
@@ -336,7 +341,14 @@ void Writer::attribute(const express::Slot &slot, const std::string &element, co
   buf_ += ">\n";
 }
 
-void Writer::record(const express::Entity &entity, const std::vector<uint32_t> &slots,
+const std::vector<std::string> &Writer::elementNames(express::EntityId entity) {
+  auto [it, added] = elementNames_.try_emplace(entity);
+  if (added)
+    it->second = attributeElementNames(model_, entity);
+  return it->second;
+}
+
+void Writer::record(const express::Entity &entity, std::span<const uint32_t> slots,
                     const std::vector<std::string> &names, std::span<const Value> values, int indent) {
   if (values.size() != slots.size()) {
     fail(std::to_string(values.size()) + " values where " + entity.name + " has " + std::to_string(slots.size()) +
@@ -375,9 +387,9 @@ void Writer::instance(size_t index) {
   if (e.name() != p21::kComplexInstance) {
     const express::EntityId id = bound_.entity(index);
     const express::Entity &entity = model_.entity(id);
-    std::vector<uint32_t> all(entity.slots.size());
-    std::iota(all.begin(), all.end(), 0u);
-    record(entity, all, attributeElementNames(model_, id), arena_.params(records[0]), 6);
+    while (allSlots_.size() < entity.slots.size())
+      allSlots_.push_back(static_cast<uint32_t>(allSlots_.size()));
+    record(entity, std::span(allSlots_).first(entity.slots.size()), elementNames(id), arena_.params(records[0]), 6);
   } else {
     for (const p21::Record &r : records) {
       const express::EntityId id = model_.findEntity(bound_.schema(), express::lower(file_.names().name(r.name)));
