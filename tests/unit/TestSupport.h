@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -37,15 +38,31 @@ inline bool looksLikePart21(std::string_view t) {
   return t.substr(i).starts_with("ISO-10303-21");
 }
 
-/// Every file below `dir`, sorted (the corpus: Part 21 files, schemas, tool
-/// tables, notes; callers pick with looksLikePart21 after reading).
-inline std::vector<std::filesystem::path> filesBelow(const std::string &dir) {
+/// A file of the corpus, read; `source` is null (and `error` says why) when
+/// it cannot be opened.
+struct CorpusFile {
+  std::filesystem::path path;
+  std::unique_ptr<SourceFile> source;
+  std::string error;
+};
+
+/// The Part 21 files below `dir` in path order, read (the corpus also holds
+/// schemas, tool tables and notes, which are left out). A file that cannot
+/// be opened is kept, with its error, for the caller to fail on.
+inline std::vector<CorpusFile> part21FilesBelow(const std::string &dir) {
   std::vector<std::filesystem::path> paths;
   for (const auto &entry : std::filesystem::recursive_directory_iterator(dir))
     if (entry.is_regular_file())
       paths.push_back(entry.path());
   std::sort(paths.begin(), paths.end());
-  return paths;
+  std::vector<CorpusFile> files;
+  for (const std::filesystem::path &path : paths) {
+    CorpusFile f{path, nullptr, {}};
+    f.source = SourceFile::open(path.string(), f.error);
+    if (!f.source || looksLikePart21(f.source->text()))
+      files.push_back(std::move(f));
+  }
+  return files;
 }
 
 /// Each collected diagnostic as "line:col: message", positions in `file`.
