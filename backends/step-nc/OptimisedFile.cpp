@@ -231,13 +231,9 @@ private:
   void fail(const Node &move, const std::string &why) {
     diags_
         .error(ws_->origin.loc, "workingstep " + ws_->symbol + ": cannot write its toolpath as STEP-NC: " + why + " (" +
-                                    move.kind + " to " + formatPoint(*move.vec("to")) + ")")
+                                    move.kind + " to " + Instances::reals(*move.vec("to")) + ")")
         .entity(ws_->origin.entityId);
     failed_ = true;
-  }
-
-  static std::string formatPoint(const Vec3 &p) {
-    return '(' + Instances::real(p.x()) + ',' + Instances::real(p.y()) + ',' + Instances::real(p.z()) + ')';
   }
 
   void flush() {

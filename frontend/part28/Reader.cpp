@@ -759,7 +759,7 @@ void Translator::closeInstance() {
   if (!b.isReference) {
     Piece p;
     p.mark(b.at);
-    p.text = "#" + std::to_string(b.id) + "=";
+    p.text = ref.text + "=";
     const bool complex = b.records.size() > 1;
     if (complex)
       p.text += '(';
