@@ -32,8 +32,8 @@ std::vector<geom::Vec2> star(int n) {
   return pts;
 }
 
-ir::Node placed(std::string kind, const ir::Vec3 &at) {
-  ir::Node n(std::move(kind));
+ir::Node placed(ir::Kind kind, const ir::Vec3 &at) {
+  ir::Node n(kind);
   n.set("at", ir::Value::point(at));
   n.set("axis", ir::Value::direction(ir::Vec3::UnitZ()));
   n.set("ref", ir::Value::direction(ir::Vec3::UnitX()));
@@ -45,49 +45,49 @@ ir::Node placed(std::string kind, const ir::Vec3 &at) {
 ir::Module pocketModule(int n) {
   ir::Module m;
   m.root.label = "BENCH";
-  ir::Node wp("workpiece");
+  ir::Node wp(ir::Kind::Workpiece);
   wp.symbol = "%wp";
   wp.label = "WP";
-  ir::Node pocket = placed("closed_pocket", {0, 0, 0});
+  ir::Node pocket = placed(ir::Kind::ClosedPocket, {0, 0, 0});
   pocket.symbol = "%pocket";
   pocket.label = "POCKET";
   pocket.set("depth", ir::Value::length(5));
   pocket.set("bottom", ir::Value::word("planar"));
-  ir::Node profile("general_profile");
+  ir::Node profile(ir::Kind::GeneralProfile);
   profile.set("closed", ir::Value::boolean(true));
-  ir::Node poly("polyline");
+  ir::Node poly(ir::Kind::Polyline);
   std::vector<geom::Vec2> pts = star(n);
   pts.push_back(pts.front());
   for (const geom::Vec2 &p : pts)
-    poly.add(ir::Node("point")).set("at", ir::Value::point({p.x(), p.y(), 0}));
+    poly.add(ir::Node(ir::Kind::Point)).set("at", ir::Value::point({p.x(), p.y(), 0}));
   profile.add(std::move(poly));
   pocket.add(std::move(profile));
   wp.add(std::move(pocket));
   m.root.add(std::move(wp));
-  ir::Node tool("tool");
+  ir::Node tool(ir::Kind::Tool);
   tool.symbol = "%mill";
   tool.label = "MILL";
   tool.set("type", ir::Value::word("endmill"));
   tool.set("diameter", ir::Value::length(10));
   m.root.add(std::move(tool));
-  ir::Node plan("workplan");
+  ir::Node plan(ir::Kind::Workplan);
   plan.symbol = "@main";
   plan.label = "MAIN";
-  ir::Node ws("workingstep");
+  ir::Node ws(ir::Kind::Workingstep);
   ws.symbol = "@rough";
   ws.label = "ROUGH";
   ws.set("feature", ir::Value::ref("%pocket"));
   ws.set("secplane", ir::Value::length(20));
-  ir::Node op("bottom_and_side_rough_milling");
+  ir::Node op(ir::Kind::BottomAndSideRoughMilling);
   op.label = "ROUGH";
   op.set("tool", ir::Value::ref("%mill"));
   op.set("radial_depth", ir::Value::length(5));
-  ir::Node tech("technology");
+  ir::Node tech(ir::Kind::Technology);
   tech.set("feed", ir::Value::feed(1000));
   tech.set("spindle", ir::Value::spindle(-6000));
   tech.set("feed_reference", ir::Value::word("tcp"));
   op.add(std::move(tech));
-  ir::Node strategy("strategy");
+  ir::Node strategy(ir::Kind::Strategy);
   strategy.set("type", ir::Value::word("contour_parallel"));
   op.add(std::move(strategy));
   ws.add(std::move(op));

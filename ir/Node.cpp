@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstdlib>
+#include <iostream>
 
 namespace stepnc::ir {
 
@@ -96,19 +98,15 @@ Node &Node::set(std::string name, Value v) {
       return *this;
     }
   // Keep the kind table's order, so that a node built in any order prints,
-  // parses back and compares equal; attributes the table does not list go last.
-  const KindSpec *spec = findKind(kind);
-  auto rank = [spec](std::string_view attribute) -> size_t {
-    if (spec)
-      for (size_t i = 0; i < spec->attrs.size(); ++i)
-        if (spec->attrs[i].name == attribute)
-          return i;
-    return SIZE_MAX;
-  };
-  const size_t mine = rank(name);
-  auto at = attrs.end();
-  if (mine != SIZE_MAX)
-    at = std::find_if(attrs.begin(), attrs.end(), [&](const Attr &a) { return rank(a.name) > mine; });
+  // parses back and compares equal.
+  const KindSpec &s = spec();
+  const size_t mine = attrIndex(s, name);
+  if (mine == SIZE_MAX) {
+    std::cerr << "stepnc: internal error: attribute '" << name << "' is not declared for '" << s.name
+              << "' (ir/Kinds.def)\n";
+    std::abort();
+  }
+  auto at = std::find_if(attrs.begin(), attrs.end(), [&](const Attr &a) { return attrIndex(s, a.name) > mine; });
   attrs.insert(at, Attr{std::move(name), std::move(v)});
   return *this;
 }
@@ -161,7 +159,7 @@ std::optional<Vec3> Node::vec(std::string_view name) const {
   return v->vec;
 }
 
-std::vector<const Node *> Node::childrenOf(std::string_view k) const {
+std::vector<const Node *> Node::childrenOf(Kind k) const {
   std::vector<const Node *> out;
   for (const Node &c : children)
     if (c.kind == k)
@@ -169,9 +167,16 @@ std::vector<const Node *> Node::childrenOf(std::string_view k) const {
   return out;
 }
 
-const Node *Node::child(std::string_view k) const {
+const Node *Node::child(Kind k) const {
   for (const Node &c : children)
     if (c.kind == k)
+      return &c;
+  return nullptr;
+}
+
+const Node *Node::childIn(Category cat) const {
+  for (const Node &c : children)
+    if (c.category() == cat)
       return &c;
   return nullptr;
 }

@@ -5,7 +5,7 @@
 // (`%pocket1` for resources, `@ws_rough_pocket1` for executables), an optional
 // label (the STEP-NC id string), attributes in the order the kind's spec gives
 // them, and children. What a kind may hold is declared once, in the kind table
-// (ir/Kinds.cpp): the printer, the parser and the verifier all read it, so a
+// (ir/Kinds.def): the printer, the parser and the verifier all read it, so a
 // new kind (a turning feature, an additive operation) is one table entry.
 //
 // Units are part of the value type and fixed: lengths in mm, angles in
@@ -13,6 +13,7 @@
 // converts once; nothing downstream converts again.
 #pragma once
 
+#include "ir/Kinds.h"
 #include "support/SourceFile.h"
 
 #include <Eigen/Core>
@@ -28,25 +29,7 @@ namespace stepnc::ir {
 
 using Vec3 = Eigen::Vector3d;
 
-enum class ValueType : uint8_t {
-  Length,     ///< mm
-  Angle,      ///< degrees
-  Feed,       ///< mm/min
-  Spindle,    ///< rev/min; negative = clockwise seen from the spindle (M3)
-  Time,       ///< s
-  Ratio,      ///< plain number, 0.5 = 50 %
-  Count,      ///< integer
-  Flag,       ///< true / false
-  Word,       ///< an identifier from a fixed set (cutmode=climb)
-  Text,       ///< a quoted string
-  Ref,        ///< a symbol: %resource or @executable
-  Point,      ///< (x,y,z) mm
-  Direction,  ///< (x,y,z) unit vector
-  Real,       ///< a plain number written exactly (shortest round trip); planned motion
-  Reals,      ///< (a,b,...) plain numbers written exactly
-};
 
-const char *valueTypeName(ValueType t);
 
 struct Value {
   ValueType type = ValueType::Length;
@@ -91,7 +74,7 @@ struct Origin {
 };
 
 struct Node {
-  std::string kind;
+  Kind kind = Kind::Project;
   std::string symbol;  ///< with its sigil ('%' or '@'), or empty
   std::string label;   ///< the STEP-NC id string, or empty
   std::vector<Attr> attrs;
@@ -100,9 +83,19 @@ struct Node {
   /// Facts derived by passes, printed as a trailing comment, never parsed as data.
   std::string comment;
 
-  explicit Node(std::string k = {}) : kind(std::move(k)) {}
+  explicit Node(Kind k = Kind::Project) : kind(k) {}
+
+  const KindSpec &spec() const { return specOf(kind); }
+  /// The kind as the text form writes it, for messages.
+  std::string kindName() const { return std::string(specOf(kind).name); }
+  Category category() const { return specOf(kind).category; }
+  /// True if the node's kind has every trait in `t` (ir/Kinds.h).
+  bool is(Traits t) const { return specOf(kind).is(t); }
 
   /// Adds or replaces an attribute, keeping the kind table's attribute order.
+  /// Setting an attribute the kind does not declare is a bug in the caller:
+  /// it stops the program with an internal error instead of writing a value
+  /// that nothing would read.
   Node &set(std::string name, Value v);
   const Value *get(std::string_view name) const;
   bool has(std::string_view name) const { return get(name) != nullptr; }
@@ -118,13 +111,15 @@ struct Node {
     return children.back();
   }
   /// Children of one kind, in order.
-  std::vector<const Node *> childrenOf(std::string_view kind) const;
-  const Node *child(std::string_view kind) const;
+  std::vector<const Node *> childrenOf(Kind k) const;
+  const Node *child(Kind k) const;
+  /// The first child of a category (a workingstep's operation, a feature's profile), or null.
+  const Node *childIn(Category c) const;
 };
 
 /// A whole program: the root node (`project`) and the file it came from.
 struct Module {
-  Node root{"project"};
+  Node root{Kind::Project};
   std::string sourceName;
 };
 

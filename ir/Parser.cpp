@@ -252,12 +252,13 @@ std::optional<Node> Parser::readNode(const KindSpec *&spec) {
     error(at, "expected a node kind, found " + found(at));
     return std::nullopt;
   }
-  spec = findKind(kind);
-  if (!spec) {
+  const std::optional<Kind> known = kindNamed(kind);
+  if (!known) {
     error(at, "unknown node kind " + quoted(kind));
     return std::nullopt;
   }
-  Node n{std::string(kind)};
+  spec = &specOf(*known);
+  Node n{*known};
   n.origin.loc = loc(at);
   readFields(n, *spec);
   return n;
@@ -315,9 +316,9 @@ bool Parser::readSymbol(Node &n, const KindSpec &spec) {
   if (!isSymbol(symbol))
     error(at, "expected a symbol ('%' or '@' and then letters, digits or '_'), found " + quoted(symbol));
   else if (spec.sigil == Sigil::None)
-    error(at, quoted(spec.kind) + " takes no symbol, found " + quoted(symbol));
+    error(at, quoted(spec.name) + " takes no symbol, found " + quoted(symbol));
   else if (symbol[0] != sigilChar(spec.sigil))
-    error(at, quoted(spec.kind) + " takes a '" + sigilChar(spec.sigil) + "' symbol, found " + quoted(symbol));
+    error(at, quoted(spec.name) + " takes a '" + sigilChar(spec.sigil) + "' symbol, found " + quoted(symbol));
   else {
     n.symbol = symbol;
     return true;
@@ -330,7 +331,7 @@ bool Parser::readLabel(Node &n, const KindSpec &spec) {
   if (!readString(n.label))
     return false;
   if (!spec.label) {
-    error(at, quoted(spec.kind) + " takes no label, found " + std::string(at, p_));
+    error(at, quoted(spec.name) + " takes no label, found " + std::string(at, p_));
     return false;
   }
   return true;
@@ -345,7 +346,7 @@ bool Parser::readAttr(Node &n, const KindSpec &spec) {
   }
   const AttrSpec *a = findAttr(spec, name);
   if (!a) {
-    error(at, "unknown attribute " + quoted(name) + " for " + quoted(spec.kind));
+    error(at, "unknown attribute " + quoted(name) + " for " + quoted(spec.name));
     return false;
   }
   if (n.has(name)) {
@@ -362,7 +363,7 @@ bool Parser::readAttr(Node &n, const KindSpec &spec) {
 
 bool Parser::readValue(const AttrSpec &a, const KindSpec &spec, Value &out) {
   const char *at = p_;
-  auto subject = [&] { return "attribute " + quoted(a.name) + " of " + quoted(spec.kind); };
+  auto subject = [&] { return "attribute " + quoted(a.name) + " of " + quoted(spec.name); };
   if (p_ < end_ && *p_ == '"') {
     if (!readString(out.text))
       return false;
@@ -434,7 +435,7 @@ bool Parser::place(Node n, const KindSpec &spec, size_t depth, const char *at) {
   open_.resize(depth);
   const Open parent = open_.back();
   if (!childAllowed(*parent.spec, spec))
-    error(at, quoted(spec.kind) + " is not allowed under " + quoted(parent.spec->kind) + ", which takes " +
+    error(at, quoted(spec.name) + " is not allowed under " + quoted(parent.spec->name) + ", which takes " +
                   allowedChildren(*parent.spec));
   Node &child = parent.node->add(std::move(n));
   open_.push_back({&child, &spec});
@@ -443,11 +444,11 @@ bool Parser::place(Node n, const KindSpec &spec, size_t depth, const char *at) {
 
 bool Parser::placeRoot(Node n, const KindSpec &spec, const char *at) {
   if (haveRoot_) {
-    error(at, "expected one root node, found a second one: " + quoted(spec.kind));
+    error(at, "expected one root node, found a second one: " + quoted(spec.name));
     return false;
   }
-  if (spec.kind != "project") {
-    error(at, "expected the root node 'project', found " + quoted(spec.kind));
+  if (spec.id != Kind::Project) {
+    error(at, "expected the root node 'project', found " + quoted(spec.name));
     return false;
   }
   module_->root = std::move(n);

@@ -162,7 +162,7 @@ std::string describeValue(const AttrSpec &a) {
 
 void printNode(const Node &n, std::string &out, const PrintOptions &o, int depth) {
   out.append(static_cast<size_t>(2 * depth), ' ');
-  out += n.kind;
+  out += n.spec().name;
   if (!n.symbol.empty()) {
     out += ' ';
     out += n.symbol;
@@ -171,7 +171,7 @@ void printNode(const Node &n, std::string &out, const PrintOptions &o, int depth
     out += ' ';
     appendQuoted(n.label, out);
   }
-  appendAttrs(n, findKind(n.kind), out);
+  appendAttrs(n, &n.spec(), out);
   if (o.locations && n.origin.loc.valid())
     appendLocation(n.origin, out);
   if (!n.comment.empty()) {

@@ -5,7 +5,7 @@
 //
 //   <kind>[ <symbol>][ "<label>"][ <name>=<value>]...[ loc(<file>:<line>:<col> #<id>)][  ; <comment>]
 //
-// Attributes come in the order of the kind table (ir/Kinds.cpp); attributes the
+// Attributes come in the order of the kind table (ir/Kinds.def); attributes the
 // table does not list follow in insertion order (the verifier reports them).
 // Every value has one spelling: fixed decimals per type, the unit as a suffix,
 // never `-0`, never an exponent. The parser (ir/Parser.h) accepts exactly this

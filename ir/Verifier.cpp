@@ -17,34 +17,44 @@ namespace stepnc::ir {
 
 namespace {
 
-/// A reference attribute whose target must be a node of a given kind or category.
-struct RefRule {
-  std::string_view owner;   ///< kind or category of the node holding the attribute
-  std::string_view attr;
-  std::string_view target;  ///< kind or category of the node referred to
+/// A kind, or any kind of a category.
+struct KindOrCategory {
+  constexpr KindOrCategory(Kind k) : kind(k), isCategory(false) {}
+  constexpr KindOrCategory(Category c) : category(c), isCategory(true) {}
+  bool matches(const KindSpec &k) const { return isCategory ? k.category == category : k.id == kind; }
+  std::string_view name() const { return isCategory ? categoryName(category) : kindName(kind); }
+  Kind kind = Kind::Project;
+  Category category = Category::Root;
+  bool isCategory;
 };
 
-constexpr RefRule kRefRules[] = {
-    {"operation", "tool", "tool"},
-    {"workingstep", "feature", "feature"},
-    {"workpiece_setup", "workpiece", "workpiece"},
-    {"workplan", "setup", "setup"},
-    {"island", "feature", "boss"},
-    {"moves", "tool", "tool"},
-    {"moves", "setup", "setup"},
+/// A reference attribute whose target must be a node of a given kind or category.
+struct RefRule {
+  KindOrCategory owner;  ///< the node holding the attribute
+  std::string_view attr;
+  KindOrCategory target;  ///< the node referred to
+};
+
+const RefRule kRefRules[] = {
+    {Category::Operation, "tool", Kind::Tool},
+    {Kind::Workingstep, "feature", Category::Feature},
+    {Kind::WorkpieceSetup, "workpiece", Kind::Workpiece},
+    {Kind::Workplan, "setup", Kind::Setup},
+    {Kind::Island, "feature", Kind::Boss},
+    {Kind::Moves, "tool", Kind::Tool},
+    {Kind::Moves, "setup", Kind::Setup},
 };
 
 /// Children an operation has at most one of; the kinds of one entry count together.
-constexpr std::string_view kAtMostOnePerOperation[] = {
-    "technology", "machine_functions", "strategy drilling_strategy trochoidal_strategy plunge_strategy", "approach",
-    "retract",
+const std::vector<Kind> kAtMostOnePerOperation[] = {
+    {Kind::Technology},
+    {Kind::MachineFunctions},
+    {Kind::Strategy, Kind::DrillingStrategy, Kind::TrochoidalStrategy, Kind::PlungeStrategy},
+    {Kind::Approach},
+    {Kind::Retract},
 };
 
 constexpr double kUnitTolerance = 1e-6;
-
-bool isA(const KindSpec &k, std::string_view kindOrCategory) {
-  return k.kind == kindOrCategory || k.category == kindOrCategory;
-}
 
 /// True if `word` is one of the space-separated words of `list`.
 bool isRadius(std::string_view name) { return name == "radius" || name.ends_with("_radius"); }
@@ -76,11 +86,12 @@ std::string printed(const Value &v) {
 
 /// How messages name a node: its kind and its symbol, or its label when it has no symbol.
 std::string nameOf(const Node &n) {
+  std::string out(n.kindName());
   if (!n.symbol.empty())
-    return n.kind + " " + n.symbol;
+    return out + " " + n.symbol;
   if (!n.label.empty())
-    return n.kind + " \"" + n.label + "\"";
-  return n.kind;
+    return out + " \"" + n.label + "\"";
+  return out;
 }
 
 class Verifier {
@@ -89,15 +100,15 @@ public:
 
   bool run(const Module &m) {
     collectSymbols(m.root);
-    if (m.root.kind != "project")
-      report(m.root, "expected the root node 'project', found " + quoted(m.root.kind));
+    if (m.root.kind != Kind::Project)
+      report(m.root, "expected the root node 'project', found " + quoted(m.root.kindName()));
     checkNode(m.root, nullptr, true);
     return errors_ == 0;
   }
 
 private:
   void collectSymbols(const Node &n);
-  /// `parent` is null under a node of unknown kind.
+  /// `parent` is null for the root.
   void checkNode(const Node &n, const KindSpec *parent, bool isRoot);
   void checkPlace(const Node &n, const KindSpec &spec, const KindSpec *parent);
   void checkHead(const Node &n, const KindSpec &spec);
@@ -138,25 +149,22 @@ void Verifier::checkToolFit(const Node &ws) {
   const Node *feature = lookup(ws.text("feature"));
   const Node *op = nullptr;
   for (const Node &c : ws.children)
-    if (const KindSpec *k = findKind(c.kind); k && k->category == "operation")
+    if (isOperation(c.kind))
       op = &c;
   const Node *tool = op ? lookup(op->text("tool")) : nullptr;
   const std::optional<double> toolDiameter = tool ? tool->number("diameter") : std::nullopt;
   if (!feature || !toolDiameter)
     return;
   constexpr double eps = 1e-9;
-  const bool finishing = op->kind == "bottom_and_side_finish_milling" || op->kind == "side_finish_milling";
-  if (finishing && (feature->kind == "closed_pocket" || feature->kind == "open_pocket")) {
+  if (op->is(Trait::WallFinishing) && feature->is(Trait::Pocket)) {
     const std::optional<double> corner = feature->number("orthogonal_radius");
     if (corner && *corner > 0 && *toolDiameter / 2 > *corner + eps)
       report(*op, "tool " + tool->symbol + " of diameter " + formatFixed(*toolDiameter, 4) +
                       " mm does not fit the corners of " + feature->symbol + " (corner radius " +
                       formatFixed(*corner, 4) + " mm)");
   }
-  static constexpr std::string_view kHoleMaking[] = {"drilling", "multistep_drilling", "reaming",
-                                                     "boring",   "tapping",            "thread_drilling"};
-  if (feature->kind == "round_hole" &&
-      std::find(std::begin(kHoleMaking), std::end(kHoleMaking), op->kind) != std::end(kHoleMaking)) {
+  // Spot drills and countersinks chamfer the hole: they are wider than it.
+  if (feature->kind == Kind::RoundHole && op->is(Trait::HoleMaking) && !op->is(Trait::Chamfers)) {
     const std::optional<double> hole = feature->number("diameter");
     if (hole && *toolDiameter > *hole + eps)
       report(*op, "tool " + tool->symbol + " of diameter " + formatFixed(*toolDiameter, 4) +
@@ -176,30 +184,26 @@ void Verifier::collectSymbols(const Node &n) {
 }
 
 void Verifier::checkNode(const Node &n, const KindSpec *parent, bool isRoot) {
-  const KindSpec *spec = findKind(n.kind);
-  if (!spec) {
-    report(n, "unknown node kind " + quoted(n.kind));
-  } else {
-    if (!isRoot)
-      checkPlace(n, *spec, parent);
-    checkHead(n, *spec);
-    checkAttrs(n, *spec);
-    checkChildren(n, *spec);
-    if (n.kind == "workingstep")
-      checkToolFit(n);
-  }
+  const KindSpec &spec = n.spec();
+  if (!isRoot)
+    checkPlace(n, spec, parent);
+  checkHead(n, spec);
+  checkAttrs(n, spec);
+  checkChildren(n, spec);
+  if (n.kind == Kind::Workingstep)
+    checkToolFit(n);
   if (n.comment.find('\n') != std::string::npos)
     report(n, "the comment has a line break, expected one line");
   for (const Node &c : n.children)
-    checkNode(c, spec, false);
+    checkNode(c, &spec, false);
 }
 
 /// Below the root: never `project`, other kinds only where their parent's spec allows them.
 void Verifier::checkPlace(const Node &n, const KindSpec &spec, const KindSpec *parent) {
-  if (spec.kind == "project")
+  if (spec.id == Kind::Project)
     report(n, "'project' is only allowed as the root node");
   else if (parent && !childAllowed(*parent, spec))
-    report(n, "not allowed under " + quoted(parent->kind) + ", which takes " + allowedChildren(*parent));
+    report(n, "not allowed under " + quoted(parent->name) + ", which takes " + allowedChildren(*parent));
 }
 
 /// The symbol, the label and the comment.
@@ -226,7 +230,7 @@ void Verifier::checkAttrs(const Node &n, const KindSpec &spec) {
     if (std::any_of(n.attrs.begin(), it, [&](const Attr &earlier) { return earlier.name == it->name; }))
       report(n, attribute(it->name) + " is given twice");
     else if (!a)
-      report(n, "unknown " + attribute(it->name) + " for " + quoted(spec.kind));
+      report(n, "unknown " + attribute(it->name) + " for " + quoted(spec.name));
     else if (it->value.type != a->type)
       report(n, attribute(it->name) + " is " + describeValue(*a) + ", found a value of type " +
                     valueTypeName(it->value.type));
@@ -264,40 +268,40 @@ void Verifier::checkRef(const Node &n, const KindSpec &spec, const Attr &a) {
     return;
   }
   const Node &target = *found->second;
-  const KindSpec *targetSpec = findKind(target.kind);
   for (const RefRule &rule : kRefRules)
-    if (rule.attr == a.name && isA(spec, rule.owner) && !(targetSpec && isA(*targetSpec, rule.target)))
-      report(n, attribute(a.name) + " refers to " + quoted(a.value.text) + ", a " + target.kind + ", expected a " +
-                    std::string(rule.target));
+    if (rule.attr == a.name && rule.owner.matches(spec) && !rule.target.matches(target.spec()))
+      report(n, attribute(a.name) + " refers to " + quoted(a.value.text) + ", a " + std::string(target.kindName()) +
+                    ", expected a " + std::string(rule.target.name()));
 }
 
 /// A workingstep has exactly one operation; an operation at most one of each of kAtMostOnePerOperation.
 void Verifier::checkChildren(const Node &n, const KindSpec &spec) {
   auto count = [&](auto matches) { return std::count_if(n.children.begin(), n.children.end(), matches); };
-  if (spec.kind == "workingstep") {
-    auto operations = count([](const Node &c) {
-      const KindSpec *k = findKind(c.kind);
-      return k && k->category == "operation";
-    });
+  if (spec.id == Kind::Workingstep) {
+    auto operations = count([](const Node &c) { return isOperation(c.kind); });
     if (operations != 1)
       report(n, "expected exactly one operation, found " + std::to_string(operations));
   }
-  if (spec.category == "executable") {
-    auto moves = count([](const Node &c) { return c.kind == "moves"; });
+  if (spec.category == Category::Executable) {
+    auto moves = count([](const Node &c) { return c.kind == Kind::Moves; });
     if (moves > 1)
       report(n, "expected at most one 'moves', found " + std::to_string(moves));
   }
-  if (spec.kind == "trochoidal_strategy" || spec.kind == "plunge_strategy") {
-    auto guides = count([](const Node &c) { return c.kind == "strategy"; });
+  if (spec.is(Trait::PatternStrategy)) {
+    auto guides = count([](const Node &c) { return c.kind == Kind::Strategy; });
     if (guides != 1)
       report(n, "expected exactly one guide 'strategy', found " + std::to_string(guides));
   }
-  if (spec.category != "operation")
+  if (spec.category != Category::Operation)
     return;
-  for (std::string_view kinds : kAtMostOnePerOperation) {
-    auto found = count([&](const Node &c) { return inList(kinds, c.kind); });
-    if (found > 1)
-      report(n, "expected at most one " + joinWords(kinds) + ", found " + std::to_string(found));
+  for (const std::vector<Kind> &kinds : kAtMostOnePerOperation) {
+    auto found = count([&](const Node &c) { return std::find(kinds.begin(), kinds.end(), c.kind) != kinds.end(); });
+    if (found > 1) {
+      std::string names;
+      for (Kind k : kinds)
+        names += (names.empty() ? "" : " ") + std::string(kindName(k));
+      report(n, "expected at most one " + joinWords(names) + ", found " + std::to_string(found));
+    }
   }
 }
 

@@ -352,7 +352,7 @@ private:
     long long capped = 0;
     for (size_t k = 0; k < program.nodes.size(); ++k) {
       auto *node = const_cast<ir::Node *>(program.nodes[k]);
-      const std::optional<double> feed = node->kind == "rapid" ? std::nullopt : node->number("feed");
+      const std::optional<double> feed = node->kind == ir::Kind::Rapid ? std::nullopt : node->number("feed");
       if (!feed || *feed <= 0 || *feed <= peak[k])
         continue;
       // Feeds are whole mm/min: one within a unit of the peak is reached.
@@ -407,7 +407,7 @@ private:
         if (auto li = f.limitedLength.find(l); li != f.limitedLength.end() && li->second > 0)
           limits += (limits.empty() ? "" : ", ") + std::string(limitName(l)) + " " +
                     formatFixed(100 * li->second / total, 0) + " %";
-      const std::string name = step.executable->symbol.empty() ? step.executable->kind : step.executable->symbol;
+      const std::string name = step.executable->symbol.empty() ? step.executable->kindName() : step.executable->symbol;
       report_.push_back("  " + name + ": " +
                         (machineName.empty() ? std::string("-")
                                              : formatFixed(f.timeBefore, 2) + " -> " + formatFixed(f.timeAfter, 2)) +

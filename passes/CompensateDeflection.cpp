@@ -530,7 +530,7 @@ private:
         }
       }
     }
-    ir::Node line("linear");
+    ir::Node line(ir::Kind::Linear);
     line.set("to", ir::Value::point(b.from)).set("feed", ir::Value::feed(std::min(a.feed, b.feed)));
     if (auto role = b.node.text("role"))
       line.set("role", ir::Value::word(*role));
@@ -559,7 +559,7 @@ private:
     if (figures.empty())
       report_.push_back("  no finishing wall in the program");
     for (const auto &[step, f] : figures) {
-      const std::string name = step->executable->symbol.empty() ? step->executable->kind : step->executable->symbol;
+      const std::string name = step->executable->symbol.empty() ? step->executable->kindName() : step->executable->symbol;
       std::string line = "  " + name + ": " + um(f.errorBefore) + " -> " + um(f.errorAfter) + ", " + um(f.taperBefore) +
                          " -> " + um(f.taperAfter) + ", " + formatFixed(f.offsetMax, 4) + ", " +
                          formatFixed(100 * f.loweredLength / f.wallLength, 0) + " %";

@@ -31,7 +31,7 @@ double ccwAngle(const Vec3 &c, const Vec3 &a, const Vec3 &b) {
 bool axisAlongZ(const Node &n, bool &positive, std::string &error) {
   const Vec3 axis = n.vec("axis").value_or(Vec3::UnitZ());
   if (std::abs(std::abs(axis.z()) - 1) > 1e-9) {
-    error = n.kind + " with its axis along " + formatTuple({axis.x(), axis.y(), axis.z()}, 6) +
+    error = n.kindName() + " with its axis along " + formatTuple({axis.x(), axis.y(), axis.z()}, 6) +
             ": only circles and helices about the tool axis are supported";
     return false;
   }
@@ -44,22 +44,22 @@ public:
   CurveResult result;
 
   void curve(const Node &n, bool forward) {
-    if (n.kind == "polyline") {
+    if (n.kind == ir::Kind::Polyline) {
       polyline(n, forward);
-    } else if (n.kind == "line") {
+    } else if (n.kind == ir::Kind::Line) {
       line(n, forward);
-    } else if (n.kind == "circle") {
+    } else if (n.kind == ir::Kind::Circle) {
       fullCircle(n, forward);
-    } else if (n.kind == "trimmed_curve") {
+    } else if (n.kind == ir::Kind::TrimmedCurve) {
       trimmed(n, forward);
-    } else if (n.kind == "composite_curve") {
+    } else if (n.kind == ir::Kind::CompositeCurve) {
       composite(n, forward);
-    } else if (n.kind == "helix") {
+    } else if (n.kind == ir::Kind::Helix) {
       fail("an untrimmed helix has no ends: it must be a trimmed curve's basis");
-    } else if (n.kind == "b_spline_curve") {
+    } else if (n.kind == ir::Kind::BSplineCurve) {
       fail("B-spline curves are not expanded into moves yet");
     } else {
-      fail("'" + n.kind + "' is not a curve");
+      fail("'" + n.kindName() + "' is not a curve");
     }
   }
 
@@ -87,7 +87,7 @@ private:
 
   void polyline(const Node &n, bool forward) {
     const size_t first = result.pieces.size();
-    std::vector<const Node *> points = n.childrenOf("point");
+    std::vector<const Node *> points = n.childrenOf(ir::Kind::Point);
     for (size_t i = 1; i < points.size(); ++i)
       addLine(*points[i - 1]->vec("at"), *points[i]->vec("at"));
     if (!forward)
@@ -133,16 +133,16 @@ private:
     const Vec3 a = forward ? *from : *to;
     const Vec3 b = forward ? *to : *from;
     const bool alongBasis = sense == forward;
-    if (basis->kind == "line" || basis->kind == "polyline") {
+    if (basis->kind == ir::Kind::Line || basis->kind == ir::Kind::Polyline) {
       addLine(a, b);
-    } else if (basis->kind == "circle" || basis->kind == "helix") {
+    } else if (basis->kind == ir::Kind::Circle || basis->kind == ir::Kind::Helix) {
       bool positive = true;
       if (!axisAlongZ(*basis, positive, result.error))
         return;
       const Vec3 c = *basis->vec("at");
       const bool ccw = positive == alongBasis;
       int64_t turns = 0;
-      if (basis->kind == "helix") {
+      if (basis->kind == ir::Kind::Helix) {
         // The angle travelled follows from the rise: |dz| / |pitch| turns.
         const double pitch = std::abs(*basis->number("pitch"));
         const double total = pitch > 0 ? std::abs(b.z() - a.z()) / pitch * kTwoPi : 0;
@@ -156,13 +156,13 @@ private:
       }
       result.pieces.push_back({true, a, b, c, ccw, turns});
     } else {
-      fail("trimmed " + basis->kind + " curves are not supported");
+      fail("trimmed " + basis->kindName() + " curves are not supported");
     }
   }
 
   void composite(const Node &n, bool forward) {
     const size_t first = result.pieces.size();
-    for (const Node *segment : n.childrenOf("segment"))
+    for (const Node *segment : n.childrenOf(ir::Kind::Segment))
       if (!segment->children.empty())
         curve(segment->children.front(), segment->flag("same_sense").value_or(true));
     if (!forward)

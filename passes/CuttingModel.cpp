@@ -30,7 +30,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 bool isMill(const std::string &type) { return type.find("mill") != std::string::npos; }
 
-const ir::Node *findResource(const ir::Module &module, std::string_view kind, std::string_view symbol) {
+const ir::Node *findResource(const ir::Module &module, ir::Kind kind, std::string_view symbol) {
   for (const ir::Node &n : module.root.children)
     if (n.kind == kind && n.symbol == symbol)
       return &n;
@@ -40,14 +40,14 @@ const ir::Node *findResource(const ir::Module &module, std::string_view kind, st
 /// The workpiece a setup holds (its first workpiece_setup), else the only
 /// workpiece.
 const ir::Node *setupWorkpiece(const ir::Module &module, const std::string &setup) {
-  if (const ir::Node *s = findResource(module, "setup", setup))
-    for (const ir::Node *ws : s->childrenOf("workpiece_setup"))
+  if (const ir::Node *s = findResource(module, ir::Kind::Setup, setup))
+    for (const ir::Node *ws : s->childrenOf(ir::Kind::WorkpieceSetup))
       if (auto w = ws->text("workpiece"))
-        if (const ir::Node *wp = findResource(module, "workpiece", *w))
+        if (const ir::Node *wp = findResource(module, ir::Kind::Workpiece, *w))
           return wp;
   const ir::Node *only = nullptr;
   for (const ir::Node &n : module.root.children)
-    if (n.kind == "workpiece") {
+    if (n.kind == ir::Kind::Workpiece) {
       if (only)
         return nullptr;
       only = &n;
@@ -111,11 +111,11 @@ PathPoint pathPointAt(const std::vector<geom::Seg> &segs, double s) {
   return {s, Vec2::Zero(), Vec2::UnitX()};
 }
 
-std::string operationKind(const ir::Node &executable) {
+std::optional<ir::Kind> operationKind(const ir::Node &executable) {
   for (const ir::Node &c : executable.children)
-    if (const ir::KindSpec *spec = ir::findKind(c.kind); spec && spec->category == "operation")
+    if (ir::isOperation(c.kind))
       return c.kind;
-  return {};
+  return std::nullopt;
 }
 
 } // namespace
@@ -191,7 +191,7 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
   const cutting::CuttingData &data = *options.data;
   CutAnalysis out;
   for (const ir::Node &n : module.root.children)
-    if (n.kind == "tool")
+    if (n.kind == ir::Kind::Tool)
       out.tools.emplace(n.symbol, cutterSetup(n, data));
 
   // The steps in program order, grouped by setup for the stock's extent.
@@ -203,7 +203,7 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
   std::vector<Pending> pending;
   double smallest = kInf;
   for (const ir::Node *e : programOrder(module))
-    if (const ir::Node *m = e->child("moves")) {
+    if (const ir::Node *m = e->child(ir::Kind::Moves)) {
       pending.push_back({e, m, m->text("setup").value_or("")});
       if (auto t = out.tools.find(m->text("tool").value_or(""));
           t != out.tools.end() && t->second.mill && t->second.cutter.radius > 0)
@@ -296,7 +296,7 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
     const double torqueLimit = options.machine ? spindleTorqueLimit(*options.machine, step.spindle) : kInf;
     const double sampleStep = std::max(2 * map.cell(), std::min(radius / 4, 1.0));
     // Hole-making tools cut to where their point reaches full diameter.
-    const double point = tool && !tool->mill ? pointLength(*findResource(module, "tool", tool->symbol)) : 0;
+    const double point = tool && !tool->mill ? pointLength(*findResource(module, ir::Kind::Tool, tool->symbol)) : 0;
     for (CutMove &cm : step.moves) {
       const Move &m = cm.move;
       if (!m.isFeed() || !m.from || radius <= 0)
@@ -373,7 +373,7 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
 }
 
 bool finishesWalls(const CutStep &step) {
-  return step.operation == "side_finish_milling" || step.operation == "bottom_and_side_finish_milling";
+  return step.operation && ir::hasTraits(*step.operation, ir::Trait::WallFinishing);
 }
 
 bool engagesPartWall(const CutAnalysis &analysis, const CutStep &step, const CutSample &sample, double z) {

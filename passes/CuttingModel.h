@@ -77,7 +77,8 @@ struct CutStep {
   cutting::Cutter cutter;            ///< the tool's, turning the way the step's spindle does
   const cutting::Material *material = nullptr;
   double spindle = 0; ///< rev/min, unsigned
-  std::string operation;
+  /// The step's operation, if it has one.
+  std::optional<ir::Kind> operation;
   /// Its moves are the file's required toolpaths (runsAsWritten): cut into
   /// the stock, never measured, so the cutting passes leave them as written.
   bool asWritten = false;

@@ -70,7 +70,7 @@ public:
   void rapid(const Vec3 &to, const char *role = "position") {
     if (positioned_ && (to - pos_).norm() <= geom::kEps)
       return;
-    Node &m = moves_.add(Node("rapid"));
+    Node &m = moves_.add(Node(ir::Kind::Rapid));
     m.set("to", Value::point(to));
     m.set("role", Value::word(role));
     pos_ = to;
@@ -81,7 +81,7 @@ public:
   void linear(const Vec3 &to, double feed, const char *role, bool smooth = false) {
     if ((to - pos_).norm() <= geom::kEps)
       return;
-    Node &m = moves_.add(Node("linear"));
+    Node &m = moves_.add(Node(ir::Kind::Linear));
     m.set("to", Value::point(to));
     m.set("feed", Value::feed(feed));
     m.set("role", Value::word(role));
@@ -91,7 +91,7 @@ public:
   }
 
   void arc(const Vec3 &to, const Vec2 &centre, bool ccw, int64_t turns, double feed, const char *role) {
-    Node &m = moves_.add(Node("arc"));
+    Node &m = moves_.add(Node(ir::Kind::Arc));
     m.set("to", Value::point(to));
     m.set("center", Value::point(at(centre, pos_.z())));
     m.set("dir", Value::word(ccw ? "ccw" : "cw"));
@@ -222,7 +222,7 @@ public:
     stats_ = &stats;
     result_ = {};
     for (Node &n : module.root.children)
-      if (n.kind == "workplan")
+      if (n.kind == ir::Kind::Workplan)
         workplan(n, n.text("setup").value_or(""));
     return result_;
   }
@@ -232,21 +232,21 @@ private:
 
   void workplan(Node &plan, const std::string &setup) {
     for (Node &e : plan.children) {
-      if (e.kind == "workplan")
+      if (e.kind == ir::Kind::Workplan)
         workplan(e, e.text("setup").value_or(setup));
-      else if ((e.kind == "workingstep" || e.kind == "rapid_movement") && !e.child("moves"))
+      else if ((e.kind == ir::Kind::Workingstep || e.kind == ir::Kind::RapidMovement) && !e.child(ir::Kind::Moves))
         executable(e, setup);
     }
   }
 
   void executable(Node &ws, const std::string &setup) {
-    if (ws.kind == "rapid_movement") {
+    if (ws.kind == ir::Kind::RapidMovement) {
       rapidMovement(ws, setup);
       return;
     }
     const Node *op = nullptr;
     for (const Node &c : ws.children)
-      if (const ir::KindSpec *k = ir::findKind(c.kind); k && k->category == "operation")
+      if (ir::isOperation(c.kind))
         op = &c;
     if (!op)
       return;
@@ -259,7 +259,7 @@ private:
     p.op = op;
     p.tool = tool;
     p.radius = tool->number("diameter").value_or(0) / 2;
-    const Node *tech = op->child("technology");
+    const Node *tech = op->child(ir::Kind::Technology);
     p.feed = tech ? tech->number("feed").value_or(0) : 0;
     p.spindle = tech ? tech->number("spindle").value_or(0) : 0;
     p.plungeFeed = p.feed;
@@ -283,7 +283,7 @@ private:
     };
     Node moves = makeMoves(ws, tool->symbol, p.spindle, coolant(*op), setup);
     // Explicit toolpaths need no shape: they are in the feature's frame.
-    if (!op->childrenOf("toolpath").empty()) {
+    if (!op->childrenOf(ir::Kind::Toolpath).empty()) {
       FrameResult fr = planeFrame(*feature);
       if (!fr.frame) {
         unsupported(ws, fr.error);
@@ -307,16 +307,14 @@ private:
       return;
     }
     p.clearanceZ = clearanceAbove(s.top);
-    // Hole-making operations are those that take a drilling strategy.
-    const bool holeMaking = ir::inList(ir::findKind(op->kind)->children, "drilling_strategy");
-    if (holeMaking ? expandHoleMaking(ws, *op, s, p, moves) : milling(ws, *op, s, p, moves))
+    if (op->is(ir::Trait::HoleMaking) ? expandHoleMaking(ws, *op, s, p, moves) : milling(ws, *op, s, p, moves))
       attach(ws, std::move(moves));
   }
 
   /// An empty `moves` for the executable `exec`, with the state in force.
   static Node makeMoves(const Node &exec, const std::string &tool, double spindle, const std::string &coolant,
                         const std::string &setup) {
-    Node moves("moves");
+    Node moves(ir::Kind::Moves);
     moves.set("tool", Value::ref(tool));
     moves.set("spindle", Value::spindle(spindle));
     moves.set("coolant", Value::word(coolant));
@@ -336,7 +334,7 @@ private:
   }
 
   static std::string coolant(const Node &op) {
-    const Node *mf = op.child("machine_functions");
+    const Node *mf = op.child(ir::Kind::MachineFunctions);
     if (!mf)
       return "off";
     if (mf->flag("through_spindle_coolant").value_or(false))
@@ -348,7 +346,7 @@ private:
 
   const Node *findTool(std::string_view symbol) const {
     for (const Node &n : module_->root.children)
-      if (n.kind == "tool" && n.symbol == symbol)
+      if (n.kind == ir::Kind::Tool && n.symbol == symbol)
         return &n;
     return nullptr;
   }
@@ -357,7 +355,7 @@ private:
 
   /// An error about workingstep `ws` located at `at` (a part of it the file gives, such as its strategy).
   void report(const Node &ws, const Node &at, const std::string &message) {
-    diags_->error(at.origin.loc, ws.kind + " " + ws.symbol + ": " + message).entity(at.origin.entityId);
+    diags_->error(at.origin.loc, ws.kindName() + " " + ws.symbol + ": " + message).entity(at.origin.entityId);
     result_.ok = false;
   }
 
@@ -371,12 +369,12 @@ private:
 
   void explicitToolpaths(const Node &ws, const Node &op, const PlaneFrame &frame, const Plan &p, Node &moves) {
     Emitter e(moves, ws.number("secplane").value_or(0));
-    for (const Node *tp : op.childrenOf("toolpath")) {
-      const Node *tech = tp->child("technology");
+    for (const Node *tp : op.childrenOf(ir::Kind::Toolpath)) {
+      const Node *tech = tp->child(ir::Kind::Technology);
       const double feed = tech && tech->number("feed") ? *tech->number("feed") : p.feed;
       const ExplicitKind kind = explicitKind(*tp);
       for (const Node &curve : tp->children) {
-        if (ir::findKind(curve.kind) == nullptr || ir::findKind(curve.kind)->category != "curve")
+        if (curve.category() != ir::Category::Curve)
           continue;
         CurveResult cr = curvePieces(curve);
         if (!cr.error.empty()) {
@@ -453,9 +451,9 @@ private:
       return;
     Node moves = makeMoves(rm, lastTool_, 0, "off", setup);
     Emitter e(moves, rm.number("secplane").value_or(0));
-    for (const Node *tp : rm.childrenOf("toolpath"))
+    for (const Node *tp : rm.childrenOf(ir::Kind::Toolpath))
       for (const Node &curve : tp->children)
-        if (const ir::KindSpec *k = ir::findKind(curve.kind); k && k->category == "curve") {
+        if (curve.category() == ir::Category::Curve) {
           CurveResult cr = curvePieces(curve);
           if (!cr.error.empty()) {
             report(rm, "its toolpath: " + cr.error);
@@ -474,11 +472,11 @@ private:
 
   bool expandHoleMaking(const Node &ws, const Node &op, const FeatureShape &s, const Plan &p, Node &moves) {
     if (!s.holeCentre) {
-      unsupported(ws, op.kind + " on a " + s.kind + ": hole-making operations are expanded on round holes only");
+      unsupported(ws, op.kindName() + " on a " + s.kindName() + ": hole-making operations are expanded on round holes only");
       return false;
     }
     // Spot drills and countersinks are wider than the hole they chamfer.
-    const bool chamfers = op.kind == "center_drilling" || op.kind == "counter_sinking";
+    const bool chamfers = op.is(ir::Trait::Chamfers);
     if (!chamfers && 2 * p.radius > s.holeDiameter + 1e-6) {
       report(ws, "its tool " + p.tool->symbol + " (diameter " + formatFixed(2 * p.radius, 3) +
                      " mm) is wider than the hole (" + formatFixed(s.holeDiameter, 3) + " mm)");
@@ -492,12 +490,12 @@ private:
       bottom -= point + std::max(kBreakthrough, op.number("overcut").value_or(0));
     if (auto depth = op.number("cutting_depth"))
       bottom = std::max(bottom, s.top - *depth);
-    if (op.kind == "center_drilling" && !op.has("cutting_depth"))
+    if (op.kind == ir::Kind::CenterDrilling && !op.has("cutting_depth"))
       bottom = std::max(bottom, s.top - std::max(point, p.radius));
     Emitter e(moves, ws.number("secplane").value_or(0));
     const Vec2 c = *s.holeCentre;
     e.travel(c, p.clearanceZ);
-    if (op.kind == "multistep_drilling") {
+    if (op.kind == ir::Kind::MultistepDrilling) {
       const double first = op.number("first_depth").value_or(s.top - bottom);
       const double step = std::max(op.number("depth_increment").value_or(first), 0.1);
       double reached = p.clearanceZ;
@@ -517,8 +515,7 @@ private:
     }
     // Reamers, boring bars and taps leave at feed (a tap with the spindle
     // reversed: the backend's tapping cycle); drills leave at rapid.
-    const bool feedOut = op.kind == "reaming" || op.kind == "boring" || op.kind == "tapping" ||
-                         op.kind == "thread_drilling";
+    const bool feedOut = op.spec().isAny(ir::Trait::BoreCycle | ir::Trait::TapCycle);
     if (feedOut)
       e.linear(at(c, p.clearanceZ), p.feed * op.number("feed_on_retract").value_or(1.0), "retract");
     e.retract();
@@ -545,15 +542,15 @@ private:
   }
 
   bool milling(const Node &ws, const Node &op, const FeatureShape &s, const Plan &p, Node &moves) {
-    for (const char *kind : {"trochoidal_strategy", "plunge_strategy"})
-      if (const Node *pattern = op.child(kind))
-        return patternMilling(ws, op, *pattern, s, p, moves);
-    const Node *strategy = op.child("strategy");
+    for (const Node &pattern : op.children)
+      if (pattern.is(ir::Trait::PatternStrategy))
+        return patternMilling(ws, op, pattern, s, p, moves);
+    const Node *strategy = op.child(ir::Kind::Strategy);
     std::string type = strategy ? strategy->text("type").value_or("") : "";
-    const bool face = op.kind == "plane_rough_milling" || op.kind == "plane_finish_milling" || s.kind == "planar_face";
+    const bool face = op.is(ir::Trait::FaceOperation) || ir::hasTraits(s.kind, ir::Trait::FaceFeature);
     if (type.empty())
       type = face ? "bidirectional" : "contour_parallel";
-    const bool sideOnly = op.kind == "side_rough_milling" || op.kind == "side_finish_milling";
+    const bool sideOnly = op.is(ir::Trait::SideOnly);
 
     const std::vector<double> levels = levelsOf(ws, op, s, p);
     if (levels.empty())
@@ -607,7 +604,7 @@ private:
           centres = geom::offset(s.target, -geom::kEps);  // links stay in the slot
           paths.push_back(std::move(*line));
         } else if (type == "center_milling") {
-          unsupported(ws, "center milling follows the course of travel of a slot; " + s.symbol + " is a " + s.kind);
+          unsupported(ws, "center milling follows the course of travel of a slot; " + s.symbol + " is a " + s.kindName());
           return false;
         } else if (!centres.empty()) {
           auto made = strategyPaths(type, face, s.unbounded, sideOnly, centres, strokeDir, stepover, followOrientation, p.radius);
@@ -850,7 +847,7 @@ private:
         linked = true;
       }
     }
-    const Node *a = op.child("approach");
+    const Node *a = op.child(ir::Kind::Approach);
     const bool straightDown = !a || a->text("type").value_or("plunge_toolaxis") == "plunge_toolaxis";
     if (!linked && straightDown && e.positioned() && (e.position().head<2>() - start).norm() <= geom::kEps &&
         e.position().z() > z) {
@@ -869,7 +866,7 @@ private:
   void approach(Emitter &e, const std::vector<Seg> &path, double z, const Plan &p, const Node &op,
                 const Region &centres) {
     const Vec2 start = path.front().a;
-    const Node *a = op.child("approach");
+    const Node *a = op.child(ir::Kind::Approach);
     const std::string type = a ? a->text("type").value_or("plunge_toolaxis") : "plunge_toolaxis";
     if (type == "plunge_helix") {
       const double radius = a->number("radius").value_or(p.radius / 2);
@@ -910,10 +907,10 @@ private:
 
   bool patternMilling(const Node &ws, const Node &op, const Node &pattern, const FeatureShape &s, const Plan &p,
                       Node &moves) {
-    const Node *guide = pattern.child("strategy");
+    const Node *guide = pattern.child(ir::Kind::Strategy);
     const std::string type = guide ? guide->text("type").value_or("") : "";
     if (type.empty() || type == "explicit") {
-      report(ws, "its " + pattern.kind +
+      report(ws, "its " + pattern.kindName() +
                      " needs an ordinary strategy as its guide (contour parallel, "
                      "bidirectional, center milling, ...), found " +
                      (type.empty() ? "none" : "'" + type + "'"));
@@ -922,7 +919,7 @@ private:
     const std::vector<double> levels = levelsOf(ws, op, s, p);
     if (levels.empty())
       return false;
-    return pattern.kind == "trochoidal_strategy" ? trochoidal(ws, op, pattern, *guide, s, p, levels, moves)
+    return pattern.kind == ir::Kind::TrochoidalStrategy ? trochoidal(ws, op, pattern, *guide, s, p, levels, moves)
                                                  : plunging(ws, op, pattern, *guide, s, p, levels, moves);
   }
 
@@ -952,15 +949,15 @@ private:
       return std::vector<std::vector<Seg>>{std::move(*line)};
     }
     if (type == "center_milling") {
-      unsupported(ws, "center milling follows the course of travel of a slot; " + s.symbol + " is a " + s.kind);
+      unsupported(ws, "center milling follows the course of travel of a slot; " + s.symbol + " is a " + s.kindName());
       return std::nullopt;
     }
     if (area.empty()) {
       tooWide(s.symbol);
       return std::nullopt;
     }
-    const bool face = op.kind == "plane_rough_milling" || op.kind == "plane_finish_milling" || s.kind == "planar_face";
-    const bool sideOnly = op.kind == "side_rough_milling" || op.kind == "side_finish_milling";
+    const bool face = op.is(ir::Trait::FaceOperation) || ir::hasTraits(s.kind, ir::Trait::FaceFeature);
+    const bool sideOnly = op.is(ir::Trait::SideOnly);
     auto made = strategyPaths(type, face, s.unbounded, sideOnly, area, strokeDirection(*reach.feature, s, &guide),
                               spacing, counterClockwise(&guide, reach.spindle), reach.radius);
     if (!made) {
@@ -1059,7 +1056,7 @@ private:
     Plan reach = p;
     reach.radius = p.radius + loop;
     const double spacing = guideSpacing(pattern, s, reach.radius);
-    const Node *a = op.child("approach");
+    const Node *a = op.child(ir::Kind::Approach);
     const std::string entry = a ? a->text("type").value_or("plunge_helix") : "plunge_helix";
     const double angle = std::max(a ? a->number("angle").value_or(5.0) : 5.0, 0.5) * kPi / 180;
     Emitter e(moves, ws.number("secplane").value_or(0));

@@ -57,10 +57,10 @@ public:
   const Node *profile(const Node &owner, std::optional<PlaneFrame> &local) {
     const Node *p = nullptr;
     for (const Node &c : owner.children)
-      if (const ir::KindSpec *k = ir::findKind(c.kind); k && k->category == "profile" && !p)
+      if (c.category() == ir::Category::Profile && !p)
         p = &c;
     if (!p) {
-      fail(owner.kind + " " + owner.symbol + " has no profile");
+      fail(owner.kindName() + " " + owner.symbol + " has no profile");
       return nullptr;
     }
     if (p->has("at")) {
@@ -81,13 +81,13 @@ public:
     if (!p)
       return std::nullopt;
     Loop l;
-    if (p->kind == "rectangular_profile") {
+    if (p->kind == ir::Kind::RectangularProfile) {
       // Centred on the profile's origin, its length along x and its width along y.
       const Vec2 half(*p->number("length") / 2, *p->number("width") / 2);
       l = geom::roundedRectangle(-half, half, cornerRadius);
-    } else if (p->kind == "circular_profile") {
+    } else if (p->kind == ir::Kind::CircularProfile) {
       l = geom::circleLoop(Vec2::Zero(), *p->number("diameter") / 2, true);
-    } else if (p->kind == "general_profile") {
+    } else if (p->kind == ir::Kind::GeneralProfile) {
       if (!p->flag("closed").value_or(false) || p->children.empty()) {
         fail("the general profile of " + owner.symbol + " is not closed");
         return std::nullopt;
@@ -104,7 +104,7 @@ public:
       }
       l.segs.back().b = l.segs.front().a;
     } else {
-      fail("a " + p->kind + " is not a closed profile (" + owner.kind + " " + owner.symbol + ")");
+      fail("a " + p->kindName() + " is not a closed profile (" + owner.kindName() + " " + owner.symbol + ")");
       return std::nullopt;
     }
     return local ? mapLoop(l, *local) : l;
@@ -118,8 +118,8 @@ public:
     const Node *p = profile(feature, local);
     if (!p)
       return false;
-    if (p->kind != "general_profile" || p->flag("closed").value_or(true) || p->children.empty())
-      return fail("the open boundary of pocket " + feature.symbol + " is a " + p->kind +
+    if (p->kind != ir::Kind::GeneralProfile || p->flag("closed").value_or(true) || p->children.empty())
+      return fail("the open boundary of pocket " + feature.symbol + " is a " + p->kindName() +
                   ": an open pocket is expanded from an open general profile (its walls)");
     CurveResult cr = curvePieces(p->children.front());
     if (!cr.error.empty())
@@ -166,7 +166,7 @@ public:
   }
 
   void islands(const Node &feature, FeatureShape &s) {
-    for (const Node *island : feature.childrenOf("island")) {
+    for (const Node *island : feature.childrenOf(ir::Kind::Island)) {
       const Node *boss = findFeature(module_, *island->text("feature"));
       if (!boss)
         continue;  // the IR verifier reports dangling references
@@ -186,7 +186,7 @@ public:
   /// coordinates; `what` names the path in messages ("open boundary").
   std::optional<std::pair<Vec2, Vec2>> straightPath(const Node &feature, const FeatureShape &s,
                                                     const std::string &what) {
-    const Node *path = feature.child("path");
+    const Node *path = feature.child(ir::Kind::Path);
     std::vector<CurvePiece> pieces;
     if (path && !path->children.empty()) {
       CurveResult cr = curvePieces(path->children.front());
@@ -197,7 +197,7 @@ public:
       pieces = std::move(cr.pieces);
     }
     if (pieces.size() != 1 || pieces[0].arc) {
-      fail("only " + feature.kind + "s along one straight " + what + " are supported (" + feature.symbol + ")");
+      fail("only " + feature.kindName() + "s along one straight " + what + " are supported (" + feature.symbol + ")");
       return std::nullopt;
     }
     return std::pair(s.frame.map(pieces[0].from.head<2>()), s.frame.map(pieces[0].to.head<2>()));
@@ -239,11 +239,11 @@ public:
       return false;
     const auto [a, b] = *path;
     double width = 0;
-    if (const Node *p = feature.child("square_u_profile"))
+    if (const Node *p = feature.child(ir::Kind::SquareUProfile))
       width = *p->number("width");
-    else if (const Node *q = feature.child("rounded_u_profile"))
+    else if (const Node *q = feature.child(ir::Kind::RoundedUProfile))
       width = *q->number("width");
-    else if (feature.child("vee_profile") || feature.child("partial_circular_profile"))
+    else if (feature.child(ir::Kind::VeeProfile) || feature.child(ir::Kind::PartialCircularProfile))
       return fail("slot " + feature.symbol + " has slanted or curved walls; 2.5D strategies cut vertical walls "
                   "only (plan: z-level passes with a form or tapered tool)");
     else
@@ -302,7 +302,7 @@ const Node *findIn(const Node &n, std::string_view symbol, const Node **parent) 
         *parent = &n;
       return &c;
     }
-    if (c.kind == "workpiece")
+    if (c.kind == ir::Kind::Workpiece)
       if (const Node *found = findIn(c, symbol, parent))
         return found;
   }
@@ -316,7 +316,7 @@ FrameResult planeFrame(const ir::Node &placed) {
   const ir::Vec3 axis = placed.vec("axis").value_or(ir::Vec3::UnitZ());
   const ir::Vec3 ref = placed.vec("ref").value_or(ir::Vec3::UnitX());
   if (std::abs(axis.z() - 1) > 1e-9)
-    return {std::nullopt, placed.kind + (placed.symbol.empty() ? "" : " " + placed.symbol) + " has its axis along " +
+    return {std::nullopt, placed.kindName() + (placed.symbol.empty() ? "" : " " + placed.symbol) + " has its axis along " +
                               formatTuple({axis.x(), axis.y(), axis.z()}, 6) + ": only features facing the tool axis +z are expanded (plan: "
                               "setups per face orientation)"};
   PlaneFrame f;
@@ -335,7 +335,7 @@ double pointLength(const ir::Node &tool) {
 }
 
 std::optional<RawBlock> rawBlock(const ir::Node *workpiece) {
-  const Node *raw = workpiece ? workpiece->child("rawpiece") : nullptr;
+  const Node *raw = workpiece ? workpiece->child(ir::Kind::Rawpiece) : nullptr;
   if (!raw || raw->text("shape") != "block" || !raw->has("size"))
     return std::nullopt;
   FrameResult fr = planeFrame(*raw);
@@ -353,8 +353,7 @@ const ir::Node *findFeature(const ir::Module &module, std::string_view symbol) {
   const Node *n = findIn(module.root, symbol, nullptr);
   if (!n)
     return nullptr;
-  const ir::KindSpec *k = ir::findKind(n->kind);
-  return k && k->category == "feature" ? n : nullptr;
+  return n->category() == ir::Category::Feature ? n : nullptr;
 }
 
 ShapeResult featureShape(const ir::Module &module, const ir::Node &feature) {
@@ -371,18 +370,18 @@ ShapeResult featureShape(const ir::Module &module, const ir::Node &feature) {
   s.bottom = s.top - feature.number("depth").value_or(0);
   ShapeBuilder b(module, workpiece);
   bool ok = true;
-  if (feature.kind == "closed_pocket" || feature.kind == "open_pocket") {
+  if (feature.kind == ir::Kind::ClosedPocket || feature.kind == ir::Kind::OpenPocket) {
     if (feature.text("bottom") != "planar" && feature.text("bottom") != "through")
       return {std::nullopt, "pocket " + feature.symbol + " has a " + feature.text("bottom").value_or("") +
                                 " bottom; only planar and through bottoms are expanded (plan: ball-end finishing)"};
-    if (feature.kind == "open_pocket") {
+    if (feature.kind == ir::Kind::OpenPocket) {
       ok = b.openPocket(feature, s);
     } else if (auto l = b.closedProfile(feature, feature.number("orthogonal_radius").value_or(0))) {
       s.target = outer(mapLoop(*l, s.frame));
       s.limit = s.target;
     }
     b.islands(feature, s);
-  } else if (feature.kind == "planar_face") {
+  } else if (feature.kind == ir::Kind::PlanarFace) {
     const Vec2 travel = s.frame.mapDir(feature.vec("travel_dir")->head<2>()).normalized();
     const Vec2 across = s.frame.mapDir(feature.vec("width_dir")->head<2>()).normalized();
     const Vec2 o = s.frame.origin;
@@ -390,23 +389,23 @@ ShapeResult featureShape(const ir::Module &module, const ir::Node &feature) {
     s.target = outer(geom::polygon({o, o + w, o + w + t, o + t}));
     s.unbounded = true;
     b.islands(feature, s);
-  } else if (feature.kind == "round_hole") {
+  } else if (feature.kind == ir::Kind::RoundHole) {
     s.holeCentre = s.frame.origin;
     s.holeDiameter = *feature.number("diameter");
     s.target = outer(geom::circleLoop(s.frame.origin, s.holeDiameter / 2, true));
     s.limit = s.target;
-  } else if (feature.kind == "slot") {
+  } else if (feature.kind == ir::Kind::Slot) {
     ok = b.slot(feature, s);
-  } else if (feature.kind == "step") {
+  } else if (feature.kind == ir::Kind::Step) {
     ok = b.step(feature, s);
     b.islands(feature, s);
-  } else if (feature.kind == "general_outside_profile") {
+  } else if (feature.kind == ir::Kind::GeneralOutsideProfile) {
     ok = b.outsideProfile(feature, s);
   } else {
-    return {std::nullopt, feature.kind + " " + feature.symbol + " is not a feature strategy expansion can cut"};
+    return {std::nullopt, feature.kindName() + " " + feature.symbol + " is not a feature strategy expansion can cut"};
   }
   if (!ok || !b.error.empty() || s.target.empty())
-    return {std::nullopt, b.error.empty() ? feature.kind + " " + feature.symbol + " has no usable outline" : b.error};
+    return {std::nullopt, b.error.empty() ? feature.kindName() + " " + feature.symbol + " has no usable outline" : b.error};
   return {std::move(s), {}};
 }
 

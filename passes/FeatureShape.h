@@ -39,7 +39,8 @@ struct IslandShape {
 
 struct FeatureShape {
   std::string symbol;
-  std::string kind;
+  ir::Kind kind = ir::Kind::ClosedPocket;
+  std::string kindName() const { return std::string(ir::kindName(kind)); }
   PlaneFrame frame;
   double top = 0;     ///< z of the feature's top (its placement)
   double bottom = 0;  ///< z of its floor (top - depth)

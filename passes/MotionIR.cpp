@@ -26,11 +26,11 @@ ProgramPath programPath(const ir::Module &module) {
   std::string tool, setup;
   std::optional<double> spindle;
   for (const ir::Node *e : programOrder(module)) {
-    if (e->kind == "program_stop" || e->kind == "optional_stop") {
+    if (e->kind == ir::Kind::ProgramStop || e->kind == ir::Kind::OptionalStop) {
       stop = true;
       continue;
     }
-    const ir::Node *moves = e->child("moves");
+    const ir::Node *moves = e->child(ir::Kind::Moves);
     if (!moves)
       continue;
     // A change of tool, setup or spindle happens at rest.
@@ -71,7 +71,7 @@ void attachMotion(ir::Module &module, const ProgramPath &program, const runtime:
   auto mutableNode = [](const ir::Node *n) { return const_cast<ir::Node *>(n); };
   for (const ir::Node *e : programOrder(module)) {
     auto &cs = mutableNode(e)->children;
-    cs.erase(std::remove_if(cs.begin(), cs.end(), [](const ir::Node &c) { return c.kind == "motion"; }), cs.end());
+    cs.erase(std::remove_if(cs.begin(), cs.end(), [](const ir::Node &c) { return c.kind == ir::Kind::Motion; }), cs.end());
   }
   std::map<const ir::Node *, ir::Node> motions;
   std::vector<const ir::Node *> order;
@@ -81,7 +81,7 @@ void attachMotion(ir::Module &module, const ProgramPath &program, const runtime:
     const runtime::SegmentInfo &info = trajectory.info[k];
     const runtime::Profile &prof = trajectory.profiles[k];
     const ir::Node *owner = program.owners.at(info.move);
-    auto [it, fresh] = motions.try_emplace(owner, ir::Node("motion"));
+    auto [it, fresh] = motions.try_emplace(owner, ir::Node(ir::Kind::Motion));
     ir::Node &motion = it->second;
     if (fresh) {
       order.push_back(owner);
@@ -90,7 +90,7 @@ void attachMotion(ir::Module &module, const ProgramPath &program, const runtime:
       motion.set("from", ir::Value::reals(numbers(seg.start)));
     }
     times[owner] += prof.duration();
-    ir::Node s("motion_segment");
+    ir::Node s(ir::Kind::MotionSegment);
     s.set("shape", ir::Value::word(seg.kind == SegmentKind::Line  ? "line"
                                    : seg.kind == SegmentKind::Arc ? "arc"
                                                                   : "blend"));
@@ -146,13 +146,13 @@ std::optional<runtime::Trajectory> readMotion(const ir::Module &module, Diagnost
   auto numbersOf = [&](const ir::Node &n, std::string_view name, size_t size) -> std::optional<std::vector<double>> {
     const ir::Value *v = n.get(name);
     if (!v || v->type != ir::ValueType::Reals || v->numbers.size() != size) {
-      fail(n, std::string(n.kind) + " needs '" + std::string(name) + "' with " + std::to_string(size) + " numbers");
+      fail(n, n.kindName() + " needs '" + std::string(name) + "' with " + std::to_string(size) + " numbers");
       return std::nullopt;
     }
     return v->numbers;
   };
   for (const ir::Node *e : programOrder(module)) {
-    const ir::Node *motion = e->child("motion");
+    const ir::Node *motion = e->child(ir::Kind::Motion);
     if (!motion)
       continue;
     const auto from = numbersOf(*motion, "from", 3);

@@ -51,7 +51,7 @@ bool degenerateArc(const Move &m) { return (xy(*m.from) - xy(m.center)).norm() <
 Move readMove(const ir::Node &n, PathKind path) {
   Move m;
   m.node = &n;
-  m.kind = n.kind == "rapid" ? MoveKind::Rapid : n.kind == "linear" ? MoveKind::Linear : MoveKind::Arc;
+  m.kind = n.kind == ir::Kind::Rapid ? MoveKind::Rapid : n.kind == ir::Kind::Linear ? MoveKind::Linear : MoveKind::Arc;
   std::optional<ir::Vec3> to = path == PathKind::Predicted ? n.vec("nominal") : std::nullopt;
   m.to = to ? *to : n.vec("to").value_or(ir::Vec3::Zero());
   std::optional<ir::Vec3> center = path == PathKind::Predicted ? n.vec("nominal_center") : std::nullopt;
@@ -120,10 +120,10 @@ namespace {
 
 void collectExecutables(const ir::Node &plan, std::vector<const ir::Node *> &out) {
   for (const ir::Node &e : plan.children) {
-    if (e.kind == "workplan")
+    if (e.kind == ir::Kind::Workplan)
       collectExecutables(e, out);
-    else if (e.kind == "workingstep" || e.kind == "rapid_movement" || e.kind == "program_stop" ||
-             e.kind == "optional_stop" || e.kind == "display_message")
+    else if (e.kind == ir::Kind::Workingstep || e.kind == ir::Kind::RapidMovement || e.kind == ir::Kind::ProgramStop ||
+             e.kind == ir::Kind::OptionalStop || e.kind == ir::Kind::DisplayMessage)
       out.push_back(&e);
   }
 }
@@ -133,7 +133,7 @@ void collectExecutables(const ir::Node &plan, std::vector<const ir::Node *> &out
 std::vector<const ir::Node *> programOrder(const ir::Module &module) {
   std::vector<const ir::Node *> out;
   for (const ir::Node &n : module.root.children)
-    if (n.kind == "workplan")
+    if (n.kind == ir::Kind::Workplan)
       collectExecutables(n, out);
   return out;
 }
@@ -142,7 +142,7 @@ std::vector<Move> walkMoves(const ir::Node &moves, std::optional<ir::Vec3> start
   std::vector<Move> out;
   std::optional<ir::Vec3> at = start;
   for (const ir::Node &n : moves.children) {
-    if (n.kind != "rapid" && n.kind != "linear" && n.kind != "arc")
+    if (n.kind != ir::Kind::Rapid && n.kind != ir::Kind::Linear && n.kind != ir::Kind::Arc)
       continue;
     Move m = readMove(n, path);
     m.from = at;
@@ -154,8 +154,8 @@ std::vector<Move> walkMoves(const ir::Node &moves, std::optional<ir::Vec3> start
 
 bool runsAsWritten(const ir::Node &executable) {
   for (const ir::Node &c : executable.children)
-    if (const ir::KindSpec *spec = ir::findKind(c.kind); spec && spec->category == "operation") {
-      const std::vector<const ir::Node *> toolpaths = c.childrenOf("toolpath");
+    if (ir::isOperation(c.kind)) {
+      const std::vector<const ir::Node *> toolpaths = c.childrenOf(ir::Kind::Toolpath);
       return !toolpaths.empty() && std::all_of(toolpaths.begin(), toolpaths.end(), [](const ir::Node *tp) {
         return tp->flag("required").value_or(true);
       });

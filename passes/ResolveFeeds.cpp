@@ -25,7 +25,7 @@ public:
   PassResult run(ir::Module &module, DiagnosticEngine &diags, PassStats &stats) override {
     std::map<std::string, const ir::Node *, std::less<>> tools;
     for (const ir::Node &n : module.root.children)
-      if (n.kind == "tool")
+      if (n.kind == ir::Kind::Tool)
         tools[n.symbol] = &n;
     PassResult result;
     visit(module.root, tools, diags, stats, result);
@@ -36,7 +36,7 @@ private:
   void visit(ir::Node &node, const std::map<std::string, const ir::Node *, std::less<>> &tools,
              DiagnosticEngine &diags, PassStats &stats, PassResult &result) {
     for (ir::Node &child : node.children) {
-      if (const ir::KindSpec *spec = ir::findKind(child.kind); spec && spec->category == "operation") {
+      if (ir::isOperation(child.kind)) {
         const ir::Node *tool = nullptr;
         if (auto symbol = child.text("tool"))
           if (auto it = tools.find(*symbol); it != tools.end())
@@ -50,7 +50,7 @@ private:
   void resolve(ir::Node &op, const ir::Node *tool, DiagnosticEngine &diags, PassStats &stats, PassResult &result) {
     ir::Node *tech = nullptr;
     for (ir::Node &c : op.children)
-      if (c.kind == "technology")
+      if (c.kind == ir::Kind::Technology)
         tech = &c;
     if (!tech)
       return;
@@ -71,7 +71,7 @@ private:
              formatFixed(n, 1) + " rev/min");
         ++stats["feeds computed"];
       } else {
-        diags.warning(op.origin.loc, op.kind + " '" + op.label +
+        diags.warning(op.origin.loc, op.kindName() + " '" + op.label +
                                          "' has no feed: neither a feed nor a feed per tooth with the tool's "
                                          "flutes and a spindle speed")
             .entity(op.origin.entityId);

@@ -55,25 +55,13 @@ constexpr size_t kMaxReports = 3;           ///< errors of one kind reported per
 
 // --- Operations ------------------------------------------------------------------
 
-bool isOneOf(std::string_view kind, std::initializer_list<std::string_view> kinds) {
-  return std::find(kinds.begin(), kinds.end(), kind) != kinds.end();
-}
-
-bool isMilling(std::string_view op) {
-  return isOneOf(op, {"plane_rough_milling", "plane_finish_milling", "bottom_and_side_rough_milling",
-                      "bottom_and_side_finish_milling", "side_rough_milling", "side_finish_milling",
-                      "freeform_operation"});
-}
-
-bool isFinishing(std::string_view op) {
-  return isOneOf(op, {"bottom_and_side_finish_milling", "side_finish_milling", "plane_finish_milling"});
-}
-
-bool isSideMilling(std::string_view op) { return isOneOf(op, {"side_rough_milling", "side_finish_milling"}); }
+bool isMilling(ir::Kind op) { return ir::hasTraits(op, ir::Trait::Milling); }
+bool isFinishing(ir::Kind op) { return ir::hasTraits(op, ir::Trait::Finishing); }
+bool isSideMilling(ir::Kind op) { return ir::hasTraits(op, ir::Trait::SideOnly); }
 
 const ir::Node *operationOf(const ir::Node &exec) {
   for (const ir::Node &c : exec.children)
-    if (const ir::KindSpec *k = ir::findKind(c.kind); k && k->category == "operation")
+    if (ir::isOperation(c.kind))
       return &c;
   return nullptr;
 }
@@ -293,7 +281,7 @@ public:
 
   PassResult run() {
     for (const ir::Node &n : module_.root.children)
-      if (n.kind == "tool")
+      if (n.kind == ir::Kind::Tool)
         tools_[n.symbol] = &n;
     visit(module_.root);
     checkFeatures();
@@ -303,11 +291,11 @@ public:
 private:
   void visit(ir::Node &n) {
     for (ir::Node &c : n.children) {
-      if (c.kind == "workplan")
+      if (c.kind == ir::Kind::Workplan)
         visit(c);
-      else if (c.kind == "workingstep" || c.kind == "rapid_movement")
+      else if (c.kind == ir::Kind::Workingstep || c.kind == ir::Kind::RapidMovement)
         for (ir::Node &m : c.children)
-          if (m.kind == "moves")
+          if (m.kind == ir::Kind::Moves)
             verify(c, m);
     }
   }
@@ -336,7 +324,7 @@ private:
     Step s;
     s.exec = &exec;
     s.movesNode = &movesNode;
-    s.name = exec.kind + " " + exec.symbol;
+    s.name = exec.kindName() + " " + exec.symbol;
     s.op = operationOf(exec);
     s.secplane = movesNode.number("secplane").value_or(0.0);
     if (auto it = tools_.find(movesNode.text("tool").value_or("")); it != tools_.end())
@@ -362,7 +350,7 @@ private:
 
   /// The feature's shape and the tool's radius; why the step cannot be fully verified, or empty.
   std::string locate(Step &s) {
-    if (s.exec->kind == "rapid_movement")
+    if (s.exec->kind == ir::Kind::RapidMovement)
       return {};  // no feature: only the safety rules apply
     if (!s.feature)
       return "its feature " + s.exec->text("feature").value_or("?") + " is not a feature of the module";
@@ -381,7 +369,7 @@ private:
   double workpieceTolerance(const ir::Node *feature) const {
     std::optional<double> first;
     for (const ir::Node &wp : module_.root.children) {
-      if (wp.kind != "workpiece")
+      if (wp.kind != ir::Kind::Workpiece)
         continue;
       const std::optional<double> tol = wp.number("global_tolerance");
       if (feature && tol && std::any_of(wp.children.begin(), wp.children.end(),
@@ -404,7 +392,7 @@ private:
       offences.push_back(
           {first.node, "the first move starts from an unknown position: it must be a rapid ending "
                        "at or above the security plane z=" +
-                           mm(s.secplane) + ", not a " + first.node->kind + " to " + pointText(first.to)});
+                           mm(s.secplane) + ", not a " + first.node->kindName() + " to " + pointText(first.to)});
     if (s.movesNode->number("spindle").value_or(0.0) == 0)
       for (const Move &m : s.moves)
         if (m.isFeed()) {
@@ -413,7 +401,7 @@ private:
         }
     // A rapid movement's rapids are the file's own explicit path: where they
     // leave the rule they are reported as warnings, to be read, not refused.
-    const bool explicitRapids = s.exec->kind == "rapid_movement";
+    const bool explicitRapids = s.exec->kind == ir::Kind::RapidMovement;
     std::vector<Offence> rapids;
     // Bores this step has cut along the tool axis, by position: their lowest point.
     std::vector<std::pair<Vec2, double>> bores;
@@ -500,7 +488,7 @@ private:
       const double low = m.from ? std::min(m.from->z(), m.to.z()) : m.to.z();
       if (low < lowest - s.tol)
         offences.push_back(
-            {m.node, m.node->kind + " to " + pointText(m.to) + " goes below the floor of " + s.shape->symbol +
+            {m.node, m.node->kindName() + " to " + pointText(m.to) + " goes below the floor of " + s.shape->symbol +
                          ": z=" + mm(low) + ", lowest allowed z=" + mm(lowest) + " (bottom " +
                          mm(s.shape->bottom) + " + allowance_bottom " + mm(s.allowanceBottom) + ")"});
     }
@@ -521,8 +509,8 @@ private:
   void checkHole(Step &s) {
     const Vec2 axis = *s.shape->holeCentre;
     std::vector<Offence> offences;
-    const bool sized = isOneOf(
-        s.op->kind, {"drilling", "multistep_drilling", "reaming", "boring", "tapping", "thread_drilling"});
+    // Spot drills and countersinks are wider than the hole they chamfer.
+    const bool sized = !s.op->is(ir::Trait::Chamfers);
     if (sized && 2 * s.radius > s.shape->holeDiameter + s.tol)
       offences.push_back({s.exec, "tool " + s.tool->symbol + " of diameter " + mm(2 * s.radius) +
                                       " is wider than " + s.shape->symbol + " (diameter " +
@@ -532,7 +520,7 @@ private:
         continue;
       const double off = farthestFrom(m, axis);
       if (off > s.tol)
-        offences.push_back({m.node, m.node->kind + " to " + pointText(m.to) + " leaves the axis of " +
+        offences.push_back({m.node, m.node->kindName() + " to " + pointText(m.to) + " leaves the axis of " +
                                         s.shape->symbol + " below its top by " + mm(off)});
     }
     report(s, offences, "gouge errors");
@@ -646,7 +634,7 @@ private:
   // --- Uncut ----------------------------------------------------------------------------
 
   void checkUncut(Step &s, const std::vector<Cut> &cuts) {
-    const bool explicitPaths = s.op->kind == "freeform_operation";
+    const bool explicitPaths = s.op->kind == ir::Kind::FreeformOperation;
     const double targetArea = s.shape->target.area();
     std::optional<double> floorZ;
     for (const Cut &c : cuts)
@@ -747,7 +735,7 @@ private:
                                               " (" + formatFixed(100 * uncut / targetArea, 3) + " %) uncut");
     d.entity(feature->origin.entityId);
     for (const Floor &f : floors)
-      d.note(f.exec->origin.loc, "cut by " + f.exec->kind + " " + f.exec->symbol + " at z=" + mm(f.z));
+      d.note(f.exec->origin.loc, "cut by " + f.exec->kindName() + " " + f.exec->symbol + " at z=" + mm(f.z));
     ++stats_["uncut errors"];
   }
 

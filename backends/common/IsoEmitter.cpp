@@ -60,9 +60,9 @@ std::optional<std::string> IsoEmitter::run(const Program &p) {
     }
     if (s.cycle && d_.cycles.count(s.cycle->kind) && cycle(s, *s.cycle))
       continue;
-    if (s.operation == "tapping" || s.operation == "thread_drilling") {
+    if (s.taps()) {
       // Written as moves, a tap would be driven out without the spindle reversed.
-      diags_.error(s.exec->origin.loc, "workingstep " + s.exec->symbol + " (" + s.operation +
+      diags_.error(s.exec->origin.loc, "workingstep " + s.exec->symbol + " (" + s.operationName() +
                                            ") can only be written as the controller's tapping cycle, which " +
                                            (d_.cycles.count(CycleKind::Tap) ? "does not make its planned moves"
                                                                              : "is off (--no-cycles)"))
@@ -92,10 +92,10 @@ std::string IsoEmitter::spindle(double rpm) const {
   return word("S", formatNumber(std::abs(rpm), {d_.speedDecimals, false, false})) + (rpm < 0 ? " M3" : " M4");
 }
 
-std::string IsoEmitter::coolant(const std::string &kind) const {
-  if (kind == "flood" || kind == "through_tool")
+std::string IsoEmitter::coolant(const std::string &mode) const {
+  if (mode == "flood" || mode == "through_tool")
     return "M8";
-  if (kind == "mist")
+  if (mode == "mist")
     return "M7";
   return "M9";
 }

@@ -38,7 +38,7 @@ protected:
   /// "S.. M3" for a signed speed (negative: clockwise, M3).
   virtual std::string spindle(double rpm) const;
   /// "M8", "M7", "M9"...
-  virtual std::string coolant(const std::string &kind) const;
+  virtual std::string coolant(const std::string &mode) const;
   /// The word that makes an arc block turn `turns` more full turns (toolpath
   /// IR rule), or "" when the target has none (helixTurns false).
   virtual std::string turnsWord(int64_t turns) const = 0;

@@ -15,14 +15,17 @@ namespace {
 constexpr double kTwoPi = 2 * std::numbers::pi;
 constexpr double kSame = 1e-9;
 
-std::optional<CycleKind> cycleKindOf(std::string_view op) {
-  if (op == "drilling" || op == "center_drilling" || op == "counter_sinking")
+std::optional<CycleKind> cycleKindOf(std::optional<ir::Kind> op) {
+  if (!op)
+    return std::nullopt;
+  const ir::KindSpec &spec = ir::specOf(*op);
+  if (spec.is(ir::Trait::DrillCycle))
     return CycleKind::Drill;
-  if (op == "multistep_drilling")
+  if (spec.is(ir::Trait::PeckCycle))
     return CycleKind::Peck;
-  if (op == "reaming" || op == "boring")
+  if (spec.is(ir::Trait::BoreCycle))
     return CycleKind::Bore;
-  if (op == "tapping" || op == "thread_drilling")
+  if (spec.is(ir::Trait::TapCycle))
     return CycleKind::Tap;
   return std::nullopt;
 }
@@ -93,7 +96,7 @@ public:
     program_.name = module_.root.label.empty() ? module_.root.symbol : module_.root.label;
     program_.toolsFromTable = table_ != nullptr;
     for (const ir::Node &n : module_.root.children)
-      if (n.kind == "workpiece" && !program_.blank)
+      if (n.kind == ir::Kind::Workpiece && !program_.blank)
         blank(n);
     for (const ir::Node *e : passes::programOrder(module_))
       executable(*e);
@@ -104,7 +107,7 @@ public:
 
 private:
   void blank(const ir::Node &workpiece) {
-    const ir::Node *raw = workpiece.child("rawpiece");
+    const ir::Node *raw = workpiece.child(ir::Kind::Rawpiece);
     if (!raw || raw->text("shape") != "block" || !raw->has("size"))
       return;
     auto frame = passes::planeFrame(*raw);
@@ -120,7 +123,7 @@ private:
   }
 
   void executable(const ir::Node &e) {
-    if (e.kind == "display_message") {
+    if (e.kind == ir::Kind::DisplayMessage) {
       Step s;
       s.kind = Step::Kind::Message;
       s.exec = &e;
@@ -128,16 +131,16 @@ private:
       program_.steps.push_back(std::move(s));
       return;
     }
-    if (e.kind == "program_stop" || e.kind == "optional_stop") {
+    if (e.kind == ir::Kind::ProgramStop || e.kind == ir::Kind::OptionalStop) {
       Step s;
-      s.kind = e.kind == "program_stop" ? Step::Kind::Stop : Step::Kind::OptionalStop;
+      s.kind = e.kind == ir::Kind::ProgramStop ? Step::Kind::Stop : Step::Kind::OptionalStop;
       s.exec = &e;
       program_.steps.push_back(std::move(s));
       return;
     }
-    const ir::Node *moves = e.child("moves");
+    const ir::Node *moves = e.child(ir::Kind::Moves);
     if (!moves) {
-      diags_.error(e.origin.loc, e.kind + " " + e.symbol +
+      diags_.error(e.origin.loc, e.kindName() + " " + e.symbol +
                                      " has no moves to write: expand-strategies made none (its warning says "
                                      "why)")
           .entity(e.origin.entityId);
@@ -148,7 +151,7 @@ private:
     s.exec = &e;
     s.label = e.label.empty() ? e.symbol : e.label;
     for (const ir::Node &c : e.children)
-      if (const ir::KindSpec *k = ir::findKind(c.kind); k && k->category == "operation")
+      if (ir::isOperation(c.kind))
         s.operation = c.kind;
     s.tool = toolIndex(*moves);
     s.spindle = moves->number("spindle").value_or(0);
@@ -188,7 +191,7 @@ private:
       return it->second;
     const ir::Node *tool = nullptr;
     for (const ir::Node &n : module_.root.children)
-      if (n.kind == "tool" && n.symbol == symbol)
+      if (n.kind == ir::Kind::Tool && n.symbol == symbol)
         tool = &n;
     if (!tool)
       return -1;  // the IR verifier reports dangling references

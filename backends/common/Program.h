@@ -61,7 +61,11 @@ struct Step {
   enum class Kind { Moves, Message, Stop, OptionalStop } kind = Kind::Moves;
   const ir::Node *exec = nullptr;
   std::string label;    ///< the workingstep's id, or the message
-  std::string operation;  ///< the operation's kind ("drilling"), or empty
+  std::optional<ir::Kind> operation;  ///< the operation's kind, if the step has one
+  /// Its operation cuts a thread with a tap (a tapping cycle's family).
+  bool taps() const { return operation && ir::hasTraits(*operation, ir::Trait::TapCycle); }
+  /// The operation's name, for messages ("tapping").
+  std::string operationName() const { return operation ? std::string(ir::kindName(*operation)) : std::string(); }
   int tool = -1;          ///< index into Program::tools
   double spindle = 0;     ///< rev/min, negative clockwise (M3); 0 on a rapid movement: keep
   std::string coolant;    ///< off, flood, mist, through_tool

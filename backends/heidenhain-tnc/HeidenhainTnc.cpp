@@ -256,11 +256,11 @@ private:
 
   void step(const Program &p, const Step &s) {
     out_.block(trimmed("* - " + commentText(s.label)));
-    if (s.operation == "tapping" || s.operation == "thread_drilling") {
+    if (s.taps()) {
       // Plain moves would feed the tap out with the spindle still turning
       // forward: it would break. Cycle 207 is left out until its facts are
       // checked (README.md).
-      diags_.error(s.exec->origin.loc, "workingstep " + s.exec->symbol + " (" + s.operation + "): " + d_.name +
+      diags_.error(s.exec->origin.loc, "workingstep " + s.exec->symbol + " (" + s.operationName() + "): " + d_.name +
                                            " writes no tapping cycle (cycle 207's parameters are not among the "
                                            "checked dialect facts), and as plain moves the tap would be fed out "
                                            "with the spindle still turning forward and break")
@@ -290,10 +290,10 @@ private:
     flushM();
   }
 
-  static std::string coolantCode(const std::string &kind) {
-    if (kind == "flood" || kind == "through_tool")
+  static std::string coolantCode(const std::string &mode) {
+    if (mode == "flood" || mode == "through_tool")
       return "M8";
-    if (kind == "mist")
+    if (mode == "mist")
       return "M7";
     return "M9";
   }

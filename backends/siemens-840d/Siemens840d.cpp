@@ -86,7 +86,6 @@ std::string printable(const std::string &text, size_t most) {
 /// is not in the sources), and a longer text says no more at the machine.
 constexpr size_t kMaxMessage = 120;
 
-bool isTapping(const std::string &operation) { return operation == "tapping" || operation == "thread_drilling"; }
 
 /// A cycle call for a hole, or why the cycle would not make the planned moves.
 struct CycleCall {
@@ -190,7 +189,7 @@ private:
   bool tapsAsCycles(const Program &p) {
     bool ok = true;
     for (const Step &s : p.steps) {
-      if (s.kind != Step::Kind::Moves || !isTapping(s.operation))
+      if (s.kind != Step::Kind::Moves || !s.taps())
         continue;
       std::string why;
       if (!d_.cycles.count(CycleKind::Tap))
@@ -201,7 +200,7 @@ private:
         why = cycleCall(p, s, *s.cycle, d_).whyNot;
       if (why.empty())
         continue;
-      diags_.error(s.exec->origin.loc, "workingstep " + s.exec->symbol + " (" + s.operation +
+      diags_.error(s.exec->origin.loc, "workingstep " + s.exec->symbol + " (" + s.operationName() +
                                            ") cannot be written as CYCLE84: " + why +
                                            "; as plain moves the spindle would not reverse at the bottom")
           .entity(s.exec->origin.entityId);

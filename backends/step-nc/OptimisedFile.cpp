@@ -170,26 +170,26 @@ public:
     std::optional<Vec3> at;
     for (const Node &m : moves.children) {
       const Vec3 to = *m.vec("to");
-      const std::string role = m.text("role").value_or(m.kind == "rapid" ? "position" : "cut");
+      const std::string role = m.text("role").value_or(m.kind == ir::Kind::Rapid ? "position" : "cut");
       smooth = smooth || m.flag("smooth").value_or(false);
       if (!at) {
         // The first move takes the tool to the first point of the first
         // toolpath: lowering makes it again, from wherever the tool is.
-        if (m.kind != "rapid" || role != "position" || to.z() != moves.number("secplane").value_or(0)) {
+        if (m.kind != ir::Kind::Rapid || role != "position" || to.z() != moves.number("secplane").value_or(0)) {
           fail(m, "the first move is not a rapid to the security plane");
           return std::nullopt;
         }
         at = to;
         continue;
       }
-      const bool rapid = m.kind == "rapid";
+      const bool rapid = m.kind == ir::Kind::Rapid;
       const double feed = rapid ? 0 : m.number("feed").value_or(0);
       const std::string_view type = toolpathType(role, rapid);
       if (type.empty()) {
-        fail(m, "a " + m.kind + " move with role " + role + " has no ISO 14649 toolpath type");
+        fail(m, "a " + m.kindName() + " move with role " + role + " has no ISO 14649 toolpath type");
         return std::nullopt;
       }
-      if (m.kind == "arc") {
+      if (m.kind == ir::Kind::Arc) {
         flush();
         if (!arc(*at, m, type, feed))
           return std::nullopt;
@@ -231,7 +231,7 @@ private:
   void fail(const Node &move, const std::string &why) {
     diags_
         .error(ws_->origin.loc, "workingstep " + ws_->symbol + ": cannot write its toolpath as STEP-NC: " + why + " (" +
-                                    move.kind + " to " + Instances::reals(*move.vec("to")) + ")")
+                                    move.kindName() + " to " + Instances::reals(*move.vec("to")) + ")")
         .entity(ws_->origin.entityId);
     failed_ = true;
   }
@@ -327,7 +327,7 @@ private:
 
 const Node *operationOf(const Node &ws) {
   for (const Node &c : ws.children)
-    if (const ir::KindSpec *k = ir::findKind(c.kind); k && k->category == "operation")
+    if (ir::isOperation(c.kind))
       return &c;
   return nullptr;
 }
@@ -335,9 +335,9 @@ const Node *operationOf(const Node &ws) {
 /// Every machining workingstep with moves, in program order.
 void workingsteps(const Node &n, std::vector<const Node *> &out) {
   for (const Node &c : n.children)
-    if (c.kind == "workplan")
+    if (c.kind == ir::Kind::Workplan)
       workingsteps(c, out);
-    else if (c.kind == "workingstep" && c.child("moves"))
+    else if (c.kind == ir::Kind::Workingstep && c.child(ir::Kind::Moves))
       out.push_back(&c);
 }
 
@@ -430,9 +430,9 @@ std::string writeOptimisedPart21(const p21::Part21File &input, const ir::Module 
       ok = false;
       continue;
     }
-    const Node *tech = op->child("technology");
+    const Node *tech = op->child(ir::Kind::Technology);
     const std::string reference = tech && tech->text("feed_reference") == "ccp" ? "CCP" : "TCP";
-    if (auto list = writer.write(*ws, *ws->child("moves"), *frame.frame, reference))
+    if (auto list = writer.write(*ws, *ws->child(ir::Kind::Moves), *frame.frame, reference))
       toolpathOf[op->origin.entityId] = *list;
   }
   if (!ok || writer.failed())

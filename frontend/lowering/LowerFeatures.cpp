@@ -47,7 +47,7 @@ std::optional<std::string> Lowerer::feature(const Instance &f) {
   };
 
   if (f.isA("planar_face")) {
-    n.kind = "planar_face";
+    n.kind = ir::Kind::PlanarFace;
     commonPlacementAndDepth();
     Instance travel = f.ref("course_of_travel");
     if (travel && travel.isA("linear_path")) {
@@ -78,7 +78,7 @@ std::optional<std::string> Lowerer::feature(const Instance &f) {
     bosses = f.refs("its_boss");
   } else if (f.isA("closed_pocket") || f.isA("open_pocket")) {
     const bool closed = f.isA("closed_pocket");
-    n.kind = closed ? "closed_pocket" : "open_pocket";
+    n.kind = closed ? ir::Kind::ClosedPocket : ir::Kind::OpenPocket;
     commonPlacementAndDepth();
     copyReal(n, "slope", f, "slope", Value::angle);
     Instance bottom = f.ref("bottom_condition");
@@ -104,7 +104,7 @@ std::optional<std::string> Lowerer::feature(const Instance &f) {
       addProfile("wall_boundary", false);
     bosses = f.refs("its_boss");
   } else if (f.isA("round_hole")) {
-    n.kind = "round_hole";
+    n.kind = ir::Kind::RoundHole;
     commonPlacementAndDepth();
     if (auto d = toleranced(f, "diameter"))
       n.set("diameter", Value::length(*d));
@@ -146,7 +146,7 @@ std::optional<std::string> Lowerer::feature(const Instance &f) {
       missing(f, "bottom_condition");
     }
   } else if (f.isA("slot")) {
-    n.kind = "slot";
+    n.kind = ir::Kind::Slot;
     commonPlacementAndDepth();
     std::vector<Instance> ends = f.refs("end_conditions");
     for (size_t i = 0; i < 2; ++i) {
@@ -171,18 +171,18 @@ std::optional<std::string> Lowerer::feature(const Instance &f) {
     addPath("course_of_travel", true);
     addProfile("swept_shape", true);
   } else if (f.isA("step")) {
-    n.kind = "step";
+    n.kind = ir::Kind::Step;
     commonPlacementAndDepth();
     addPath("open_boundary", true);
     addProfile("wall_boundary", false);
     bosses = f.refs("its_boss");
   } else if (f.isA("general_outside_profile")) {
-    n.kind = "general_outside_profile";
+    n.kind = ir::Kind::GeneralOutsideProfile;
     commonPlacementAndDepth();
     addPath("profile_swept_shape", false);
     addProfile("feature_boundary", true);
   } else if (f.isA("boss")) {
-    n.kind = "boss";
+    n.kind = ir::Kind::Boss;
     commonPlacementAndDepth();
     copyReal(n, "slope", f, "slope", Value::angle);
     addProfile("its_boundary", true);
@@ -191,7 +191,7 @@ std::optional<std::string> Lowerer::feature(const Instance &f) {
     return std::nullopt;
   }
   stamp(n, f);
-  n.symbol = symbolFor('%', f.string("its_id"), n.kind);
+  n.symbol = symbolFor('%', f.string("its_id"), n.kindName());
   lowered_[f.index()] = n.symbol;
   // Bosses are features of their own; the pocket, face or step refers to them
   // as islands, the material its machining must leave.
@@ -201,7 +201,7 @@ std::optional<std::string> Lowerer::feature(const Instance &f) {
       continue;
     }
     if (auto sym = feature(b)) {
-      Node island("island");
+      Node island(ir::Kind::Island);
       stamp(island, b, "");
       island.set("feature", Value::ref(*sym));
       n.add(std::move(island));

@@ -132,38 +132,38 @@ std::optional<Node> Lowerer::profile(const Instance &p) {
   };
   Node n;
   if (p.isA("rectangular_closed_profile")) {
-    n.kind = "rectangular_profile";
+    n.kind = ir::Kind::RectangularProfile;
     length(n, "width", "profile_width", true);
     length(n, "length", "profile_length", true);
     withPlacement(n);
   } else if (p.isA("circular_closed_profile")) {
-    n.kind = "circular_profile";
+    n.kind = ir::Kind::CircularProfile;
     length(n, "diameter", "diameter", true);
     withPlacement(n);
   } else if (p.isA("linear_profile")) {
-    n.kind = "linear_profile";
+    n.kind = ir::Kind::LinearProfile;
     length(n, "length", "profile_length", true);
   } else if (p.isA("square_u_profile")) {
-    n.kind = "square_u_profile";
+    n.kind = ir::Kind::SquareUProfile;
     length(n, "width", "width", true);
     length(n, "first_radius", "first_radius", false);
     angle(n, "first_angle", "first_angle", false);
     length(n, "second_radius", "second_radius", false);
     angle(n, "second_angle", "second_angle", false);
   } else if (p.isA("rounded_u_profile")) {
-    n.kind = "rounded_u_profile";
+    n.kind = ir::Kind::RoundedUProfile;
     length(n, "width", "width", true);
   } else if (p.isA("vee_profile")) {
-    n.kind = "vee_profile";
+    n.kind = ir::Kind::VeeProfile;
     length(n, "profile_radius", "profile_radius", false);
     angle(n, "profile_angle", "profile_angle", true);
     angle(n, "tilt_angle", "tilt_angle", true);
   } else if (p.isA("partial_circular_profile")) {
-    n.kind = "partial_circular_profile";
+    n.kind = ir::Kind::PartialCircularProfile;
     length(n, "radius", "radius", true);
     angle(n, "sweep_angle", "sweep_angle", true);
   } else if (p.isA("general_closed_profile") || p.isA("general_profile")) {
-    n.kind = "general_profile";
+    n.kind = ir::Kind::GeneralProfile;
     const bool closed = p.isA("general_closed_profile");
     n.set("closed", Value::boolean(closed));
     if (auto c = curve(p.ref(closed ? "closed_profile_shape" : "its_profile")))
@@ -181,14 +181,14 @@ std::optional<Node> Lowerer::profile(const Instance &p) {
 std::optional<Node> Lowerer::path(const Instance &t) {
   if (!t)
     return std::nullopt;
-  Node n("path");
+  Node n(ir::Kind::Path);
   stamp(n, t, "");
   Placement pl;
   if (Instance a = t.ref("placement"))
     if (auto p = placement(a))
       pl = *p;
   if (t.isA("linear_path")) {
-    Node line("line");
+    Node line(ir::Kind::Line);
     stamp(line, t, "");
     line.set("at", Value::point(pl.at));
     if (auto d = direction(t.ref("its_direction")))
@@ -218,16 +218,16 @@ std::optional<Node> Lowerer::curve(const Instance &c) {
     return std::nullopt;
   Node n;
   if (c.isA("polyline")) {
-    n.kind = "polyline";
+    n.kind = ir::Kind::Polyline;
     for (const Instance &p : c.refs("points"))
       if (auto v = point(p)) {
-        Node pt("point");
+        Node pt(ir::Kind::Point);
         stamp(pt, p, "");
         pt.set("at", Value::point(*v));
         n.add(std::move(pt));
       }
   } else if (c.isA("line")) {
-    n.kind = "line";
+    n.kind = ir::Kind::Line;
     if (auto at = point(c.ref("pnt")))
       n.set("at", Value::point(*at));
     else
@@ -241,7 +241,7 @@ std::optional<Node> Lowerer::curve(const Instance &c) {
       missing(c, "dir");
     }
   } else if (c.isA("circle") || c.isA("helix")) {
-    n.kind = c.isA("circle") ? "circle" : "helix";
+    n.kind = c.isA("circle") ? ir::Kind::Circle : ir::Kind::Helix;
     if (auto p = placement(c.ref("position")))
       setPlacement(n, *p);
     else
@@ -250,14 +250,14 @@ std::optional<Node> Lowerer::curve(const Instance &c) {
       n.set("radius", Value::length(*r));
     else
       missing(c, "radius");
-    if (n.kind == "helix") {
+    if (n.kind == ir::Kind::Helix) {
       if (auto pitch = c.real("pitch"))
         n.set("pitch", Value::length(*pitch));
       else
         missing(c, "pitch");
     }
   } else if (c.isA("trimmed_curve")) {
-    n.kind = "trimmed_curve";
+    n.kind = ir::Kind::TrimmedCurve;
     // Each trim is a point and/or a parameter; keep what is given.
     for (std::string_view which : {"trim_1", "trim_2"}) {
       const std::string side = which == "trim_1" ? "from" : "to";
@@ -282,9 +282,9 @@ std::optional<Node> Lowerer::curve(const Instance &c) {
     else
       missing(c, "basis_curve");
   } else if (c.isA("composite_curve")) {
-    n.kind = "composite_curve";
+    n.kind = ir::Kind::CompositeCurve;
     for (const Instance &s : c.refs("segments")) {
-      Node seg("segment");
+      Node seg(ir::Kind::Segment);
       stamp(seg, s, "");
       seg.set("transition", Value::word(s.enumeration("transition").value_or("continuous")));
       seg.set("same_sense", Value::boolean(s.boolean("same_sense").value_or(true)));
@@ -295,7 +295,7 @@ std::optional<Node> Lowerer::curve(const Instance &c) {
       n.add(std::move(seg));
     }
   } else if (c.isA("b_spline_curve")) {
-    n.kind = "b_spline_curve";
+    n.kind = ir::Kind::BSplineCurve;
     if (auto degree = c.integer("degree"))
       n.set("degree", Value::integer(*degree));
     else
@@ -313,7 +313,7 @@ std::optional<Node> Lowerer::curve(const Instance &c) {
       missing(c, "weights_data", "must have one weight per control point");
     for (size_t i = 0; i < points.size(); ++i)
       if (auto v = point(points[i])) {
-        Node pt("point");
+        Node pt(ir::Kind::Point);
         stamp(pt, points[i], "");
         pt.set("at", Value::point(*v));
         if (i < weights.size() && weights.size() == points.size())
@@ -326,7 +326,7 @@ std::optional<Node> Lowerer::curve(const Instance &c) {
       if (knots.size() != multiplicities.size())
         missing(c, "knot_multiplicities", "must have one multiplicity per knot");
       for (size_t i = 0; i < knots.size() && i < multiplicities.size(); ++i) {
-        Node k("knot");
+        Node k(ir::Kind::Knot);
         k.set("value", Value::ratio(knots[i]));
         k.set("multiplicity", Value::integer(static_cast<int64_t>(multiplicities[i])));
         n.add(std::move(k));

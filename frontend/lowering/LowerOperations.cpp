@@ -12,13 +12,24 @@ namespace stepnc::lowering {
 
 namespace {
 
-// ARM entity -> IR operation kind. Order matters only for readability: each
-// entity is concrete, so exactly one matches.
-constexpr std::string_view kOperations[] = {
-    "plane_rough_milling", "plane_finish_milling", "bottom_and_side_rough_milling",
-    "bottom_and_side_finish_milling", "side_rough_milling", "side_finish_milling", "freeform_operation",
-    "drilling", "center_drilling", "counter_sinking", "multistep_drilling", "reaming", "boring", "tapping",
-    "thread_drilling"};
+// ARM entity -> IR operation kind (the IR keeps the ARM's names). Order
+// matters only for readability: each entity is concrete, so exactly one matches.
+constexpr std::pair<std::string_view, ir::Kind> kOperations[] = {
+    {"plane_rough_milling", ir::Kind::PlaneRoughMilling},
+    {"plane_finish_milling", ir::Kind::PlaneFinishMilling},
+    {"bottom_and_side_rough_milling", ir::Kind::BottomAndSideRoughMilling},
+    {"bottom_and_side_finish_milling", ir::Kind::BottomAndSideFinishMilling},
+    {"side_rough_milling", ir::Kind::SideRoughMilling},
+    {"side_finish_milling", ir::Kind::SideFinishMilling},
+    {"freeform_operation", ir::Kind::FreeformOperation},
+    {"drilling", ir::Kind::Drilling},
+    {"center_drilling", ir::Kind::CenterDrilling},
+    {"counter_sinking", ir::Kind::CounterSinking},
+    {"multistep_drilling", ir::Kind::MultistepDrilling},
+    {"reaming", ir::Kind::Reaming},
+    {"boring", ir::Kind::Boring},
+    {"tapping", ir::Kind::Tapping},
+    {"thread_drilling", ir::Kind::ThreadDrilling}};
 
 // ARM tool body entity -> IR tool type; most specific first.
 constexpr std::pair<std::string_view, std::string_view> kToolBodies[] = {
@@ -49,7 +60,7 @@ std::optional<std::string> Lowerer::tool(const Instance &t) {
     unsupported(t, "tool");
     return std::nullopt;
   }
-  Node n("tool");
+  Node n(ir::Kind::Tool);
   stamp(n, t);
   n.symbol = symbolFor('%', t.string("its_id"), "tool");
   Instance body = t.ref("its_tool_body");
@@ -132,7 +143,7 @@ void commonStrategyAttributes(Lowerer &l, Node &s, const Instance &strategy) {
 std::optional<Node> millingStrategy(Lowerer &l, const Instance &strategy) {
   const bool trochoidal = strategy.isA("trochoidal_milling");
   if (trochoidal || strategy.isA("plunge_milling")) {
-    Node p(trochoidal ? "trochoidal_strategy" : "plunge_strategy");
+    Node p(trochoidal ? ir::Kind::TrochoidalStrategy : ir::Kind::PlungeStrategy);
     l.stamp(p, strategy, "");
     commonStrategyAttributes(l, p, strategy);
     if (trochoidal) {
@@ -177,7 +188,7 @@ std::optional<Node> millingStrategy(Lowerer &l, const Instance &strategy) {
     l.unsupported(strategy, "machining strategy");
     return std::nullopt;
   }
-  Node s("strategy");
+  Node s(ir::Kind::Strategy);
   l.stamp(s, strategy, "");
   s.set("type", Value::word(std::string(type)));
   commonStrategyAttributes(l, s, strategy);
@@ -197,7 +208,7 @@ std::optional<Node> millingStrategy(Lowerer &l, const Instance &strategy) {
 }
 
 Node technology(Lowerer &l, const Instance &tech) {
-  Node n("technology");
+  Node n(ir::Kind::Technology);
   if (auto f = tech.real("feedrate")) {
     const double feed = l.feedMmPerMin(*f);
     n.set("feed", Value::feed(feed));
@@ -220,7 +231,7 @@ Node technology(Lowerer &l, const Instance &tech) {
 }
 
 Node machineFunctions(const Instance &mf) {
-  Node n("machine_functions");
+  Node n(ir::Kind::MachineFunctions);
   for (std::string_view flag : {"coolant", "mist", "through_spindle_coolant", "chip_removal"})
     copyFlag(n, flag, mf, flag);
   copyReal(n, "coolant_pressure", mf, "coolant_pressure", Value::ratio);
@@ -231,16 +242,17 @@ Node machineFunctions(const Instance &mf) {
 } // namespace
 
 std::optional<Node> Lowerer::operation(const Instance &op) {
-  Node n;
-  for (std::string_view kind : kOperations)
-    if (op.isA(kind)) {
-      n.kind = std::string(kind);
+  std::optional<ir::Kind> kind;
+  for (auto [entity, k] : kOperations)
+    if (op.isA(entity)) {
+      kind = k;
       break;
     }
-  if (n.kind.empty()) {
+  if (!kind) {
     unsupported(op, "operation");
     return std::nullopt;
   }
+  Node n(*kind);
   stamp(n, op);
   if (auto sym = tool(op.ref("its_tool")))
     n.set("tool", Value::ref(*sym));
@@ -284,7 +296,7 @@ std::optional<Node> Lowerer::operation(const Instance &op) {
     n.add(machineFunctions(mf));
   if (Instance strategy = op.ref("its_machining_strategy")) {
     if (strategy.isA("drilling_type_strategy")) {
-      Node d("drilling_strategy");
+      Node d(ir::Kind::DrillingStrategy);
       stamp(d, strategy, "");
       for (std::string_view ratio :
            {"reduced_cut_at_start", "reduced_feed_at_start", "reduced_cut_at_end", "reduced_feed_at_end"})
@@ -296,11 +308,11 @@ std::optional<Node> Lowerer::operation(const Instance &op) {
       n.add(std::move(*lowered));
     }
   }
-  for (std::string_view which : {"approach", "retract"}) {
+  for (auto [which, kind] : {std::pair{"approach", ir::Kind::Approach}, {"retract", ir::Kind::Retract}}) {
     Instance ar = op.ref(which);
     if (!ar)
       continue;
-    Node a{std::string(which)};
+    Node a{kind};
     stamp(a, ar, "");
     std::string_view type;
     for (std::string_view t : {"plunge_toolaxis", "plunge_ramp", "plunge_helix", "plunge_zigzag", "along_path"})
@@ -334,7 +346,7 @@ void Lowerer::toolpaths(const Instance &list, Node &parent) {
       unsupported(tp, "toolpath");
       continue;
     }
-    Node n("toolpath");
+    Node n(ir::Kind::Toolpath);
     stamp(n, tp, "");
     n.set("role", Value::word(tp.enumeration("its_type").value_or("trajectory_path")));
     n.set("required", Value::boolean(tp.boolean("its_priority").value_or(true)));

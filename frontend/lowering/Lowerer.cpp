@@ -85,7 +85,7 @@ std::optional<std::string> Lowerer::workpiece(const Instance &wp) {
     return std::nullopt;
   if (auto it = lowered_.find(wp.index()); it != lowered_.end())
     return it->second;
-  Node node("workpiece");
+  Node node(ir::Kind::Workpiece);
   stamp(node, wp);
   node.symbol = symbolFor('%', wp.string("its_id"), "workpiece");
   if (Instance material = wp.ref("its_material")) {
@@ -103,7 +103,7 @@ std::optional<std::string> Lowerer::workpiece(const Instance &wp) {
       bounding = raw.ref("its_bounding_geometry");
   if (bounding) {
     if (bounding.isA("block")) {
-      Node raw("rawpiece");
+      Node raw(ir::Kind::Rawpiece);
       stamp(raw, bounding, "");
       raw.set("shape", Value::word("block"));
       auto x = bounding.real("x"), y = bounding.real("y"), z = bounding.real("z");
@@ -120,7 +120,7 @@ std::optional<std::string> Lowerer::workpiece(const Instance &wp) {
   }
   for (const Instance &clamp : wp.refs("clamping_positions"))
     if (auto p = point(clamp)) {
-      Node c("clamp");
+      Node c(ir::Kind::Clamp);
       stamp(c, clamp, "");
       c.set("at", Value::point(*p));
       node.add(std::move(c));
@@ -136,7 +136,7 @@ std::optional<std::string> Lowerer::setup(const Instance &s) {
     return std::nullopt;
   if (auto it = lowered_.find(s.index()); it != lowered_.end())
     return it->second;
-  Node node("setup");
+  Node node(ir::Kind::Setup);
   stamp(node, s);
   node.symbol = symbolFor('%', s.string("its_id"), "setup");
   Placement origin;
@@ -147,7 +147,7 @@ std::optional<std::string> Lowerer::setup(const Instance &s) {
   if (auto h = planeHeight(s, "its_secplane", "security plane"))
     node.set("secplane", Value::length(*h));
   for (const Instance &ws : s.refs("its_workpiece_setup")) {
-    Node w("workpiece_setup");
+    Node w(ir::Kind::WorkpieceSetup);
     stamp(w, ws, "");
     if (auto wp = workpiece(ws.ref("its_workpiece")))
       w.set("workpiece", Value::ref(*wp));
@@ -168,7 +168,7 @@ std::optional<std::string> Lowerer::setup(const Instance &s) {
 // --- executables -------------------------------------------------------------
 
 std::optional<Node> Lowerer::workingstep(const Instance &ws) {
-  Node node("workingstep");
+  Node node(ir::Kind::Workingstep);
   stamp(node, ws);
   node.symbol = symbolFor('@', ws.string("its_id"), "ws");
   if (auto f = feature(ws.ref("its_feature")))
@@ -191,7 +191,7 @@ std::optional<Node> Lowerer::workplan(const Instance &wp) {
     diags_.error(wp.loc(), "workplan " + hashId(wp.id()) + " contains itself").entity(wp.id(), "WORKPLAN");
     return std::nullopt;
   }
-  Node node("workplan");
+  Node node(ir::Kind::Workplan);
   stamp(node, wp);
   node.symbol = symbolFor('@', wp.string("its_id"), "workplan");
   if (Instance s = wp.ref("its_setup"))
@@ -214,15 +214,15 @@ bool Lowerer::executable(const Instance &exe, Node &parent) {
       parent.add(std::move(*wp));
     return true;
   }
-  for (std::string_view simple : {"program_stop", "optional_stop"})
-    if (exe.isA(simple)) {
-      Node n{std::string(simple)};
+  for (auto [entity, kind] : {std::pair{"program_stop", ir::Kind::ProgramStop}, {"optional_stop", ir::Kind::OptionalStop}})
+    if (exe.isA(entity)) {
+      Node n{kind};
       stamp(n, exe);
       parent.add(std::move(n));
       return true;
     }
   if (exe.isA("rapid_movement")) {
-    Node n("rapid_movement");
+    Node n(ir::Kind::RapidMovement);
     stamp(n, exe);
     n.symbol = symbolFor('@', exe.string("its_id"), "rapid");
     if (auto h = planeHeight(exe, "its_secplane", "security plane"))
@@ -233,7 +233,7 @@ bool Lowerer::executable(const Instance &exe, Node &parent) {
     return true;
   }
   if (exe.isA("display_message")) {
-    Node n("display_message");
+    Node n(ir::Kind::DisplayMessage);
     stamp(n, exe);
     n.set("message", Value::string(exe.string("its_text").value_or("")));
     parent.add(std::move(n));
@@ -273,7 +273,7 @@ std::unique_ptr<ir::Module> Lowerer::run() {
   std::optional<Node> plan = workplan(main);
   // Resources first, in a fixed order: workpieces, tools, setups; then the plan.
   std::vector<Node> ordered;
-  for (std::string_view kind : {"workpiece", "tool", "setup"})
+  for (ir::Kind kind : {ir::Kind::Workpiece, ir::Kind::Tool, ir::Kind::Setup})
     for (Node &c : module_->root.children)
       if (c.kind == kind)
         ordered.push_back(std::move(c));

@@ -34,7 +34,7 @@ struct SimCommandOptions {
 };
 
 std::string label(const ir::Node &e) {
-  std::string s = e.kind + " " + e.symbol;
+  std::string s = e.kindName() + " " + e.symbol;
   if (!e.label.empty())
     s += " \"" + e.label + "\"";
   return s;
@@ -69,8 +69,8 @@ int runSim(const SimCommandOptions &opts) {
     // Whatever the input lacks is made: moves, then the motion.
     bool hasMoves = false, hasMotion = false;
     for (const ir::Node *e : passes::programOrder(*module)) {
-      hasMoves |= e->child("moves") != nullptr;
-      hasMotion |= e->child("motion") != nullptr;
+      hasMoves |= e->child(ir::Kind::Moves) != nullptr;
+      hasMotion |= e->child(ir::Kind::Motion) != nullptr;
     }
     std::string pipeline;
     if (!hasMoves) {

@@ -136,12 +136,12 @@ TEST_CASE("tool tables: entries by id or symbol, errors at line and column", "[b
   DiagnosticEngine diags(collector);
   auto table = ToolTable::parse(*file, diags);
   REQUIRE(table);
-  ir::Node t2("tool");
+  ir::Node t2(ir::Kind::Tool);
   t2.symbol = "%t2";
   t2.label = "T2 ENDMILL";
-  ir::Node t3("tool");
+  ir::Node t3(ir::Kind::Tool);
   t3.symbol = "%t3";
-  ir::Node t4("tool");
+  ir::Node t4(ir::Kind::Tool);
   t4.symbol = "%t4";
   REQUIRE(table->find(t2));
   CHECK(table->find(t2)->number == 12);

@@ -9,8 +9,8 @@ namespace stepnc::ir::test {
 
 namespace {
 
-Node node(std::string kind, std::string symbol = {}, std::string label = {}) {
-  Node n(std::move(kind));
+Node node(Kind kind, std::string symbol = {}, std::string label = {}) {
+  Node n(kind);
   n.symbol = std::move(symbol);
   n.label = std::move(label);
   return n;
@@ -24,21 +24,21 @@ Node &place(Node &n, const Vec3 &at) {
 }
 
 Node workpiece() {
-  Node wp = node("workpiece", "%simple_workpiece", "SIMPLE WORKPIECE");
+  Node wp = node(Kind::Workpiece, "%simple_workpiece", "SIMPLE WORKPIECE");
   wp.set("material", Value::string("ST-50 \\ STEEL")).set("global_tolerance", Value::length(0.01));
 
-  Node &raw = wp.add(node("rawpiece"));
+  Node &raw = wp.add(node(Kind::Rawpiece));
   raw.set("shape", Value::word("block")).set("size", Value::point(Vec3(110, 110, 80)));
   place(raw, Vec3(-5, -5, -5));
 
-  Node &pocket = wp.add(node("closed_pocket", "%pocket1", "POCKET1"));
+  Node &pocket = wp.add(node(Kind::ClosedPocket, "%pocket1", "POCKET1"));
   place(pocket, Vec3(50, 50, 0));
   pocket.set("depth", Value::length(15))
       .set("bottom", Value::word("planar"))
       .set("orthogonal_radius", Value::length(10));
-  pocket.add(node("rectangular_profile")).set("width", Value::length(60)).set("length", Value::length(40));
+  pocket.add(node(Kind::RectangularProfile)).set("width", Value::length(60)).set("length", Value::length(40));
 
-  Node &hole = wp.add(node("round_hole", "%hole1", "HOLE1"));
+  Node &hole = wp.add(node(Kind::RoundHole, "%hole1", "HOLE1"));
   place(hole, Vec3(20, 20, 0));
   hole.set("depth", Value::length(12.5))
       .set("diameter", Value::length(10))
@@ -48,44 +48,44 @@ Node workpiece() {
 }
 
 Node millingWorkingstep() {
-  Node ws = node("workingstep", "@ws_rough_pocket1", "ROUGH POCKET1");
+  Node ws = node(Kind::Workingstep, "@ws_rough_pocket1", "ROUGH POCKET1");
   ws.set("feature", Value::ref("%pocket1")).set("secplane", Value::length(20));
-  Node &op = ws.add(node("bottom_and_side_rough_milling", {}, "ROUGH POCKET1"));
+  Node &op = ws.add(node(Kind::BottomAndSideRoughMilling, {}, "ROUGH POCKET1"));
   op.set("tool", Value::ref("%mill_18mm"))
       .set("retract_plane", Value::length(20))
       .set("axial_depth", Value::length(6.5))
       .set("radial_depth", Value::length(5))
       .set("allowance_side", Value::length(1))
       .set("allowance_bottom", Value::length(0.5));
-  op.add(node("technology"))
+  op.add(node(Kind::Technology))
       .set("feed", Value::feed(2400))
       .set("spindle", Value::spindle(-720))
       .set("feed_reference", Value::word("tcp"));
-  op.add(node("machine_functions")).set("coolant", Value::boolean(true));
-  Node &strategy = op.add(node("strategy"));
+  op.add(node(Kind::MachineFunctions)).set("coolant", Value::boolean(true));
+  Node &strategy = op.add(node(Kind::Strategy));
   strategy.set("type", Value::word("contour_parallel"))
       .set("overlap", Value::ratio(0.05))
       .set("rotation", Value::word("cw"))
       .set("cutmode", Value::word("conventional"));
   strategy.comment = "overlap from the tool";
-  op.add(node("approach")).set("type", Value::word("plunge_toolaxis"));
+  op.add(node(Kind::Approach)).set("type", Value::word("plunge_toolaxis"));
   return ws;
 }
 
 Node drillingWorkingstep() {
-  Node ws = node("workingstep", "@ws_drill_hole1", "DRILL HOLE1");
+  Node ws = node(Kind::Workingstep, "@ws_drill_hole1", "DRILL HOLE1");
   ws.set("feature", Value::ref("%hole1")).set("secplane", Value::length(20));
-  Node &op = ws.add(node("drilling", {}, "DRILL HOLE1"));
+  Node &op = ws.add(node(Kind::Drilling, {}, "DRILL HOLE1"));
   op.set("tool", Value::ref("%drill_10mm"))
       .set("retract_plane", Value::length(20))
       .set("cutting_depth", Value::length(12.5))
       .set("dwell_bottom", Value::time(1.5))
       .set("feed_on_retract", Value::ratio(1));
-  op.add(node("technology"))
+  op.add(node(Kind::Technology))
       .set("feed", Value::feed(300))
       .set("spindle", Value::spindle(-1200))
       .set("feed_reference", Value::word("tcp"));
-  op.add(node("drilling_strategy"))
+  op.add(node(Kind::DrillingStrategy))
       .set("reduced_cut_at_start", Value::ratio(0.5))
       .set("reduced_feed_at_start", Value::ratio(0.5))
       .set("depth_of_start", Value::length(2));
@@ -95,7 +95,7 @@ Node drillingWorkingstep() {
 void collect(Node &n, std::string_view symbolOrKind, Node *&found) {
   if (found)
     return;
-  if (n.symbol == symbolOrKind || n.kind == symbolOrKind) {
+  if (n.symbol == symbolOrKind || n.kindName() == symbolOrKind) {
     found = &n;
     return;
   }
@@ -109,22 +109,22 @@ Module sampleModule() {
   Module m;
   m.root.label = "EXECUTE \"EXAMPLE1\" Fräsen";
   m.root.add(workpiece());
-  m.root.add(node("tool", "%mill_18mm", "MILL 18MM"))
+  m.root.add(node(Kind::Tool, "%mill_18mm", "MILL 18MM"))
       .set("type", Value::word("endmill"))
       .set("diameter", Value::length(18))
       .set("corner_radius", Value::length(0))
       .set("flutes", Value::integer(4))
       .set("hand", Value::word("right"));
-  m.root.add(node("tool", "%drill_10mm", "DRILL 10MM"))
+  m.root.add(node(Kind::Tool, "%drill_10mm", "DRILL 10MM"))
       .set("type", Value::word("twist_drill"))
       .set("diameter", Value::length(10))
       .set("tip_half_angle", Value::angle(59));
-  Node &setup = m.root.add(node("setup", "%setup1", "SETUP1"));
+  Node &setup = m.root.add(node(Kind::Setup, "%setup1", "SETUP1"));
   place(setup, Vec3(0, 0, 0)).set("secplane", Value::length(20));
-  Node &wpSetup = setup.add(node("workpiece_setup"));
+  Node &wpSetup = setup.add(node(Kind::WorkpieceSetup));
   wpSetup.set("workpiece", Value::ref("%simple_workpiece"));
   place(wpSetup, Vec3(-0.0, 0, -0.0));
-  Node &plan = m.root.add(node("workplan", "@main_workplan", "MAIN WORKPLAN"));
+  Node &plan = m.root.add(node(Kind::Workplan, "@main_workplan", "MAIN WORKPLAN"));
   plan.set("setup", Value::ref("%setup1"));
   plan.add(millingWorkingstep());
   plan.add(drillingWorkingstep());

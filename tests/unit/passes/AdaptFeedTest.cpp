@@ -35,7 +35,7 @@ ir::test::Parsed parsed() {
 std::vector<double> feeds(const Node &moves) {
   std::vector<double> out;
   for (const Node &n : moves.children)
-    if (n.kind != "rapid")
+    if (n.kind != ir::Kind::Rapid)
       out.push_back(*n.number("feed"));
   return out;
 }
@@ -47,7 +47,7 @@ TEST_CASE("adapt-feed: a straight slot gets fz = h*", "[adapt-feed]") {
   // Programmed 0.2 mm per tooth: 0.2 x 4 x 3000 = 2400 mm/min. Slotting 5 deep.
   test::addStraightCut(*p.module, Vec3(-10, 25, -5), Vec3(110, 25, -5), 2400);
   REQUIRE(test::runPipeline(*p.module, "adapt-feed"));
-  const std::vector<double> f = feeds(*ir::test::find(p.module->root, "@ws").child("moves"));
+  const std::vector<double> f = feeds(*ir::test::find(p.module->root, "@ws").child(ir::Kind::Moves));
   // The plunge outside the block is kept; the slot in full engagement gets
   // h* x flutes x rev/min = 0.10 x 4 x 3000 = 1200 mm/min; where the tool
   // enters and leaves the block it is engaged less, so the pieces there are
@@ -70,13 +70,13 @@ TEST_CASE("adapt-feed: a wall at constant radial depth gets the chip-thinning fe
     const double y = 50 + 5 - ae;
     test::addStraightCut(*p.module, Vec3(-10, y, -5), Vec3(110, y, -5), 12000);
     REQUIRE(test::runPipeline(*p.module, "adapt-feed"));
-    const std::vector<double> f = feeds(*ir::test::find(p.module->root, "@ws").child("moves"));
+    const std::vector<double> f = feeds(*ir::test::find(p.module->root, "@ws").child(ir::Kind::Moves));
     // fz = h* / sin(phi_e), phi_e = acos(1 - ae / R) (REFERENCES: chip thinning).
     const double expected = 0.10 / std::sin(std::acos(1 - ae / 5)) * 4 * 3000;
     // The piece along the middle of the wall (the ends, where the tool enters
     // and leaves the block, take less).
     double middle = 0;
-    for (const Move &m : walkMoves(*ir::test::find(p.module->root, "@ws").child("moves")))
+    for (const Move &m : walkMoves(*ir::test::find(p.module->root, "@ws").child(ir::Kind::Moves)))
       if (m.isFeed() && m.from && !m.changesHeight() && m.from->x() < 50 && m.to.x() > 50)
         middle = m.feed;
     INFO("ae " << ae << " feeds " << f.size());
@@ -91,12 +91,12 @@ TEST_CASE("adapt-feed: pocket corners get lower feeds than the walls", "[adapt-f
   // Contour-parallel roughing of the 40 x 30 pocket, 3 mm stepover at one level.
   Node &op = ir::test::find(p.module->root, "bottom_and_side_rough_milling");
   op.set("axial_depth", Value::length(10)).set("radial_depth", Value::length(3));
-  Node &tech = op.add(Node("technology"));
+  Node &tech = op.add(Node(ir::Kind::Technology));
   tech.set("feed", Value::feed(12000)).set("spindle", Value::spindle(-3000));
-  op.add(Node("strategy")).set("type", Value::word("contour_parallel"));
+  op.add(Node(ir::Kind::Strategy)).set("type", Value::word("contour_parallel"));
   std::vector<std::string> errors;
   REQUIRE(test::runPipeline(*p.module, "expand-strategies,adapt-feed,verify-toolpaths", &errors));
-  const Node &moves = *ir::test::find(p.module->root, "@ws").child("moves");
+  const Node &moves = *ir::test::find(p.module->root, "@ws").child(ir::Kind::Moves);
   // The outermost ring at the floor: the tool centre runs round [35, 65] x
   // [15, 35]. Along the middles of its sides the tool takes the 3 mm left by
   // the ring inside it; coming into a corner it meets the side ahead too, so

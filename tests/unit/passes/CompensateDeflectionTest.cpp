@@ -71,7 +71,7 @@ TEST_CASE("compensate-deflection: a wall at constant radial depth is offset by t
   // The piece along the middle of the wall: moved towards the material (-y)
   // by the fixed point, within what a cell of the stock does to ae; its
   // predicted end on the nominal line.
-  const Node &moves = *ir::test::find(p.module->root, "@ws").child("moves");
+  const Node &moves = *ir::test::find(p.module->root, "@ws").child(ir::Kind::Moves);
   const Node *middle = nullptr;
   for (const Move &m : walkMoves(moves))
     if (m.isFeed() && m.from && !m.changesHeight() && m.from->x() < 50 && m.to.x() > 50)
@@ -112,15 +112,15 @@ TEST_CASE("compensate-deflection: zero force leaves the path unchanged", "[compe
     test::addStraightCut(*p.module, Vec3(-10, y, -8), Vec3(110, y, -8), 1200);
   Node &ws = ir::test::find(p.module->root, "@ws");
   // One moves node: the passes one after the other.
-  for (size_t i = 1; i < ws.childrenOf("moves").size(); ++i)
-    for (const Node &n : ws.childrenOf("moves")[i]->children)
-      const_cast<Node *>(ws.childrenOf("moves")[0])->add(n);
-  while (ws.childrenOf("moves").size() > 1)
+  for (size_t i = 1; i < ws.childrenOf(ir::Kind::Moves).size(); ++i)
+    for (const Node &n : ws.childrenOf(ir::Kind::Moves)[i]->children)
+      const_cast<Node *>(ws.childrenOf(ir::Kind::Moves)[0])->add(n);
+  while (ws.childrenOf(ir::Kind::Moves).size() > 1)
     ws.children.pop_back();
   const ir::Module before = *p.module;
   REQUIRE(test::runPipeline(*p.module, "compensate-deflection"));
-  const Node &a = *ir::test::find(p.module->root, "@ws").child("moves");
-  const Node &b = *ir::test::find(const_cast<Node &>(before.root), "@ws").child("moves");
+  const Node &a = *ir::test::find(p.module->root, "@ws").child(ir::Kind::Moves);
+  const Node &b = *ir::test::find(const_cast<Node &>(before.root), "@ws").child(ir::Kind::Moves);
   // The first pass is compensated (and so split or joined by connectors);
   // the other two end exactly as programmed, their moves unchanged.
   REQUIRE(a.children.size() > b.children.size());
@@ -140,7 +140,7 @@ TEST_CASE("compensate-deflection: an offset above the limit lowers the feed", "[
   const ir::Module before = *p.module;
   REQUIRE(test::runPipeline(*p.module, "compensate-deflection<max-offset=" + std::to_string(limit) + ">"));
   double lowest = 1e9;
-  for (const Move &m : walkMoves(*ir::test::find(p.module->root, "@ws").child("moves")))
+  for (const Move &m : walkMoves(*ir::test::find(p.module->root, "@ws").child(ir::Kind::Moves)))
     if (m.isFeed())
       lowest = std::min(lowest, m.feed);
   INFO("limit " << limit << " mm, full offset " << full << " mm");

@@ -115,7 +115,7 @@ void checkInvariants(const std::string &path, const cutting::CuttingData &data, 
     for (; j < after.nodes.size(); ++j) {
       const double f = after.nodes[j]->number("feed").value_or(0);
       raised += f > feed;
-      overCap += after.nodes[j]->kind != "rapid" && f > cap[j] + 1;
+      overCap += after.nodes[j]->kind != ir::Kind::Rapid && f > cap[j] + 1;
       if ((*after.nodes[j]->vec("to") - end).norm() < 1e-9 && after.nodes[j]->kind == before.nodes[i]->kind)
         break;
     }

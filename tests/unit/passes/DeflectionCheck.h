@@ -33,7 +33,7 @@ inline DeflectionCheck checkDeflection(const ir::Module &before, const ir::Modul
   const CutAnalysis analysis = analyseCuts(before, {&data, nullptr});
   std::vector<const ir::Node *> moved;
   for (const ir::Node *e : programOrder(after))
-    if (const ir::Node *m = e->child("moves"))
+    if (const ir::Node *m = e->child(ir::Kind::Moves))
       moved.push_back(m);
   if (moved.size() != analysis.steps.size()) {
     out.failures.push_back("the programs have different workingsteps");

@@ -154,7 +154,7 @@ TEST_CASE("a move pushed 0.5 mm towards the wall is caught by the verifier", "[e
   int mutants = 0, caught = 0;
   for (size_t k = 0; k < moves.children.size(); ++k) {
     ir::Node &m = moves.children[k];
-    if (m.kind != "linear" || m.text("role") != "cut" || m.vec("to")->z() > -5.9)
+    if (m.kind != ir::Kind::Linear || m.text("role") != "cut" || m.vec("to")->z() > -5.9)
       continue;
     // Only moves ending on the outermost ring (a radius from the walls) can gouge when pushed out.
     const ir::Vec3 p = *m.vec("to");
@@ -197,7 +197,7 @@ TEST_CASE("rings of a pocket with an arc corner stay arcs", "[expand]") {
   double lastZ = 20;
   for (const ir::Node &m : moves.children) {
     const double z = m.vec("to")->z();
-    if (m.kind == "arc") {
+    if (m.kind == ir::Kind::Arc) {
       ++arcs;
       if (std::abs(z - lastZ) > 1e-9)
         ++helices;

@@ -18,19 +18,19 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 
 Node &rapid(Node &moves, const Vec3 &to) {
-  Node &m = moves.add(Node("rapid"));
+  Node &m = moves.add(Node(ir::Kind::Rapid));
   m.set("to", Value::point(to));
   return m;
 }
 
 Node &linear(Node &moves, const Vec3 &to) {
-  Node &m = moves.add(Node("linear"));
+  Node &m = moves.add(Node(ir::Kind::Linear));
   m.set("to", Value::point(to)).set("feed", Value::feed(600));
   return m;
 }
 
 Node &arc(Node &moves, const Vec3 &to, const Vec3 &centre, bool ccw, int64_t turns = 0) {
-  Node &m = moves.add(Node("arc"));
+  Node &m = moves.add(Node(ir::Kind::Arc));
   m.set("to", Value::point(to))
       .set("center", Value::point(centre))
       .set("dir", Value::word(ccw ? "ccw" : "cw"));
@@ -50,12 +50,12 @@ double totalSweep(const std::vector<geom::Seg> &segs) {
 } // namespace
 
 TEST_CASE("walkMoves knows where every move starts", "[verify][movewalk]") {
-  Node moves("moves");
+  Node moves(ir::Kind::Moves);
   rapid(moves, Vec3(0, 0, 50));
   rapid(moves, Vec3(10, 0, 5)).set("role", Value::word("approach"));
   linear(moves, Vec3(10, 0, 0));
   arc(moves, Vec3(30, 0, 0), Vec3(20, 0, 0), false);
-  moves.add(Node("unrelated"));  // not a move: skipped
+  moves.add(Node(ir::Kind::Motion));  // not a move: skipped
 
   std::vector<Move> walk = walkMoves(moves);
   REQUIRE(walk.size() == 4);
@@ -83,7 +83,7 @@ TEST_CASE("walkMoves knows where every move starts", "[verify][movewalk]") {
 }
 
 TEST_CASE("lengths of lines, arcs and helices", "[verify][movewalk]") {
-  Node moves("moves");
+  Node moves(ir::Kind::Moves);
   rapid(moves, Vec3(0, 0, 0));
   linear(moves, Vec3(30, 40, 0));                              // 50
   arc(moves, Vec3(50, 40, 0), Vec3(40, 40, 0), false);         // cw half circle, r 10: 10 pi
@@ -105,7 +105,7 @@ TEST_CASE("lengths of lines, arcs and helices", "[verify][movewalk]") {
 }
 
 TEST_CASE("planar(): lines, axial moves, full circles and helices", "[verify][movewalk]") {
-  Node moves("moves");
+  Node moves(ir::Kind::Moves);
   rapid(moves, Vec3(10, 0, 5));
   linear(moves, Vec3(10, 0, -5));                              // axial: nothing in the plane
   linear(moves, Vec3(20, 0, -5));                              // one line

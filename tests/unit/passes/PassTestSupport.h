@@ -99,22 +99,22 @@ inline void addStraightCut(ir::Module &module, const ir::Vec3 &from, const ir::V
                            double spindle = -3000) {
   using ir::Value;
   ir::Node &ws = ir::test::find(module.root, "@ws");
-  ir::Node moves("moves");
+  ir::Node moves(ir::Kind::Moves);
   moves.set("tool", Value::ref("%mill10"))
       .set("spindle", Value::spindle(spindle))
       .set("coolant", Value::word("flood"))
       .set("setup", Value::ref("%s1"))
       .set("secplane", Value::length(20));
-  auto add = [&](const char *kind, const ir::Vec3 &p, double f) {
+  auto add = [&](ir::Kind kind, const ir::Vec3 &p, double f) {
     ir::Node &n = moves.add(ir::Node(kind));
     n.set("to", Value::point(p));
     if (f > 0)
       n.set("feed", Value::feed(f));
   };
-  add("rapid", ir::Vec3(from.x(), from.y(), 20), 0);
-  add("linear", from, feed);
-  add("linear", to, feed);
-  add("rapid", ir::Vec3(to.x(), to.y(), 20), 0);
+  add(ir::Kind::Rapid, ir::Vec3(from.x(), from.y(), 20), 0);
+  add(ir::Kind::Linear, from, feed);
+  add(ir::Kind::Linear, to, feed);
+  add(ir::Kind::Rapid, ir::Vec3(to.x(), to.y(), 20), 0);
   ws.add(std::move(moves));
 }
 

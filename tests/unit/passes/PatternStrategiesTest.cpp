@@ -36,7 +36,7 @@ std::string example(const char *name) { return std::string(STEPNC_SOURCE_DIR) + 
 
 const ir::Node &movesOf(const ir::Module &m) {
   for (const ir::Node *exec : programOrder(m))
-    if (const ir::Node *moves = exec->child("moves"))
+    if (const ir::Node *moves = exec->child(ir::Kind::Moves))
       return *moves;
   FAIL("no moves");
   throw;
@@ -151,8 +151,8 @@ void checkPocketTrochoid(const ir::Node &moves, size_t lines) {
 
 /// Gives every pattern strategy under `n` a guide of `type` in place of its own.
 void setGuide(ir::Node &n, const char *type) {
-  if (n.kind == "trochoidal_strategy" || n.kind == "plunge_strategy") {
-    ir::Node guide("strategy");
+  if (n.kind == ir::Kind::TrochoidalStrategy || n.kind == ir::Kind::PlungeStrategy) {
+    ir::Node guide(ir::Kind::Strategy);
     guide.set("type", ir::Value::word(type));
     n.children.front() = std::move(guide);
     return;
@@ -296,7 +296,7 @@ TEST_CASE("pattern: plunges go along the tool axis, link above the material, lea
     const ir::Node *strategy = nullptr;
     for (const ir::Node *exec : programOrder(*l.module))
       for (const ir::Node &c : exec->children)
-        if (const ir::Node *p = c.child("plunge_strategy"))
+        if (const ir::Node *p = c.child(ir::Kind::PlungeStrategy))
           strategy = p;
     REQUIRE(strategy);
     const double pitch = *strategy->number("radial_step"), bottom = *strategy->number("bottom_radius");

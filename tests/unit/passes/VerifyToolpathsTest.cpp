@@ -87,11 +87,11 @@ public:
         .set("secplane", Value::length(20));
   }
 
-  Path &rapid(double x, double y, double z) { return add("rapid", Vec3(x, y, z)); }
-  Path &line(double x, double y, double z) { return add("linear", Vec3(x, y, z)).feed(); }
+  Path &rapid(double x, double y, double z) { return add(ir::Kind::Rapid, Vec3(x, y, z)); }
+  Path &line(double x, double y, double z) { return add(ir::Kind::Linear, Vec3(x, y, z)).feed(); }
   Path &line(double x, double y) { return line(x, y, at_.z()); }
   Path &arc(double x, double y, double cx, double cy, bool ccw = true, int64_t turns = 0, double z = NAN) {
-    add("arc", Vec3(x, y, std::isnan(z) ? at_.z() : z));
+    add(ir::Kind::Arc, Vec3(x, y, std::isnan(z) ? at_.z() : z));
     Node &m = moves.children.back();
     m.set("center", Value::point(Vec3(cx, cy, 0))).set("dir", Value::word(ccw ? "ccw" : "cw"));
     if (turns > 0)
@@ -106,10 +106,10 @@ public:
     return line(x1, y0).line(x1, y1).line(x0, y1).line(x0, y0);
   }
 
-  Node moves{"moves"};
+  Node moves{ir::Kind::Moves};
 
 private:
-  Path &add(const char *kind, const Vec3 &to) {
+  Path &add(ir::Kind kind, const Vec3 &to) {
     moves.add(Node(kind)).set("to", Value::point(to));
     at_ = to;
     return *this;
