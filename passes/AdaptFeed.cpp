@@ -17,7 +17,7 @@
 // `--stats` report.
 #include "passes/CuttingModel.h"
 #include "passes/CuttingPass.h"
-#include "passes/MotionIR.h"
+#include "ir/motion/MotionIR.h"
 
 #include "support/Format.h"
 
@@ -327,7 +327,7 @@ private:
     std::map<const ir::Node *, double> out;
     if (!machine)
       return out;
-    const ProgramPath program = programPath(module);
+    const ir::ProgramPath program = ir::programPath(module);
     if (program.path.moves.empty())
       return out;
     const runtime::Trajectory t = runtime::plan(program.path, *machine);
@@ -342,7 +342,7 @@ private:
   /// controller's max feed, and on a short move what it gets to between
   /// speeding up and slowing down); how many were.
   static long long capByDynamics(ir::Module &module, const runtime::Machine &machine) {
-    const ProgramPath program = programPath(module);
+    const ir::ProgramPath program = ir::programPath(module);
     if (program.path.moves.empty())
       return 0;
     const runtime::Trajectory t = runtime::plan(program.path, machine);

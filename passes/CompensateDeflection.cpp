@@ -168,8 +168,8 @@ Profile fitProfile(std::vector<Band> bands) {
 }
 
 /// The unit direction of a horizontal move at its point p.
-Vec2 tangentAt(const Move &m, const ir::Vec3 &p) {
-  if (m.kind == MoveKind::Arc) {
+Vec2 tangentAt(const ir::Move &m, const ir::Vec3 &p) {
+  if (m.kind == ir::MoveKind::Arc) {
     const Vec2 u = (p.head<2>() - m.center.head<2>()).normalized();
     return m.ccw ? Vec2(-u.y(), u.x()) : Vec2(u.y(), -u.x());
   }
@@ -179,7 +179,7 @@ Vec2 tangentAt(const Move &m, const ir::Vec3 &p) {
 /// The point `offset` mm to the left (right when negative) of the nominal
 /// point p of a horizontal move, square to its direction there: a line is
 /// shifted along its normal, an arc's radius changes about its centre.
-ir::Vec3 offsetPoint(const Move &m, const ir::Vec3 &p, double offset) {
+ir::Vec3 offsetPoint(const ir::Move &m, const ir::Vec3 &p, double offset) {
   if (offset == 0)
     return p;
   const Vec2 t = tangentAt(m, p);
@@ -208,10 +208,10 @@ struct RewriteCounts {
 /// where it is programmed to start and end and the nominal ends it is
 /// predicted to reach.
 struct Placed {
-  explicit Placed(ir::Node n, const Move *m = nullptr) : node(std::move(n)), move(m) {}
+  explicit Placed(ir::Node n, const ir::Move *m = nullptr) : node(std::move(n)), move(m) {}
 
   ir::Node node;
-  const Move *move = nullptr; ///< the move it is or is a piece of; null for other children
+  const ir::Move *move = nullptr; ///< the move it is or is a piece of; null for other children
   bool changed = false;       ///< its end is to be written
   ir::Vec3 from = ir::Vec3::Zero(), to = ir::Vec3::Zero();
   ir::Vec3 nominalFrom = ir::Vec3::Zero(), nominalTo = ir::Vec3::Zero();
@@ -219,7 +219,7 @@ struct Placed {
   std::optional<ir::Node> lead; ///< a connector run before it
 
   /// A horizontal feed line whose start is known.
-  bool flatLine() const { return move && move->kind == MoveKind::Linear && move->from && !move->changesHeight(); }
+  bool flatLine() const { return move && move->kind == ir::MoveKind::Linear && move->from && !move->changesHeight(); }
 };
 
 /// Per workingstep: what the report shows.
@@ -418,7 +418,7 @@ private:
         placed.emplace_back(std::move(child));
         continue;
       }
-      const Move &m = cm->move;
+      const ir::Move &m = cm->move;
       const MoveFit &fit = fits[size_t(cm - step.moves.data())];
       std::vector<Placed> pieces;
       if (!fit.samples.empty())
@@ -465,7 +465,7 @@ private:
   /// offset, the profile's at its middle); none when the move stays as it
   /// is.
   static std::vector<Placed> cut(const ir::Node &node, const MoveFit &fit, const Profile &profile) {
-    const Move &m = fit.cm->move;
+    const ir::Move &m = fit.cm->move;
     const double length = m.length();
     std::vector<double> at{0, length};
     if (m.turns == 0) {
@@ -499,7 +499,7 @@ private:
           std::find_if(fit.feeds.begin(), fit.feeds.end(), [&](const FeedPiece &f) { return (a + b) / 2 <= f.to; });
       const double fz = piece == fit.feeds.end() ? fit.feeds.back().fz : piece->fz;
       p.feed = fz < fit.cm->fz ? fit.cm->feedFor(fz) : m.feed;
-      if (m.kind == MoveKind::Arc && oa != ob) {
+      if (m.kind == ir::MoveKind::Arc && oa != ob) {
         const Vec2 c = geom::balancedCentre(p.from.head<2>(), p.to.head<2>(), m.center.head<2>());
         p.node.set("center", ir::Value::point({c.x(), c.y(), m.center.z()}))
             .set("nominal_center", ir::Value::point(m.center));

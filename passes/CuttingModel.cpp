@@ -11,7 +11,7 @@
 #include "passes/CuttingModel.h"
 
 #include "ir/Kinds.h"
-#include "passes/FeatureShape.h"
+#include "ir/geom/FeatureShape.h"
 #include "support/Format.h"
 
 #include <algorithm>
@@ -30,20 +30,13 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 bool isMill(const std::string &type) { return type.find("mill") != std::string::npos; }
 
-const ir::Node *findResource(const ir::Module &module, ir::Kind kind, std::string_view symbol) {
-  for (const ir::Node &n : module.root.children)
-    if (n.kind == kind && n.symbol == symbol)
-      return &n;
-  return nullptr;
-}
-
 /// The workpiece a setup holds (its first workpiece_setup), else the only
 /// workpiece.
 const ir::Node *setupWorkpiece(const ir::Module &module, const std::string &setup) {
-  if (const ir::Node *s = findResource(module, ir::Kind::Setup, setup))
+  if (const ir::Node *s = ir::findResource(module, ir::Kind::Setup, setup))
     for (const ir::Node *ws : s->childrenOf(ir::Kind::WorkpieceSetup))
       if (auto w = ws->text("workpiece"))
-        if (const ir::Node *wp = findResource(module, ir::Kind::Workpiece, *w))
+        if (const ir::Node *wp = ir::findResource(module, ir::Kind::Workpiece, *w))
           return wp;
   const ir::Node *only = nullptr;
   for (const ir::Node &n : module.root.children)
@@ -112,10 +105,8 @@ PathPoint pathPointAt(const std::vector<geom::Seg> &segs, double s) {
 }
 
 std::optional<ir::Kind> operationKind(const ir::Node &executable) {
-  for (const ir::Node &c : executable.children)
-    if (ir::isOperation(c.kind))
-      return c.kind;
-  return std::nullopt;
+  const ir::Node *op = ir::operationOf(executable);
+  return op ? std::optional<ir::Kind>(op->kind) : std::nullopt;
 }
 
 } // namespace
@@ -202,7 +193,7 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
   };
   std::vector<Pending> pending;
   double smallest = kInf;
-  for (const ir::Node *e : programOrder(module))
+  for (const ir::Node *e : ir::programOrder(module))
     if (const ir::Node *m = e->child(ir::Kind::Moves)) {
       pending.push_back({e, m, m->text("setup").value_or("")});
       if (auto t = out.tools.find(m->text("tool").value_or(""));
@@ -219,13 +210,13 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
     step.executable = p.exec;
     step.movesNode = p.moves;
     step.operation = operationKind(*p.exec);
-    step.asWritten = runsAsWritten(*p.exec);
+    step.asWritten = ir::runsAsWritten(*p.exec);
     if (auto t = out.tools.find(p.moves->text("tool").value_or("")); t != out.tools.end())
       step.tool = &t->second;
     const double spindle = p.moves->number("spindle").value_or(0);
     step.spindle = std::abs(spindle);
     step.setup = p.setup;
-    for (const Move &m : walkMoves(*p.moves, position)) {
+    for (const ir::Move &m : ir::walkMoves(*p.moves, position)) {
       CutMove cm;
       cm.move = m;
       step.moves.push_back(std::move(cm));
@@ -245,7 +236,7 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
       // The stock's extent: the raw piece and everything this setup's moves
       // sweep.
       const ir::Node *wp = setupWorkpiece(module, p.setup);
-      const std::optional<RawBlock> raw = rawBlock(wp);
+      const std::optional<ir::RawBlock> raw = ir::rawBlock(wp);
       geom::Box box = raw ? raw->box : geom::Box{};
       double top = raw ? raw->top : -kInf;
       for (const Pending &q : pending) {
@@ -254,14 +245,14 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
         double r = 0;
         if (auto t = out.tools.find(q.moves->text("tool").value_or("")); t != out.tools.end())
           r = t->second.cutter.radius;
-        for (const Move &m : walkMoves(*q.moves))
+        for (const ir::Move &m : ir::walkMoves(*q.moves))
           if (m.isFeed())
             box.add(geom::Box{m.to.head<2>(), m.to.head<2>()}.grown(r + 1));
         // No block raw piece: material up to the highest feature top.
         if (!raw)
           if (auto f = q.exec->text("feature"))
-            if (const ir::Node *feature = findFeature(module, *f))
-              if (auto shape = featureShape(module, *feature).shape)
+            if (const ir::Node *feature = ir::findFeature(module, *f))
+              if (auto shape = ir::featureShape(module, *feature).shape)
                 top = std::max(top, shape->top);
       }
       if (box.empty())
@@ -296,9 +287,9 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
     const double torqueLimit = options.machine ? spindleTorqueLimit(*options.machine, step.spindle) : kInf;
     const double sampleStep = std::max(2 * map.cell(), std::min(radius / 4, 1.0));
     // Hole-making tools cut to where their point reaches full diameter.
-    const double point = tool && !tool->mill ? pointLength(*findResource(module, ir::Kind::Tool, tool->symbol)) : 0;
+    const double point = tool && !tool->mill ? ir::pointLength(*ir::findResource(module, ir::Kind::Tool, tool->symbol)) : 0;
     for (CutMove &cm : step.moves) {
-      const Move &m = cm.move;
+      const ir::Move &m = cm.move;
       if (!m.isFeed() || !m.from || radius <= 0)
         continue;
       const std::vector<geom::Seg> segs = m.planar();

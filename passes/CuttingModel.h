@@ -13,7 +13,7 @@
 #include "cutting/Deflection.h"
 #include "cutting/Mechanics.h"
 #include "ir/Node.h"
-#include "passes/MoveWalk.h"
+#include "ir/geom/MoveWalk.h"
 #include "runtime/Machine.h"
 
 #include <algorithm>
@@ -56,7 +56,7 @@ struct CutSample {
 };
 
 struct CutMove {
-  Move move;
+  ir::Move move;
   bool measured = false; ///< a horizontal feed move of a milling cutter
   double fz = 0;         ///< mm per tooth at the move's feed
   std::vector<CutSample> samples;
@@ -79,7 +79,7 @@ struct CutStep {
   double spindle = 0; ///< rev/min, unsigned
   /// The step's operation, if it has one.
   std::optional<ir::Kind> operation;
-  /// Its moves are the file's required toolpaths (runsAsWritten): cut into
+  /// Its moves are the file's required toolpaths (ir::runsAsWritten): cut into
   /// the stock, never measured, so the cutting passes leave them as written.
   bool asWritten = false;
   std::vector<CutMove> moves;

@@ -1,7 +1,7 @@
 // expand-strategies: from features to moves.
 //
 // Each machining workingstep gets a `moves` child: the tool-centre path in
-// workpiece coordinates, made from the feature's shape (passes/FeatureShape),
+// workpiece coordinates, made from the feature's shape (ir/geom/FeatureShape),
 // the operation (allowances, depths of cut, stepover), its strategy, approach
 // and retract. The plan of every milling workingstep is the same:
 //   1. levels: from the feature's top down to its floor plus the bottom
@@ -19,8 +19,8 @@
 
 #include "geom/Boolean.h"
 #include "ir/Kinds.h"
-#include "passes/Curves.h"
-#include "passes/FeatureShape.h"
+#include "ir/geom/Curves.h"
+#include "ir/geom/FeatureShape.h"
 #include "passes/PatternPaths.h"
 #include "support/Format.h"
 
@@ -188,7 +188,7 @@ double sharpestCorner(const Region &r) {
 /// The widest stepover between rings of a tool of radius `radius` that
 /// leaves no material at the target's sharpest convex corner
 /// (R (1 + sin(theta / 2)), REFERENCES), with 2 % to spare.
-double ringCoverLimit(const FeatureShape &s, double radius) {
+double ringCoverLimit(const ir::FeatureShape &s, double radius) {
   return radius * (1 + std::sin(sharpestCorner(s.target) / 2)) * 0.98;
 }
 
@@ -244,14 +244,11 @@ private:
       rapidMovement(ws, setup);
       return;
     }
-    const Node *op = nullptr;
-    for (const Node &c : ws.children)
-      if (ir::isOperation(c.kind))
-        op = &c;
+    const Node *op = ir::operationOf(ws);
     if (!op)
       return;
-    const Node *feature = findFeature(*module_, ws.text("feature").value_or(""));
-    const Node *tool = findTool(op->text("tool").value_or(""));
+    const Node *feature = ir::findFeature(*module_, ws.text("feature").value_or(""));
+    const Node *tool = ir::findTool(*module_, op->text("tool").value_or(""));
     if (!feature || !tool)
       return;  // the IR verifier reports dangling references
     Plan p;
@@ -284,7 +281,7 @@ private:
     Node moves = makeMoves(ws, tool->symbol, p.spindle, coolant(*op), setup);
     // Explicit toolpaths need no shape: they are in the feature's frame.
     if (!op->childrenOf(ir::Kind::Toolpath).empty()) {
-      FrameResult fr = planeFrame(*feature);
+      ir::FrameResult fr = ir::planeFrame(*feature);
       if (!fr.frame) {
         unsupported(ws, fr.error);
         return;
@@ -294,12 +291,12 @@ private:
       attach(ws, std::move(moves));
       return;
     }
-    ShapeResult shape = featureShape(*module_, *feature);
+    ir::ShapeResult shape = ir::featureShape(*module_, *feature);
     if (!shape.shape) {
       unsupported(ws, shape.error);
       return;
     }
-    const FeatureShape &s = *shape.shape;
+    const ir::FeatureShape &s = *shape.shape;
     const double secplane = ws.number("secplane").value_or(0);
     if (secplane < s.top) {
       report(ws, "its security plane z=" + formatFixed(secplane, 4) + " mm is below the top of " + s.symbol +
@@ -344,13 +341,6 @@ private:
     return mf->flag("coolant").value_or(false) ? "flood" : "off";
   }
 
-  const Node *findTool(std::string_view symbol) const {
-    for (const Node &n : module_->root.children)
-      if (n.kind == ir::Kind::Tool && n.symbol == symbol)
-        return &n;
-    return nullptr;
-  }
-
   void report(const Node &ws, const std::string &message) { report(ws, ws, message); }
 
   /// An error about workingstep `ws` located at `at` (a part of it the file gives, such as its strategy).
@@ -367,7 +357,7 @@ private:
 
   // --- Explicit toolpaths -------------------------------------------------------
 
-  void explicitToolpaths(const Node &ws, const Node &op, const PlaneFrame &frame, const Plan &p, Node &moves) {
+  void explicitToolpaths(const Node &ws, const Node &op, const ir::PlaneFrame &frame, const Plan &p, Node &moves) {
     Emitter e(moves, ws.number("secplane").value_or(0));
     for (const Node *tp : op.childrenOf(ir::Kind::Toolpath)) {
       const Node *tech = tp->child(ir::Kind::Technology);
@@ -376,7 +366,7 @@ private:
       for (const Node &curve : tp->children) {
         if (curve.category() != ir::Category::Curve)
           continue;
-        CurveResult cr = curvePieces(curve);
+        ir::CurveResult cr = ir::curvePieces(curve);
         if (!cr.error.empty()) {
           report(ws, "its explicit toolpath: " + cr.error);
           return;
@@ -384,12 +374,12 @@ private:
         const bool reversed = tp->flag("reversed").value_or(false);
         if (reversed) {
           std::reverse(cr.pieces.begin(), cr.pieces.end());
-          for (CurvePiece &c : cr.pieces) {
+          for (ir::CurvePiece &c : cr.pieces) {
             std::swap(c.from, c.to);
             c.ccw = !c.ccw;
           }
         }
-        for (const CurvePiece &c : cr.pieces)
+        for (const ir::CurvePiece &c : cr.pieces)
           explicitPiece(frame, c, kind, feed, p.clearanceZ, e);
       }
     }
@@ -421,7 +411,7 @@ private:
   }
 
   /// One piece of an explicit toolpath, mapped from the feature's frame.
-  void explicitPiece(const PlaneFrame &f, const CurvePiece &c, const ExplicitKind &kind, double feed,
+  void explicitPiece(const ir::PlaneFrame &f, const ir::CurvePiece &c, const ExplicitKind &kind, double feed,
                      double clearanceZ, Emitter &e) {
     const Vec3 from = at(f.map(c.from.head<2>()), f.z + c.from.z());
     const Vec3 to = at(f.map(c.to.head<2>()), f.z + c.to.z());
@@ -454,12 +444,12 @@ private:
     for (const Node *tp : rm.childrenOf(ir::Kind::Toolpath))
       for (const Node &curve : tp->children)
         if (curve.category() == ir::Category::Curve) {
-          CurveResult cr = curvePieces(curve);
+          ir::CurveResult cr = ir::curvePieces(curve);
           if (!cr.error.empty()) {
             report(rm, "its toolpath: " + cr.error);
             return;
           }
-          for (const CurvePiece &c : cr.pieces) {
+          for (const ir::CurvePiece &c : cr.pieces) {
             if (!e.positioned())
               e.travel(c.from.head<2>(), c.from.z());
             e.rapid(c.to);
@@ -470,7 +460,7 @@ private:
 
   // --- Hole making --------------------------------------------------------------
 
-  bool expandHoleMaking(const Node &ws, const Node &op, const FeatureShape &s, const Plan &p, Node &moves) {
+  bool expandHoleMaking(const Node &ws, const Node &op, const ir::FeatureShape &s, const Plan &p, Node &moves) {
     if (!s.holeCentre) {
       unsupported(ws, op.kindName() + " on a " + s.kindName() + ": hole-making operations are expanded on round holes only");
       return false;
@@ -485,7 +475,7 @@ private:
     const Node &feature = *p.feature;
     // The depth the tool's tip reaches: the floor, or past it for through holes.
     double bottom = s.bottom;
-    const double point = pointLength(*p.tool);
+    const double point = ir::pointLength(*p.tool);
     if (feature.text("bottom") == "through")
       bottom -= point + std::max(kBreakthrough, op.number("overcut").value_or(0));
     if (auto depth = op.number("cutting_depth"))
@@ -527,7 +517,7 @@ private:
   /// The heights a milling operation cuts at, from the top down to the
   /// floor plus its allowance, in equal steps no deeper than the axial
   /// depth of cut; none (after a warning) when the allowance leaves nothing.
-  std::vector<double> levelsOf(const Node &ws, const Node &op, const FeatureShape &s, const Plan &p) {
+  std::vector<double> levelsOf(const Node &ws, const Node &op, const ir::FeatureShape &s, const Plan &p) {
     const double floorZ = s.bottom + p.allowanceBottom;
     if (floorZ >= s.top - 1e-9) {
       unsupported(ws, "the bottom allowance leaves nothing to cut");
@@ -541,7 +531,7 @@ private:
     return out;
   }
 
-  bool milling(const Node &ws, const Node &op, const FeatureShape &s, const Plan &p, Node &moves) {
+  bool milling(const Node &ws, const Node &op, const ir::FeatureShape &s, const Plan &p, Node &moves) {
     for (const Node &pattern : op.children)
       if (pattern.is(ir::Trait::PatternStrategy))
         return patternMilling(ws, op, pattern, s, p, moves);
@@ -582,7 +572,7 @@ private:
     for (size_t i = 0; i < levels.size(); ++i) {
       const double z = levels[i];
       std::vector<bool> here;
-      for (const IslandShape &isl : s.islands)
+      for (const ir::IslandShape &isl : s.islands)
         here.push_back(isl.top > z + 1e-9);
       if (standing != here) {
         standing = here;
@@ -648,7 +638,7 @@ private:
   /// tool radius (and side allowance) short of flat ends, short of radiused
   /// ends as far as the tool is narrower than the slot, and run a radius past
   /// open ends. None when the tool is wider than the slot less its allowances.
-  static std::optional<std::vector<Seg>> slotCentreline(const FeatureShape::SlotPath &slot, const Plan &p) {
+  static std::optional<std::vector<Seg>> slotCentreline(const ir::FeatureShape::SlotPath &slot, const Plan &p) {
     const double reach = p.radius + p.allowanceSide;
     if (2 * reach > slot.width + 1e-6)
       return std::nullopt;
@@ -707,7 +697,7 @@ private:
 
   /// Where the tool centre may be at one level: away from walls and islands by
   /// the radius plus the side allowance; for faces, over the face and past it.
-  Region centreArea(const FeatureShape &s, const Region &area, const std::vector<Region> &islands, const Plan &p) {
+  Region centreArea(const ir::FeatureShape &s, const Region &area, const std::vector<Region> &islands, const Plan &p) {
     const double reach = p.radius + p.allowanceSide;
     Region centres;
     if (s.unbounded) {
@@ -772,7 +762,7 @@ private:
 
   /// The stroke direction: the strategy's feed direction, else the face's
   /// course of travel, else the feature's x axis.
-  static Vec2 strokeDirection(const Node &feature, const FeatureShape &s, const Node *strategy) {
+  static Vec2 strokeDirection(const Node &feature, const ir::FeatureShape &s, const Node *strategy) {
     if (strategy)
       if (auto d = strategy->vec("feed_dir"); d && d->head<2>().norm() > 1e-9)
         return s.frame.mapDir(d->head<2>()).normalized();
@@ -905,7 +895,7 @@ private:
 
   // --- Pattern strategies (docs/pattern-strategies.md) -------------------------
 
-  bool patternMilling(const Node &ws, const Node &op, const Node &pattern, const FeatureShape &s, const Plan &p,
+  bool patternMilling(const Node &ws, const Node &op, const Node &pattern, const ir::FeatureShape &s, const Plan &p,
                       Node &moves) {
     const Node *guide = pattern.child(ir::Kind::Strategy);
     const std::string type = guide ? guide->text("type").value_or("") : "";
@@ -928,7 +918,7 @@ private:
   /// kept `margin` further from the walls; `area` receives where the guide
   /// may run. None after a diagnostic when the motif does not fit.
   std::optional<std::vector<std::vector<Seg>>> guidePaths(const Node &ws, const Node &op, const Node &guide,
-                                                          const FeatureShape &s, const Plan &reach, double z,
+                                                          const ir::FeatureShape &s, const Plan &reach, double z,
                                                           double spacing, double margin, Region &area) {
     const std::string type = guide.text("type").value_or("");
     area = centreArea(s, s.unbounded ? s.target : s.limit, islandsAt(s, z, reach.allowanceSide), reach);
@@ -968,9 +958,9 @@ private:
   }
 
   /// The islands standing at height z, grown by the side allowance.
-  static std::vector<Region> islandsAt(const FeatureShape &s, double z, double allowance) {
+  static std::vector<Region> islandsAt(const ir::FeatureShape &s, double z, double allowance) {
     std::vector<Region> out;
-    for (const IslandShape &isl : s.islands)
+    for (const ir::IslandShape &isl : s.islands)
       if (isl.top > z + 1e-9)
         out.push_back(geom::offset(isl.region, allowance));
     return out;
@@ -979,7 +969,7 @@ private:
   /// After a motif at height z: one contour of the tool along every wall,
   /// climb, taking what the motif leaves there (its scallops or cusps
   /// between loops or plunges, and corners tighter than its reach).
-  void wallPass(Emitter &e, const Node &op, const FeatureShape &s, const Plan &p, double z, bool ccw) {
+  void wallPass(Emitter &e, const Node &op, const ir::FeatureShape &s, const Plan &p, double z, bool ccw) {
     const Region centres = centreArea(s, s.unbounded ? s.target : s.limit, islandsAt(s, z, p.allowanceSide), p);
     if (centres.empty())
       return;
@@ -1021,14 +1011,14 @@ private:
   /// The spacing of guide paths for a motif as wide as a tool of radius
   /// `radius`: from the pattern's overlap (default kPatternOverlap), never
   /// so wide that a ring leaves material at the region's sharpest corner.
-  static double guideSpacing(const Node &pattern, const FeatureShape &s, double radius) {
+  static double guideSpacing(const Node &pattern, const ir::FeatureShape &s, double radius) {
     double overlap = pattern.number("overlap").value_or(kPatternOverlap);
     if (overlap <= 0 || overlap >= 1)
       overlap = kPatternOverlap;
     return std::min(2 * radius * (1 - overlap), ringCoverLimit(s, radius));
   }
 
-  bool trochoidal(const Node &ws, const Node &op, const Node &pattern, const Node &guide, const FeatureShape &s,
+  bool trochoidal(const Node &ws, const Node &op, const Node &pattern, const Node &guide, const ir::FeatureShape &s,
                   const Plan &p, const std::vector<double> &levels, Node &moves) {
     const double loop = pattern.number("radius").value_or(0);
     const double step = pattern.number("step").value_or(0);
@@ -1097,7 +1087,7 @@ private:
     return true;
   }
 
-  bool plunging(const Node &ws, const Node &op, const Node &pattern, const Node &guide, const FeatureShape &s,
+  bool plunging(const Node &ws, const Node &op, const Node &pattern, const Node &guide, const ir::FeatureShape &s,
                 const Plan &p, const std::vector<double> &levels, Node &moves) {
     const double clearance = pattern.number("clearance").value_or(0);
     const double backOff = std::max(0.0, pattern.number("retract_offset").value_or(0));

@@ -1,6 +1,6 @@
 // plan-motion: plans the whole program's moves on a machine (runtime/Planner)
-// and writes the trajectory into the IR as `motion` nodes (passes/MotionIR).
-#include "passes/MotionIR.h"
+// and writes the trajectory into the IR as `motion` nodes (ir/motion/MotionIR).
+#include "ir/motion/MotionIR.h"
 #include "passes/Pass.h"
 #include "runtime/Machine.h"
 #include "support/Format.h"
@@ -25,7 +25,7 @@ public:
     const auto machine = runtime::loadMachine(machinePath_, machineFile_, diags);
     if (!machine)
       return {false, false};
-    const ProgramPath program = programPath(module);
+    const ir::ProgramPath program = ir::programPath(module);
     if (program.path.moves.empty()) {
       diags.warning({}, "plan-motion: the program has no moves to plan (run expand-strategies first)");
       return {true, false};
@@ -34,7 +34,7 @@ public:
     if (tolerance_)
       options.tolerance = *tolerance_;
     const runtime::Trajectory trajectory = runtime::plan(program.path, *machine, options);
-    attachMotion(module, program, trajectory);
+    ir::attachMotion(module, program, trajectory);
     long long blends = 0, stops = 0;
     for (size_t k = 0; k < trajectory.segments.size(); ++k) {
       blends += trajectory.segments[k].kind == runtime::SegmentKind::Blend;

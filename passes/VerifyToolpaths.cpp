@@ -1,6 +1,6 @@
 // verify-toolpaths: checks the moves of every workingstep against its feature,
 // independently of the code that generated them. It shares with strategy
-// expansion only the reading of the feature (FeatureShape) and of the moves
+// expansion only the reading of the feature (ir::FeatureShape) and of the moves
 // (MoveWalk); every area is computed with the exact Booleans of geom/Boolean.h
 // (never with geom::offset or geom::clip, the generator's tools).
 //
@@ -25,8 +25,8 @@
 
 #include "geom/Boolean.h"
 #include "ir/Kinds.h"
-#include "passes/FeatureShape.h"
-#include "passes/MoveWalk.h"
+#include "ir/geom/FeatureShape.h"
+#include "ir/geom/MoveWalk.h"
 #include "support/Format.h"
 
 #include <algorithm>
@@ -59,12 +59,6 @@ bool isMilling(ir::Kind op) { return ir::hasTraits(op, ir::Trait::Milling); }
 bool isFinishing(ir::Kind op) { return ir::hasTraits(op, ir::Trait::Finishing); }
 bool isSideMilling(ir::Kind op) { return ir::hasTraits(op, ir::Trait::SideOnly); }
 
-const ir::Node *operationOf(const ir::Node &exec) {
-  for (const ir::Node &c : exec.children)
-    if (ir::isOperation(c.kind))
-      return &c;
-  return nullptr;
-}
 
 // --- Text --------------------------------------------------------------------------
 
@@ -97,7 +91,7 @@ bool sameRegion(const Region &a, const Region &b) {
 }
 
 /// Indices of the islands standing above height z: the ones a cut at z must avoid.
-std::vector<size_t> islandsAbove(const FeatureShape &shape, double z, double tol) {
+std::vector<size_t> islandsAbove(const ir::FeatureShape &shape, double z, double tol) {
   std::vector<size_t> out;
   for (size_t i = 0; i < shape.islands.size(); ++i)
     if (shape.islands[i].top > z + tol)
@@ -118,7 +112,7 @@ std::string indexKey(const std::vector<size_t> &indices) {
 class RegionCache {
 public:
   /// The islands with the given indices, united and grown by d.
-  const Region &islands(const FeatureShape &s, const std::vector<size_t> &idx, double d) {
+  const Region &islands(const ir::FeatureShape &s, const std::vector<size_t> &idx, double d) {
     return get("islands", s, {d}, idx, [&] {
       std::vector<Region> parts;
       for (size_t i : idx)
@@ -129,7 +123,7 @@ public:
 
   /// Where the tool's edge may be (bounded shapes): the limit shrunk by the
   /// side allowance, without the islands grown by it.
-  const Region &allowed(const FeatureShape &s, double allowance, const std::vector<size_t> &idx) {
+  const Region &allowed(const ir::FeatureShape &s, double allowance, const std::vector<size_t> &idx) {
     return get("allowed", s, {allowance}, idx, [&] {
       const Region walls = offsetExact(s.limit, -allowance);
       const Region &isl = islands(s, idx, allowance);
@@ -140,7 +134,7 @@ public:
   /// What a tool of radius r can reach of the target: the opening of the
   /// allowed area (shrunk by r, grown back by r) within the target; for
   /// unbounded shapes, the target without the closing of the grown islands.
-  const Region &reachable(const FeatureShape &s, double r, double allowance, const std::vector<size_t> &idx) {
+  const Region &reachable(const ir::FeatureShape &s, double r, double allowance, const std::vector<size_t> &idx) {
     return get("reachable", s, {r, allowance}, idx, [&] {
       if (s.unbounded) {
         const Region &isl = islands(s, idx, allowance + r);
@@ -153,7 +147,7 @@ public:
 
   /// What side milling must clear: the reachable area within `band` of the
   /// allowed area's boundary (walls and islands; only islands when unbounded).
-  const Region &sideBand(const FeatureShape &s, double r, double allowance, double band,
+  const Region &sideBand(const ir::FeatureShape &s, double r, double allowance, double band,
                          const std::vector<size_t> &idx) {
     return get("band", s, {r, allowance, band}, idx, [&] {
       const Region &reach = reachable(s, r, allowance, idx);
@@ -169,7 +163,7 @@ public:
 
 private:
   template <class Make>
-  const Region &get(const char *what, const FeatureShape &s, std::initializer_list<double> numbers,
+  const Region &get(const char *what, const ir::FeatureShape &s, std::initializer_list<double> numbers,
                     const std::vector<size_t> &idx, Make &&make) {
     std::string key = what;
     for (const std::string &part : {s.symbol, indexKey(idx)})
@@ -195,7 +189,7 @@ struct Cut {
   Vec2 lowPoint = Vec2::Zero();  ///< where it is lowest, in the plane
 };
 
-Cut cutOf(const Move &m) {
+Cut cutOf(const ir::Move &m) {
   Cut c;
   const ir::Vec3 &low = m.from->z() < m.to.z() ? *m.from : m.to;
   c.low = low.z();
@@ -248,13 +242,13 @@ struct Step {
   std::string name;  ///< "workingstep @ws1", for messages
   const ir::Node *op = nullptr;
   const ir::Node *feature = nullptr;
-  const FeatureShape *shape = nullptr;  ///< null: no feature, or one FeatureShape cannot handle
+  const ir::FeatureShape *shape = nullptr;  ///< null: no feature, or one ir::FeatureShape cannot handle
   const ir::Node *tool = nullptr;
   double radius = 0;  ///< 0: unknown
   double tol = kDefaultTolerance;
   double secplane = 0;
   double allowanceSide = 0, allowanceBottom = 0;
-  std::vector<Move> moves;
+  std::vector<ir::Move> moves;
   Figures figures;
 };
 
@@ -325,7 +319,7 @@ private:
     s.exec = &exec;
     s.movesNode = &movesNode;
     s.name = exec.kindName() + " " + exec.symbol;
-    s.op = operationOf(exec);
+    s.op = ir::operationOf(exec);
     s.secplane = movesNode.number("secplane").value_or(0.0);
     if (auto it = tools_.find(movesNode.text("tool").value_or("")); it != tools_.end())
       s.tool = it->second;
@@ -337,13 +331,13 @@ private:
     }
     // Where the tool is predicted to go: moves compensated for its deflection
     // are programmed off the part and reach their `nominal` ends.
-    s.moves = walkMoves(movesNode, std::nullopt, PathKind::Predicted);
+    s.moves = ir::walkMoves(movesNode, std::nullopt, ir::PathKind::Predicted);
     s.figures.moves = s.moves.size();
-    for (const Move &m : s.moves)
+    for (const ir::Move &m : s.moves)
       s.figures.path += m.length();
     stats_["moves checked"] += static_cast<long long>(s.moves.size());
     const std::optional<std::string> feature = exec.text("feature");
-    s.feature = feature ? findFeature(module_, *feature) : nullptr;
+    s.feature = feature ? ir::findFeature(module_, *feature) : nullptr;
     s.tol = tolerance_.value_or(workpieceTolerance(s.feature));
     return s;
   }
@@ -358,7 +352,7 @@ private:
       return "its tool has no diameter";
     auto it = shapes_.find(s.feature->symbol);
     if (it == shapes_.end())
-      it = shapes_.emplace(s.feature->symbol, featureShape(module_, *s.feature)).first;
+      it = shapes_.emplace(s.feature->symbol, ir::featureShape(module_, *s.feature)).first;
     if (!it->second.shape)
       return it->second.error;
     s.shape = &*it->second.shape;
@@ -387,14 +381,14 @@ private:
     if (s.moves.empty())
       return;
     std::vector<Offence> offences;
-    const Move &first = s.moves.front();
+    const ir::Move &first = s.moves.front();
     if (!first.from && (first.isFeed() || first.to.z() < s.secplane - s.tol))
       offences.push_back(
           {first.node, "the first move starts from an unknown position: it must be a rapid ending "
                        "at or above the security plane z=" +
                            mm(s.secplane) + ", not a " + first.node->kindName() + " to " + pointText(first.to)});
     if (s.movesNode->number("spindle").value_or(0.0) == 0)
-      for (const Move &m : s.moves)
+      for (const ir::Move &m : s.moves)
         if (m.isFeed()) {
           offences.push_back({m.node, "feed move with the spindle stopped (spindle=0 on its moves)"});
           break;
@@ -405,7 +399,7 @@ private:
     std::vector<Offence> rapids;
     // Bores this step has cut along the tool axis, by position: their lowest point.
     std::vector<std::pair<Vec2, double>> bores;
-    for (const Move &m : s.moves) {
+    for (const ir::Move &m : s.moves) {
       if (m.isFeed() && m.from && (m.to.head<2>() - m.from->head<2>()).norm() <= s.tol && m.to.z() < m.from->z()) {
         auto bore = std::find_if(bores.begin(), bores.end(), [&](const auto &b) {
           return (b.first - m.to.head<2>()).norm() <= s.tol;
@@ -415,7 +409,7 @@ private:
         else
           bore->second = std::min(bore->second, m.to.z());
       }
-      if (m.kind == MoveKind::Rapid && m.from && !rapidSafe(s, m, bores))
+      if (m.kind == ir::MoveKind::Rapid && m.from && !rapidSafe(s, m, bores))
         rapids.push_back({m.node, "rapid from " + pointText(*m.from) + " to " + pointText(m.to) +
                                       " below the security plane z=" + mm(s.secplane) +
                                       (s.shape ? " and not along the tool axis above " + s.shape->symbol
@@ -433,7 +427,7 @@ private:
   /// tool leaves through the space its own body fills) or downwards ending in
   /// the free space above the feature, or above the bottom of a bore this
   /// step has already cut there (back into a drilled hole between pecks).
-  bool rapidSafe(const Step &s, const Move &m, const std::vector<std::pair<Vec2, double>> &bores) const {
+  bool rapidSafe(const Step &s, const ir::Move &m, const std::vector<std::pair<Vec2, double>> &bores) const {
     const double low = std::min(m.from->z(), m.to.z());
     if (low >= s.secplane - s.tol)
       return true;
@@ -451,7 +445,7 @@ private:
   /// top, or the top of an island standing higher within reach of the tool.
   double clearHeight(const Step &s, const Vec2 &xy) const {
     double z = s.shape->top;
-    for (const IslandShape &island : s.shape->islands) {
+    for (const ir::IslandShape &island : s.shape->islands) {
       if (island.top <= z)
         continue;
       const bool near = island.region.contains(xy) ||
@@ -472,7 +466,7 @@ private:
       return;
     }
     std::vector<Cut> cuts;
-    for (const Move &m : s.moves)
+    for (const ir::Move &m : s.moves)
       if (m.isFeed() && m.from && std::min(m.from->z(), m.to.z()) < s.shape->top - s.tol)
         cuts.push_back(cutOf(m));
     checkGouge(s, cuts);
@@ -484,7 +478,7 @@ private:
     const double floor = s.shape->bottom + s.allowanceBottom;
     const double lowest = floor - throughAllowance(s);
     std::vector<Offence> offences;
-    for (const Move &m : s.moves) {
+    for (const ir::Move &m : s.moves) {
       const double low = m.from ? std::min(m.from->z(), m.to.z()) : m.to.z();
       if (low < lowest - s.tol)
         offences.push_back(
@@ -496,11 +490,11 @@ private:
   }
 
   /// How far below the floor a through bottom lets the tool go: its point
-  /// (passes::pointLength) plus the operation's overcut, at least 1 mm.
+  /// (ir::pointLength) plus the operation's overcut, at least 1 mm.
   double throughAllowance(const Step &s) const {
     if (s.feature->text("bottom") != "through")
       return 0;
-    const double point = pointLength(*s.tool);
+    const double point = ir::pointLength(*s.tool);
     const double overcut = s.op ? s.op->number("overcut").value_or(0.0) : 0.0;
     return point + std::max(kThroughOvercut, overcut);
   }
@@ -515,7 +509,7 @@ private:
       offences.push_back({s.exec, "tool " + s.tool->symbol + " of diameter " + mm(2 * s.radius) +
                                       " is wider than " + s.shape->symbol + " (diameter " +
                                       mm(s.shape->holeDiameter) + ")"});
-    for (const Move &m : s.moves) {
+    for (const ir::Move &m : s.moves) {
       if (!m.from || std::min(m.from->z(), m.to.z()) >= s.shape->top - s.tol)
         continue;
       const double off = farthestFrom(m, axis);
@@ -527,7 +521,7 @@ private:
   }
 
   /// The largest distance in the plane from p to the move.
-  static double farthestFrom(const Move &m, const Vec2 &p) {
+  static double farthestFrom(const ir::Move &m, const Vec2 &p) {
     double d = std::max((m.from->head<2>() - p).norm(), (m.to.head<2>() - p).norm());
     for (const Seg &seg : m.planar()) {
       if (!seg.isArc())
@@ -605,7 +599,7 @@ private:
     // Required toolpaths run as the file writes them: where they enter a
     // wall (a finishing path compensated for tool deflection does, by its
     // offset), stepnc warns but does not refuse the file.
-    if (runsAsWritten(*s.exec)) {
+    if (ir::runsAsWritten(*s.exec)) {
       for (Offence &o : offences)
         o.message += " (a required toolpath of the file, run as written)";
       report(s, offences, "gouges of required toolpaths", /*warning=*/true);
@@ -706,7 +700,7 @@ private:
           std::any_of(floors.begin(), floors.end(), [](const Floor &f) { return f.finishing; });
       if (floors.size() < 2 || !finished)
         continue;
-      const FeatureShape &shape = *shapes_.at(symbol).shape;
+      const ir::FeatureShape &shape = *shapes_.at(symbol).shape;
       try {
         checkFeature(shape, floors);
       } catch (const std::exception &e) {
@@ -715,7 +709,7 @@ private:
     }
   }
 
-  void checkFeature(const FeatureShape &shape, const std::vector<Floor> &floors) {
+  void checkFeature(const ir::FeatureShape &shape, const std::vector<Floor> &floors) {
     double radius = floors.front().radius, lowest = floors.front().z;
     std::vector<Region> swept;
     for (const Floor &f : floors) {
@@ -723,13 +717,13 @@ private:
       lowest = std::min(lowest, f.z);
       swept.push_back(f.swept);
     }
-    const double tol = tolerance_.value_or(workpieceTolerance(findFeature(module_, shape.symbol)));
+    const double tol = tolerance_.value_or(workpieceTolerance(ir::findFeature(module_, shape.symbol)));
     const Region &reach = cache_.reachable(shape, radius, 0, islandsAbove(shape, lowest, tol));
     const double uncut = geom::subtract(reach, geom::uniteAll(swept)).area();
     const double targetArea = shape.target.area();
     if (!(uncut > kUncutShare * targetArea))
       return;
-    const ir::Node *feature = findFeature(module_, shape.symbol);
+    const ir::Node *feature = ir::findFeature(module_, shape.symbol);
     auto d =
         diags_.error(feature->origin.loc, "feature " + shape.symbol + ": rough + finish leave " + mm2(uncut) +
                                               " (" + formatFixed(100 * uncut / targetArea, 3) + " %) uncut");
@@ -782,7 +776,7 @@ private:
   const unsigned errorsBefore_ = diags_.errorCount();
   bool changed_ = false;
   std::map<std::string, const ir::Node *, std::less<>> tools_;
-  std::map<std::string, ShapeResult> shapes_;
+  std::map<std::string, ir::ShapeResult> shapes_;
   std::map<std::string, std::vector<Floor>> floors_;
   RegionCache cache_;
   /// Distance indexes of cached regions' boundaries (the cache never moves its regions).

@@ -1,8 +1,8 @@
 #include "backends/common/Program.h"
 
 #include "ir/Kinds.h"
-#include "passes/FeatureShape.h"
-#include "passes/MoveWalk.h"
+#include "ir/geom/FeatureShape.h"
+#include "ir/geom/MoveWalk.h"
 
 #include <cmath>
 #include <map>
@@ -98,7 +98,7 @@ public:
     for (const ir::Node &n : module_.root.children)
       if (n.kind == ir::Kind::Workpiece && !program_.blank)
         blank(n);
-    for (const ir::Node *e : passes::programOrder(module_))
+    for (const ir::Node *e : ir::programOrder(module_))
       executable(*e);
     if (!ok_)
       return std::nullopt;
@@ -110,7 +110,7 @@ private:
     const ir::Node *raw = workpiece.child(ir::Kind::Rawpiece);
     if (!raw || raw->text("shape") != "block" || !raw->has("size"))
       return;
-    auto frame = passes::planeFrame(*raw);
+    auto frame = ir::planeFrame(*raw);
     if (!frame.frame)
       return;
     const Vec3 size = *raw->vec("size");
@@ -150,22 +150,21 @@ private:
     Step s;
     s.exec = &e;
     s.label = e.label.empty() ? e.symbol : e.label;
-    for (const ir::Node &c : e.children)
-      if (ir::isOperation(c.kind))
-        s.operation = c.kind;
+    if (const ir::Node *op = ir::operationOf(e))
+      s.operation = op->kind;
     s.tool = toolIndex(*moves);
     s.spindle = moves->number("spindle").value_or(0);
     s.coolant = moves->text("coolant").value_or("off");
     s.secplane = moves->number("secplane").value_or(0);
-    // The moves as every reader of the toolpath IR sees them (passes/MoveWalk).
-    for (const passes::Move &m : passes::walkMoves(*moves, position_)) {
+    // The moves as every reader of the toolpath IR sees them (ir/geom/MoveWalk).
+    for (const ir::Move &m : ir::walkMoves(*moves, position_)) {
       Move mv;
       mv.node = m.node;
       mv.from = m.from.value_or(position_);
       mv.to = m.to;
       mv.role = m.role;
-      mv.kind = m.kind == passes::MoveKind::Rapid   ? Move::Kind::Rapid
-                : m.kind == passes::MoveKind::Arc ? Move::Kind::Arc
+      mv.kind = m.kind == ir::MoveKind::Rapid   ? Move::Kind::Rapid
+                : m.kind == ir::MoveKind::Arc ? Move::Kind::Arc
                                                   : Move::Kind::Linear;
       mv.feed = m.feed;
       mv.smooth = mv.kind == Move::Kind::Linear && m.node && m.node->flag("smooth").value_or(false);
@@ -177,8 +176,8 @@ private:
     if (!s.moves.empty())
       position_ = s.moves.back().to;
     if (auto kind = cycleKindOf(s.operation)) {
-      const ir::Node *feature = passes::findFeature(module_, e.text("feature").value_or(""));
-      auto frame = feature ? passes::planeFrame(*feature) : passes::FrameResult{};
+      const ir::Node *feature = ir::findFeature(module_, e.text("feature").value_or(""));
+      auto frame = feature ? ir::planeFrame(*feature) : ir::FrameResult{};
       if (frame.frame)
         s.cycle = recogniseCycle(s, *kind, frame.frame->z);
     }
@@ -189,10 +188,7 @@ private:
     const std::string symbol = moves.text("tool").value_or("");
     if (auto it = toolIndex_.find(symbol); it != toolIndex_.end())
       return it->second;
-    const ir::Node *tool = nullptr;
-    for (const ir::Node &n : module_.root.children)
-      if (n.kind == ir::Kind::Tool && n.symbol == symbol)
-        tool = &n;
+    const ir::Node *tool = ir::findTool(module_, symbol);
     if (!tool)
       return -1;  // the IR verifier reports dangling references
     ToolCall t;

@@ -2,7 +2,7 @@
 // wrote) in the native motion format of runtime/NativeFormat.h, for open
 // controllers that play time-parameterised segments themselves.
 #include "backends/Backend.h"
-#include "passes/MotionIR.h"
+#include "ir/motion/MotionIR.h"
 #include "runtime/NativeFormat.h"
 
 namespace stepnc::backends {
@@ -23,7 +23,7 @@ public:
 
   std::optional<std::string> emit(const ir::Module &module, const EmitOptions &options,
                                   DiagnosticEngine &diags) override {
-    auto trajectory = passes::readMotion(module, diags);
+    auto trajectory = ir::readMotion(module, diags);
     if (!trajectory)
       return std::nullopt;
     return runtime::writeNative(*trajectory, options.source);

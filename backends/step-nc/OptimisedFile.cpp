@@ -15,7 +15,7 @@
 #include "frontend/lowering/Lowering.h"
 #include "frontend/part21/Writer.h"
 #include "ir/Kinds.h"
-#include "passes/FeatureShape.h"
+#include "ir/geom/FeatureShape.h"
 
 #include <algorithm>
 #include <array>
@@ -32,7 +32,7 @@ namespace {
 using ir::Node;
 using ir::Vec3;
 using p21::InstanceId;
-using passes::PlaneFrame;
+using ir::PlaneFrame;
 
 constexpr double kTwoPi = 2 * std::numbers::pi;
 /// Units in the last place searched either side of a first guess for a value
@@ -69,7 +69,7 @@ std::vector<double> around(double x) {
 
 /// `p` (workpiece coordinates) in the frame `f`: the local point that
 /// expand-strategies maps back to exactly `p` where one is found.
-Vec3 localPoint(const PlaneFrame &f, const Vec3 &p) {
+Vec3 localPoint(const ir::PlaneFrame &f, const Vec3 &p) {
   const geom::Vec2 d = p.head<2>() - f.origin;
   const double lx = d.dot(f.x), ly = d.dot(f.y);
   const double lz = preimage(p.z(), p.z() - f.z, [&](double z) { return f.z + z; });
@@ -158,7 +158,7 @@ public:
   /// The TOOLPATH_LIST of `ws`'s `moves`, in the frame of its feature; none
   /// (after an error) when a move cannot be written, or (silently) when the
   /// moves are a single positioning.
-  std::optional<InstanceId> write(const Node &ws, const Node &moves, const PlaneFrame &frame,
+  std::optional<InstanceId> write(const Node &ws, const Node &moves, const ir::PlaneFrame &frame,
                                   const std::string &feedReference) {
     ws_ = &ws;
     frame_ = &frame;
@@ -249,7 +249,7 @@ private:
 
   /// An arc from `from` as a trimmed circle, or a trimmed helix when it changes height.
   bool arc(const Vec3 &from, const Node &m, std::string_view type, double feed) {
-    const PlaneFrame &f = *frame_;
+    const ir::PlaneFrame &f = *frame_;
     const Vec3 a = localPoint(f, from), b = localPoint(f, *m.vec("to"));
     const Vec3 centre = *m.vec("center");
     const Vec3 c = localPoint(f, Vec3(centre.x(), centre.y(), from.z()));
@@ -269,7 +269,7 @@ private:
       basis = out_.add("CIRCLE", "''," + Instances::ref(out_.placement(c)) + ',' + Instances::real(radius));
     } else {
       // The pitch that gives back the turns: lowering counts them from the
-      // rise, the pitch and the last partial arc (passes/Curves.cpp).
+      // rise, the pitch and the last partial arc (ir/geom/Curves.cpp).
       double partial = std::atan2(b.y() - c.y(), b.x() - c.x()) - std::atan2(a.y() - c.y(), a.x() - c.x());
       partial = std::fmod(std::fmod(partial, kTwoPi) + kTwoPi, kTwoPi);
       if (!ccw && partial > 0)
@@ -316,7 +316,7 @@ private:
   Instances &out_;
   DiagnosticEngine &diags_;
   const Node *ws_ = nullptr;
-  const PlaneFrame *frame_ = nullptr;
+  const ir::PlaneFrame *frame_ = nullptr;
   double spindle_ = 0;
   std::string feedReference_;
   Run run_;
@@ -324,13 +324,6 @@ private:
   std::map<std::tuple<double, double, std::string>, InstanceId> technologies_;
   bool failed_ = false;
 };
-
-const Node *operationOf(const Node &ws) {
-  for (const Node &c : ws.children)
-    if (ir::isOperation(c.kind))
-      return &c;
-  return nullptr;
-}
 
 /// Every machining workingstep with moves, in program order.
 void workingsteps(const Node &n, std::vector<const Node *> &out) {
@@ -411,8 +404,8 @@ std::string writeOptimisedPart21(const p21::Part21File &input, const ir::Module 
   std::vector<const Node *> steps;
   workingsteps(module.root, steps);
   for (const Node *ws : steps) {
-    const Node *op = operationOf(*ws);
-    const Node *feature = passes::findFeature(module, ws->text("feature").value_or(""));
+    const Node *op = ir::operationOf(*ws);
+    const Node *feature = ir::findFeature(module, ws->text("feature").value_or(""));
     if (!op || !feature || op->origin.entityId == 0)
       continue;
     if (auto [it, fresh] = writtenBy.emplace(op->origin.entityId, ws); !fresh) {
@@ -424,7 +417,7 @@ std::string writeOptimisedPart21(const p21::Part21File &input, const ir::Module 
       ok = false;
       continue;
     }
-    const passes::FrameResult frame = passes::planeFrame(*feature);
+    const ir::FrameResult frame = ir::planeFrame(*feature);
     if (!frame.frame) {
       diags.error(ws->origin.loc, "workingstep " + ws->symbol + ": " + frame.error).entity(ws->origin.entityId);
       ok = false;

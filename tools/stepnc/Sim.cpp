@@ -3,8 +3,8 @@
 // reaches, where and why it is slower, and any limit it breaks. IN may be the
 // native format, IR text (with motion, or moves to plan) or STEP-NC (compiled
 // to moves and planned first).
-#include "passes/MotionIR.h"
-#include "passes/MoveWalk.h"
+#include "ir/motion/MotionIR.h"
+#include "ir/geom/MoveWalk.h"
 #include "runtime/Machine.h"
 #include "runtime/NativeFormat.h"
 #include "runtime/Player.h"
@@ -54,7 +54,7 @@ int runSim(const SimCommandOptions &opts) {
 
   std::optional<runtime::Trajectory> trajectory;
   std::unique_ptr<ir::Module> module;
-  std::optional<passes::ProgramPath> program;
+  std::optional<ir::ProgramPath> program;
   if (source->text().starts_with("STEPNC-MOTION")) {
     trajectory = runtime::readNative(*source, diags);
   } else {
@@ -68,7 +68,7 @@ int runSim(const SimCommandOptions &opts) {
       return usage ? kExitUsage : kExitDiagnostics;
     // Whatever the input lacks is made: moves, then the motion.
     bool hasMoves = false, hasMotion = false;
-    for (const ir::Node *e : passes::programOrder(*module)) {
+    for (const ir::Node *e : ir::programOrder(*module)) {
       hasMoves |= e->child(ir::Kind::Moves) != nullptr;
       hasMotion |= e->child(ir::Kind::Motion) != nullptr;
     }
@@ -85,8 +85,8 @@ int runSim(const SimCommandOptions &opts) {
     if (!pipeline.empty())
       if (const int rc = runPipeline(*module, pipeline, {}, diags); rc != kExitOk)
         return rc;
-    trajectory = passes::readMotion(*module, diags);
-    program = passes::programPath(*module);
+    trajectory = ir::readMotion(*module, diags);
+    program = ir::programPath(*module);
   }
   if (!trajectory || diags.hasErrors()) {
     std::cerr << "stepnc: cannot simulate " << opts.input << '\n';

@@ -3,7 +3,7 @@
 // than its walls, and its invariants on every corpus file that reaches the
 // toolpath IR.
 #include "passes/CuttingModel.h"
-#include "passes/MotionIR.h"
+#include "ir/motion/MotionIR.h"
 
 #include "tests/unit/TestSupport.h"
 #include "tests/unit/ir/SampleModule.h"
@@ -76,7 +76,7 @@ TEST_CASE("adapt-feed: a wall at constant radial depth gets the chip-thinning fe
     // The piece along the middle of the wall (the ends, where the tool enters
     // and leaves the block, take less).
     double middle = 0;
-    for (const Move &m : walkMoves(*ir::test::find(p.module->root, "@ws").child(ir::Kind::Moves)))
+    for (const ir::Move &m : ir::walkMoves(*ir::test::find(p.module->root, "@ws").child(ir::Kind::Moves)))
       if (m.isFeed() && m.from && !m.changesHeight() && m.from->x() < 50 && m.to.x() > 50)
         middle = m.feed;
     INFO("ae " << ae << " feeds " << f.size());
@@ -102,7 +102,7 @@ TEST_CASE("adapt-feed: pocket corners get lower feeds than the walls", "[adapt-f
   // the ring inside it; coming into a corner it meets the side ahead too, so
   // the engagement and the chip factor rise and the feed must drop.
   double wallLow = 1e9, cornerLow = 1e9;
-  for (const Move &m : walkMoves(moves)) {
+  for (const ir::Move &m : ir::walkMoves(moves)) {
     if (!m.isFeed() || !m.from || m.changesHeight() || std::abs(m.to.z() + 10) > 1e-6)
       continue;
     auto onRing = [](const Vec3 &q) {

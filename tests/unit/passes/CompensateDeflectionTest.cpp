@@ -73,7 +73,7 @@ TEST_CASE("compensate-deflection: a wall at constant radial depth is offset by t
   // predicted end on the nominal line.
   const Node &moves = *ir::test::find(p.module->root, "@ws").child(ir::Kind::Moves);
   const Node *middle = nullptr;
-  for (const Move &m : walkMoves(moves))
+  for (const ir::Move &m : ir::walkMoves(moves))
     if (m.isFeed() && m.from && !m.changesHeight() && m.from->x() < 50 && m.to.x() > 50)
       middle = m.node;
   REQUIRE(middle);
@@ -140,7 +140,7 @@ TEST_CASE("compensate-deflection: an offset above the limit lowers the feed", "[
   const ir::Module before = *p.module;
   REQUIRE(test::runPipeline(*p.module, "compensate-deflection<max-offset=" + std::to_string(limit) + ">"));
   double lowest = 1e9;
-  for (const Move &m : walkMoves(*ir::test::find(p.module->root, "@ws").child(ir::Kind::Moves)))
+  for (const ir::Move &m : ir::walkMoves(*ir::test::find(p.module->root, "@ws").child(ir::Kind::Moves)))
     if (m.isFeed())
       lowest = std::min(lowest, m.feed);
   INFO("limit " << limit << " mm, full offset " << full << " mm");

@@ -7,7 +7,7 @@
 // passing, and no place where the machine runs below half its feed that the
 // nominal program does not have.
 #include "passes/CuttingModel.h"
-#include "passes/MotionIR.h"
+#include "ir/motion/MotionIR.h"
 
 #include "tests/unit/TestSupport.h"
 #include "tests/unit/passes/DeflectionCheck.h"
@@ -34,7 +34,7 @@ const char *const kFiles[] = {
     "jucsr__sanssouci/oneHoleOneSlotOneStepOnePoket.p21",
     "unseenlaser__iso-14649-toolkit/ex1.stp",
     // Not ex1E.stp: its explicit toolpaths are required (its_priority), so
-    // the cutting passes leave them as written (passes::runsAsWritten;
+    // the cutting passes leave them as written (ir::runsAsWritten;
     // tests/passes/adapt-feed/required-toolpaths.test checks that).
 };
 
@@ -103,7 +103,7 @@ void checkInvariants(const std::string &path, const cutting::CuttingData &data, 
   // Feeds: every piece of a move at or below its programmed feed, and at
   // most 1 mm/min (feeds are whole mm/min) above the highest speed the
   // machine reaches on it.
-  const ProgramPath before = programPath(programmed), after = programPath(adapted);
+  const ir::ProgramPath before = ir::programPath(programmed), after = ir::programPath(adapted);
   const runtime::Trajectory plan = runtime::plan(after.path, machine);
   std::vector<double> cap(after.path.moves.size(), 0);
   for (size_t k = 0; k < plan.segments.size(); ++k)

@@ -32,7 +32,7 @@ inline DeflectionCheck checkDeflection(const ir::Module &before, const ir::Modul
   DeflectionCheck out;
   const CutAnalysis analysis = analyseCuts(before, {&data, nullptr});
   std::vector<const ir::Node *> moved;
-  for (const ir::Node *e : programOrder(after))
+  for (const ir::Node *e : ir::programOrder(after))
     if (const ir::Node *m = e->child(ir::Kind::Moves))
       moved.push_back(m);
   if (moved.size() != analysis.steps.size()) {
@@ -43,8 +43,8 @@ inline DeflectionCheck checkDeflection(const ir::Module &before, const ir::Modul
     const CutStep &step = analysis.steps[i];
     if (!finishesWalls(step) || !step.tool || !step.tool->mill || !step.material)
       continue;
-    const std::vector<Move> programmed = walkMoves(*moved[i]);
-    const std::vector<Move> predicted = walkMoves(*moved[i], std::nullopt, PathKind::Predicted);
+    const std::vector<ir::Move> programmed = ir::walkMoves(*moved[i]);
+    const std::vector<ir::Move> predicted = ir::walkMoves(*moved[i], std::nullopt, ir::PathKind::Predicted);
     const double perFz = step.cutter.flutes * step.spindle; // mm/min per mm of fz
     for (const CutMove &cm : step.moves)
       for (const CutSample &s : cm.samples) {
@@ -54,7 +54,7 @@ inline DeflectionCheck checkDeflection(const ir::Module &before, const ir::Modul
         const double z = cm.move.to.z();
         size_t found = predicted.size();
         for (size_t j = 0; j < predicted.size() && found == predicted.size(); ++j) {
-          const Move &m = predicted[j];
+          const ir::Move &m = predicted[j];
           if (!m.isFeed() || !m.from || m.changesHeight() || std::abs(m.to.z() - z) > 1e-9)
             continue;
           for (const geom::Seg &seg : m.planar())
@@ -70,10 +70,10 @@ inline DeflectionCheck checkDeflection(const ir::Module &before, const ir::Modul
         // Where the programmed move runs beside the sample, along the
         // wall's normal: a line where it crosses the normal (its offset
         // may change along it), an arc at its radius about its centre.
-        const Move &p = programmed[found];
+        const ir::Move &p = programmed[found];
         const geom::Vec2 n = s.intoWall();
         double offset = 0;
-        if (p.kind == MoveKind::Arc) {
+        if (p.kind == ir::MoveKind::Arc) {
           // s.at + offset n on the circle: the root nearest the sample.
           const geom::Vec2 w = s.at - p.center.head<2>();
           const double r = (p.to - p.center).head<2>().norm(), half = w.dot(n);

@@ -12,7 +12,7 @@
 //     between plunges no higher than the pitch implies, the verifier passing;
 //   - errors for motifs that cannot work.
 #include "cutting/Mechanics.h"
-#include "passes/MoveWalk.h"
+#include "ir/geom/MoveWalk.h"
 #include "passes/PatternPaths.h"
 
 #include "tests/unit/passes/PassTestSupport.h"
@@ -35,7 +35,7 @@ constexpr double kPi = std::numbers::pi;
 std::string example(const char *name) { return std::string(STEPNC_SOURCE_DIR) + "/examples/patterns/" + name; }
 
 const ir::Node &movesOf(const ir::Module &m) {
-  for (const ir::Node *exec : programOrder(m))
+  for (const ir::Node *exec : ir::programOrder(m))
     if (const ir::Node *moves = exec->child(ir::Kind::Moves))
       return *moves;
   FAIL("no moves");
@@ -53,16 +53,16 @@ double uncutPercent(const ir::Node &moves) {
 /// The trochoid: the run of feed moves in the plane that follows the first
 /// helical entry (a helix and a turn at the bottom), up to the first move
 /// that is not a cut.
-std::vector<Move> trochoidRun(const std::vector<Move> &moves) {
-  std::vector<Move> run;
+std::vector<ir::Move> trochoidRun(const std::vector<ir::Move> &moves) {
+  std::vector<ir::Move> run;
   bool entered = false;
-  for (const Move &m : moves) {
-    const bool entry = m.kind == MoveKind::Arc && m.role == "plunge";
+  for (const ir::Move &m : moves) {
+    const bool entry = m.kind == ir::MoveKind::Arc && m.role == "plunge";
     if (!entered || entry) {
       entered = entered || entry;
       continue;
     }
-    if (m.role != "cut" || m.kind != MoveKind::Linear)
+    if (m.role != "cut" || m.kind != ir::MoveKind::Linear)
       break;
     run.push_back(m);
   }
@@ -96,9 +96,9 @@ Smoothness smoothness(const std::vector<Vec2> &pts) {
   return s;
 }
 
-std::vector<Vec2> pointsOf(const std::vector<Move> &run) {
+std::vector<Vec2> pointsOf(const std::vector<ir::Move> &run) {
   std::vector<Vec2> pts{run.front().from->head<2>()};
-  for (const Move &m : run)
+  for (const ir::Move &m : run)
     pts.push_back(m.to.head<2>());
   return pts;
 }
@@ -112,7 +112,7 @@ std::vector<Vec2> pointsOf(const std::vector<Move> &run) {
 /// the stock to show the step (it is known to half a cell), near enough
 /// that the chord's direction is the tangent's (the loops turn by about
 /// 3 deg per 0.15 mm).
-double measuredEngagement(const std::vector<Move> &troch, const Vec2 &start, double loop, double radius,
+double measuredEngagement(const std::vector<ir::Move> &troch, const Vec2 &start, double loop, double radius,
                           const geom::Box &box) {
   const double z = troch.front().to.z(), cell = 0.05;
   cutting::HeightMap stock(box, cell);
@@ -122,7 +122,7 @@ double measuredEngagement(const std::vector<Move> &troch, const Vec2 &start, dou
   cutter.radius = radius;
   double largest = 0;
   for (size_t i = 0; i + 1 < troch.size(); ++i) {
-    const Move &next = troch[i + 1];
+    const ir::Move &next = troch[i + 1];
     const Vec2 dir = (next.to - *next.from).head<2>().normalized();
     const Vec2 at = next.from->head<2>() + dir * std::min(3 * cell, (next.to - *next.from).norm());
     largest = std::max(largest, cutting::measureEngagement(stock, at, z, dir, cutter).angle());
@@ -137,7 +137,7 @@ double measuredEngagement(const std::vector<Move> &troch, const Vec2 &start, dou
 /// default target is 90 deg; the loops of later guide paths cut beside
 /// what earlier ones cleared), + 2 deg for the height field's resolution.
 void checkPocketTrochoid(const ir::Node &moves, size_t lines) {
-  const std::vector<Move> troch = trochoidRun(walkMoves(moves));
+  const std::vector<ir::Move> troch = trochoidRun(ir::walkMoves(moves));
   const Smoothness s = smoothness(pointsOf(troch));
   INFO("largest turn " << s.largestTurn * 180 / kPi << " deg, jump " << s.largestJump << " /mm");
   CHECK(troch.size() > lines);
@@ -223,8 +223,8 @@ TEST_CASE("pattern: a trochoidal slot is one smooth curve as wide as 2 (R_t + R)
   CHECK(uncutPercent(moves) < 0.1);
   CHECK(moves.comment.find("gouge 0.000 mm2") != std::string::npos);
 
-  const std::vector<Move> all = walkMoves(moves);
-  const std::vector<Move> troch = trochoidRun(all);
+  const std::vector<ir::Move> all = ir::walkMoves(moves);
+  const std::vector<ir::Move> troch = trochoidRun(all);
   REQUIRE(troch.size() > 1000);
   const std::vector<Vec2> pts = pointsOf(troch);
   const Smoothness s = smoothness(pts);
@@ -250,7 +250,7 @@ TEST_CASE("pattern: a trochoid's measured engagement stays within the pass's tar
   CHECK(run(*l.module, "resolve-feeds,expand-strategies<max-engagement=60>").empty());
   const ir::Node &moves = movesOf(*l.module);
   CHECK(moves.comment.find("lowered: engagement at most 60.0 deg") != std::string::npos);
-  const std::vector<Move> troch = trochoidRun(walkMoves(moves));
+  const std::vector<ir::Move> troch = trochoidRun(ir::walkMoves(moves));
   REQUIRE(troch.size() > 1000);
   const double largest = measuredEngagement(troch, {20, 30}, 2.8, 5, {{0, 0}, {100, 60}});
   INFO("largest engagement " << largest * 180 / kPi << " deg");
@@ -294,7 +294,7 @@ TEST_CASE("pattern: plunges go along the tool axis, link above the material, lea
     CHECK(uncutPercent(moves) < 0.1);
     CHECK(moves.comment.find("gouge 0.000 mm2") != std::string::npos);
     const ir::Node *strategy = nullptr;
-    for (const ir::Node *exec : programOrder(*l.module))
+    for (const ir::Node *exec : ir::programOrder(*l.module))
       for (const ir::Node &c : exec->children)
         if (const ir::Node *p = c.child(ir::Kind::PlungeStrategy))
           strategy = p;
@@ -303,10 +303,10 @@ TEST_CASE("pattern: plunges go along the tool axis, link above the material, lea
 
     // The plunges: every axial move down before the contour along the walls.
     std::vector<Vec2> plunges;
-    for (const Move &m : walkMoves(moves)) {
+    for (const ir::Move &m : ir::walkMoves(moves)) {
       if (m.role == "cut")
         break;
-      if (m.role == "plunge" && m.kind == MoveKind::Linear && m.from && m.to.z() < -1) {
+      if (m.role == "plunge" && m.kind == ir::MoveKind::Linear && m.from && m.to.z() < -1) {
         CHECK((m.to.head<2>() - m.from->head<2>()).norm() < 1e-9);
         plunges.push_back(m.to.head<2>());
       }

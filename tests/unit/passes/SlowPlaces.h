@@ -4,7 +4,7 @@
 // place (a corner, a stop, a step in the path).
 #pragma once
 
-#include "passes/MotionIR.h"
+#include "ir/motion/MotionIR.h"
 #include "runtime/Planner.h"
 #include "runtime/Player.h"
 #include "tests/unit/runtime/ShippedMachine.h"
@@ -19,7 +19,7 @@ namespace stepnc::test {
 /// The sampled positions where the program runs a feed move below
 /// `fraction` of its programmed feed.
 inline std::vector<ir::Vec3> slowPlaces(const ir::Module &module, const runtime::Machine &machine, double fraction) {
-  const passes::ProgramPath program = passes::programPath(module);
+  const ir::ProgramPath program = ir::programPath(module);
   const runtime::Trajectory trajectory = runtime::plan(program.path, machine);
   std::vector<ir::Vec3> out;
   runtime::simulate(trajectory, machine, {}, [&](const runtime::Sample &s) {

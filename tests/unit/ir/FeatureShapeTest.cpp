@@ -1,8 +1,8 @@
 // Feature shapes: the area each kind of feature asks to clear, with exact
 // areas worked out by hand.
-#include "passes/FeatureShape.h"
+#include "ir/geom/FeatureShape.h"
 
-#include "../ir/SampleModule.h"
+#include "SampleModule.h"
 
 #include <catch2/catch.hpp>
 
@@ -21,13 +21,13 @@ const std::string kHead = "project \"P\"\n"
 
 const std::string kZ = "axis=(0.000000,0.000000,1.000000) ref=(1.000000,0.000000,0.000000)";
 
-passes::ShapeResult shapeOf(const std::string &features, std::string_view symbol,
+ir::ShapeResult shapeOf(const std::string &features, std::string_view symbol,
                             std::unique_ptr<ir::Module> *keep = nullptr) {
   auto parsed = ir::test::parse(kHead + features);
   REQUIRE(parsed.errors.empty());
-  const ir::Node *f = passes::findFeature(*parsed.module, symbol);
+  const ir::Node *f = ir::findFeature(*parsed.module, symbol);
   REQUIRE(f);
-  passes::ShapeResult r = passes::featureShape(*parsed.module, *f);
+  ir::ShapeResult r = ir::featureShape(*parsed.module, *f);
   if (keep)
     *keep = std::move(parsed.module);
   return r;

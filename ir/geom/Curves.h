@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-namespace stepnc::passes {
+namespace stepnc::ir {
 
 /// A straight piece, or a circular (helical when `to` is at another height)
 /// piece about an axis parallel to z through `center`.
@@ -36,4 +36,4 @@ CurveResult curvePieces(const ir::Node &curve);
 /// The pieces as plane segments (z dropped). Full turns become full circles.
 std::vector<geom::Seg> planarSegs(const std::vector<CurvePiece> &pieces);
 
-} // namespace stepnc::passes
+} // namespace stepnc::ir

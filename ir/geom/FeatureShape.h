@@ -10,12 +10,13 @@
 
 #include "geom/Geometry.h"
 #include "ir/Node.h"
+#include "ir/Program.h"
 
 #include <optional>
 #include <string>
 #include <vector>
 
-namespace stepnc::passes {
+namespace stepnc::ir {
 
 /// A feature's frame in workpiece coordinates, restricted to the plane.
 struct PlaneFrame {
@@ -94,7 +95,4 @@ struct RawBlock {
 };
 std::optional<RawBlock> rawBlock(const ir::Node *workpiece);
 
-/// The feature node a symbol names, or null.
-const ir::Node *findFeature(const ir::Module &module, std::string_view symbol);
-
-} // namespace stepnc::passes
+} // namespace stepnc::ir

@@ -16,7 +16,7 @@
 #include <optional>
 #include <vector>
 
-namespace stepnc::passes {
+namespace stepnc::ir {
 
 /// Every move of the module in program order.
 struct ProgramPath {
@@ -39,4 +39,4 @@ void attachMotion(ir::Module &module, const ProgramPath &program, const runtime:
 /// node that is wrong); nullopt when there are none or one is wrong.
 std::optional<runtime::Trajectory> readMotion(const ir::Module &module, DiagnosticEngine &diags);
 
-} // namespace stepnc::passes
+} // namespace stepnc::ir

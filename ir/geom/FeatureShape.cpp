@@ -1,14 +1,14 @@
-#include "passes/FeatureShape.h"
+#include "ir/geom/FeatureShape.h"
 
 #include "geom/Boolean.h"
 #include "ir/Kinds.h"
-#include "passes/Curves.h"
+#include "ir/geom/Curves.h"
 #include "support/Format.h"
 
 #include <cmath>
 #include <numbers>
 
-namespace stepnc::passes {
+namespace stepnc::ir {
 
 namespace {
 
@@ -295,20 +295,6 @@ private:
   const Node *workpiece_;
 };
 
-const Node *findIn(const Node &n, std::string_view symbol, const Node **parent) {
-  for (const Node &c : n.children) {
-    if (c.symbol == symbol) {
-      if (parent)
-        *parent = &n;
-      return &c;
-    }
-    if (c.kind == ir::Kind::Workpiece)
-      if (const Node *found = findIn(c, symbol, parent))
-        return found;
-  }
-  return nullptr;
-}
-
 } // namespace
 
 FrameResult planeFrame(const ir::Node &placed) {
@@ -349,16 +335,8 @@ std::optional<RawBlock> rawBlock(const ir::Node *workpiece) {
   return block;
 }
 
-const ir::Node *findFeature(const ir::Module &module, std::string_view symbol) {
-  const Node *n = findIn(module.root, symbol, nullptr);
-  if (!n)
-    return nullptr;
-  return n->category() == ir::Category::Feature ? n : nullptr;
-}
-
 ShapeResult featureShape(const ir::Module &module, const ir::Node &feature) {
-  const Node *workpiece = nullptr;
-  findIn(module.root, feature.symbol, &workpiece);
+  const Node *workpiece = workpieceOf(module, feature);
   FrameResult fr = planeFrame(feature);
   if (!fr.frame)
     return {std::nullopt, fr.error};
@@ -409,4 +387,4 @@ ShapeResult featureShape(const ir::Module &module, const ir::Node &feature) {
   return {std::move(s), {}};
 }
 
-} // namespace stepnc::passes
+} // namespace stepnc::ir

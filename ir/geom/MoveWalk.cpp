@@ -7,7 +7,7 @@
 // rule: `turns` counts the turns *before* the last arc, so a full circle has
 // turns 0 and a helix of three whole turns down one axis position turns 2).
 // A change of height spreads evenly over the angle: a helix.
-#include "passes/MoveWalk.h"
+#include "ir/geom/MoveWalk.h"
 
 #include "ir/Kinds.h"
 
@@ -15,7 +15,7 @@
 #include <cmath>
 #include <numbers>
 
-namespace stepnc::passes {
+namespace stepnc::ir {
 
 namespace {
 
@@ -116,28 +116,6 @@ ir::Vec3 Move::pointAt(double s) const {
   return {p.x(), p.y(), a.z()};
 }
 
-namespace {
-
-void collectExecutables(const ir::Node &plan, std::vector<const ir::Node *> &out) {
-  for (const ir::Node &e : plan.children) {
-    if (e.kind == ir::Kind::Workplan)
-      collectExecutables(e, out);
-    else if (e.kind == ir::Kind::Workingstep || e.kind == ir::Kind::RapidMovement || e.kind == ir::Kind::ProgramStop ||
-             e.kind == ir::Kind::OptionalStop || e.kind == ir::Kind::DisplayMessage)
-      out.push_back(&e);
-  }
-}
-
-} // namespace
-
-std::vector<const ir::Node *> programOrder(const ir::Module &module) {
-  std::vector<const ir::Node *> out;
-  for (const ir::Node &n : module.root.children)
-    if (n.kind == ir::Kind::Workplan)
-      collectExecutables(n, out);
-  return out;
-}
-
 std::vector<Move> walkMoves(const ir::Node &moves, std::optional<ir::Vec3> start, PathKind path) {
   std::vector<Move> out;
   std::optional<ir::Vec3> at = start;
@@ -152,15 +130,4 @@ std::vector<Move> walkMoves(const ir::Node &moves, std::optional<ir::Vec3> start
   return out;
 }
 
-bool runsAsWritten(const ir::Node &executable) {
-  for (const ir::Node &c : executable.children)
-    if (ir::isOperation(c.kind)) {
-      const std::vector<const ir::Node *> toolpaths = c.childrenOf(ir::Kind::Toolpath);
-      return !toolpaths.empty() && std::all_of(toolpaths.begin(), toolpaths.end(), [](const ir::Node *tp) {
-        return tp->flag("required").value_or(true);
-      });
-    }
-  return false;
-}
-
-} // namespace stepnc::passes
+} // namespace stepnc::ir

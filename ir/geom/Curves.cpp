@@ -1,4 +1,4 @@
-#include "passes/Curves.h"
+#include "ir/geom/Curves.h"
 
 #include "support/Format.h"
 
@@ -6,7 +6,7 @@
 #include <cmath>
 #include <numbers>
 
-namespace stepnc::passes {
+namespace stepnc::ir {
 
 namespace {
 
@@ -204,4 +204,4 @@ std::vector<geom::Seg> planarSegs(const std::vector<CurvePiece> &pieces) {
   return out;
 }
 
-} // namespace stepnc::passes
+} // namespace stepnc::ir

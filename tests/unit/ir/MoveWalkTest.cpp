@@ -1,6 +1,6 @@
-// Tests of passes/MoveWalk.h: where each move starts, lengths of lines, arcs
+// Tests of ir/geom/MoveWalk.h: where each move starts, lengths of lines, arcs
 // and helices (worked out by hand), and what the moves are in the plane.
-#include "passes/MoveWalk.h"
+#include "ir/geom/MoveWalk.h"
 
 #include <catch2/catch.hpp>
 
@@ -8,7 +8,7 @@
 #include <numbers>
 
 using namespace stepnc;
-using namespace stepnc::passes;
+using namespace stepnc::ir;
 using ir::Node;
 using ir::Value;
 using ir::Vec3;
@@ -57,7 +57,7 @@ TEST_CASE("walkMoves knows where every move starts", "[verify][movewalk]") {
   arc(moves, Vec3(30, 0, 0), Vec3(20, 0, 0), false);
   moves.add(Node(ir::Kind::Motion));  // not a move: skipped
 
-  std::vector<Move> walk = walkMoves(moves);
+  std::vector<ir::Move> walk = ir::walkMoves(moves);
   REQUIRE(walk.size() == 4);
   CHECK_FALSE(walk[0].from);
   CHECK(walk[0].length() == 0);  // from an unknown position
@@ -71,13 +71,13 @@ TEST_CASE("walkMoves knows where every move starts", "[verify][movewalk]") {
   CHECK(walk[2].feed == 600);
   CHECK(walk[0].feed == 0);
   CHECK_FALSE(walk[0].isFeed());
-  CHECK(walk[3].kind == MoveKind::Arc);
+  CHECK(walk[3].kind == ir::MoveKind::Arc);
   CHECK_FALSE(walk[3].ccw);
   CHECK(walk[2].changesHeight());
   CHECK_FALSE(walk[3].changesHeight());
 
   // A known start makes the first move measurable.
-  std::vector<Move> known = walkMoves(moves, Vec3(0, 0, 20));
+  std::vector<ir::Move> known = ir::walkMoves(moves, Vec3(0, 0, 20));
   REQUIRE(known[0].from);
   CHECK(known[0].length() == Approx(30));
 }
@@ -92,7 +92,7 @@ TEST_CASE("lengths of lines, arcs and helices", "[verify][movewalk]") {
   arc(moves, Vec3(50, 40, -6), Vec3(40, 40, 0), false, 2);     // helix: 2 turns + 1/4 cw, down 6
   linear(moves, Vec3(50, 40, -10));                             // axial: 4
 
-  std::vector<Move> w = walkMoves(moves);
+  std::vector<ir::Move> w = ir::walkMoves(moves);
   REQUIRE(w.size() == 7);
   CHECK(w[1].length() == Approx(50));
   CHECK(w[2].length() == Approx(10 * kPi));
@@ -113,7 +113,7 @@ TEST_CASE("planar(): lines, axial moves, full circles and helices", "[verify][mo
   arc(moves, Vec3(10, 10, -9), Vec3(10, 0, 0), true, 2);       // helix: 2 turns then a quarter
   arc(moves, Vec3(10, 10, -12), Vec3(10, 0, 0), false, 2);     // 2 turns then a whole turn back to the start
 
-  std::vector<Move> w = walkMoves(moves);
+  std::vector<ir::Move> w = ir::walkMoves(moves);
   REQUIRE(w.size() == 6);
   CHECK(w[1].planar().empty());
   REQUIRE(w[2].planar().size() == 1);

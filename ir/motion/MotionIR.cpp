@@ -1,12 +1,12 @@
-#include "passes/MotionIR.h"
+#include "ir/motion/MotionIR.h"
 
-#include "passes/MoveWalk.h"
+#include "ir/geom/MoveWalk.h"
 #include "support/Format.h"
 
 #include <algorithm>
 #include <map>
 
-namespace stepnc::passes {
+namespace stepnc::ir {
 
 using runtime::PathMove;
 using runtime::Segment;
@@ -231,4 +231,4 @@ std::optional<runtime::Trajectory> readMotion(const ir::Module &module, Diagnost
   return out;
 }
 
-} // namespace stepnc::passes
+} // namespace stepnc::ir

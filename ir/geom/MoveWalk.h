@@ -6,12 +6,13 @@
 
 #include "geom/Geometry.h"
 #include "ir/Node.h"
+#include "ir/Program.h"
 
 #include <optional>
 #include <string>
 #include <vector>
 
-namespace stepnc::passes {
+namespace stepnc::ir {
 
 enum class MoveKind : uint8_t { Rapid, Linear, Arc };
 
@@ -54,16 +55,4 @@ enum class PathKind : uint8_t { Programmed, Predicted };
 std::vector<Move> walkMoves(const ir::Node &moves, std::optional<ir::Vec3> start = std::nullopt,
                             PathKind path = PathKind::Programmed);
 
-/// The executables the machine runs, in program order: every workingstep,
-/// rapid movement, program stop, optional stop and display message of the
-/// module's workplans, nested workplans flattened where they stand.
-std::vector<const ir::Node *> programOrder(const ir::Module &module);
-
-/// Whether an executable's moves are its operation's explicit toolpaths,
-/// every one of them required (ISO 14649 `its_priority`): they run as the
-/// file writes them: no pass changes their path, and adapt-feed changes a
-/// feed only to what the machine reaches on the move (which changes nothing
-/// the machine does).
-bool runsAsWritten(const ir::Node &executable);
-
-} // namespace stepnc::passes
+} // namespace stepnc::ir
