@@ -14,12 +14,12 @@ namespace {
 
 using T = ValueType;
 
-constexpr std::array<std::string_view, 18> kCategoryNames = {
-    "root",      "resource", "executable", "feature",  "island",   "profile",
-    "path",      "curve",    "point",      "segment",  "knot",     "operation",
-    "technology", "strategy", "toolpath",  "move",     "motion",   "motion_segment",
+constexpr std::array<std::string_view, 21> kCategoryNames = {
+    "root",     "resource", "executable", "feature",        "island", "profile", "path",
+    "curve",    "point",    "segment",    "knot",           "operation", "technology", "strategy",
+    "toolpath", "move",     "motion",     "motion_segment", "state",  "branch",  "expression",
 };
-static_assert(kCategoryNames.size() == static_cast<size_t>(Category::MotionSegment) + 1);
+static_assert(kCategoryNames.size() == static_cast<size_t>(Category::Expression) + 1);
 
 std::vector<KindSpec> makeTable() {
 #define ATTRS(...) std::vector<AttrSpec>{__VA_ARGS__}

@@ -32,6 +32,9 @@ enum class ValueType : uint8_t {
   Direction,  ///< (x,y,z) unit vector
   Real,       ///< a plain number written exactly (shortest round trip); planned motion
   Reals,      ///< (a,b,...) plain numbers written exactly
+  FeedPerRev, ///< mm/rev
+  Power,      ///< W
+  MassFlow,   ///< g/min (powder fed to a deposition head)
 };
 
 const char *valueTypeName(ValueType t);
@@ -58,6 +61,9 @@ enum class Category : uint8_t {
   Move,
   Motion,
   MotionSegment,
+  State,       ///< a change of process state among moves
+  Branch,      ///< a branch of control flow (then, else, branch)
+  Expression,  ///< a numeric or boolean expression
 };
 
 /// Facts about a kind that several layers need, declared with it in Kinds.def.
@@ -67,6 +73,8 @@ namespace Trait {
 // The process an operation belongs to.
 inline constexpr Traits Milling = 1u << 0;
 inline constexpr Traits HoleMaking = 1u << 1;  ///< drilling, reaming, boring, tapping, ... (ISO 14649-11 4.7)
+inline constexpr Traits Turning = 1u << 2;     ///< ISO 14649-12/121 (also on turned features)
+inline constexpr Traits Additive = 1u << 3;    ///< ISO 14649-17 deposition (also on added features)
 // Milling operations.
 inline constexpr Traits Roughing = 1u << 5;
 inline constexpr Traits Finishing = 1u << 6;
@@ -84,6 +92,9 @@ inline constexpr Traits Pocket = 1u << 20;
 inline constexpr Traits FaceFeature = 1u << 21;
 // Strategies.
 inline constexpr Traits PatternStrategy = 1u << 24;  ///< a motif along a guide strategy (trochoidal, plunge)
+// Program structure.
+inline constexpr Traits ControlFlow = 1u << 26;  ///< an executable whose course is decided when the program runs
+inline constexpr Traits Boolean = 1u << 27;      ///< an expression whose value is true or false
 } // namespace Trait
 
 enum class Kind : uint8_t {

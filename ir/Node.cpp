@@ -26,6 +26,9 @@ const char *valueTypeName(ValueType t) {
   case ValueType::Direction: return "direction";
   case ValueType::Real: return "number";
   case ValueType::Reals: return "number list";
+  case ValueType::FeedPerRev: return "feed per revolution";
+  case ValueType::Power: return "power";
+  case ValueType::MassFlow: return "mass flow";
   }
   return "value";
 }
@@ -129,7 +132,10 @@ std::optional<double> Node::number(std::string_view name) const {
   case ValueType::Spindle:
   case ValueType::Time:
   case ValueType::Ratio:
-  case ValueType::Real: return v->number;
+  case ValueType::Real:
+  case ValueType::FeedPerRev:
+  case ValueType::Power:
+  case ValueType::MassFlow: return v->number;
   case ValueType::Count: return static_cast<double>(v->count);
   default: return std::nullopt;
   }

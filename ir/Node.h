@@ -33,7 +33,7 @@ using Vec3 = Eigen::Vector3d;
 
 struct Value {
   ValueType type = ValueType::Length;
-  double number = 0;   ///< Length, Angle, Feed, Spindle, Time, Ratio
+  double number = 0;   ///< Length, Angle, Feed, Spindle, Time, Ratio, Real, FeedPerRev, Power, MassFlow
   int64_t count = 0;   ///< Count
   bool flag = false;   ///< Flag
   std::string text;    ///< Word, Text, Ref (with its sigil)
@@ -46,6 +46,9 @@ struct Value {
   static Value spindle(double revPerMin) { return makeNumber(ValueType::Spindle, revPerMin); }
   static Value time(double s) { return makeNumber(ValueType::Time, s); }
   static Value ratio(double r) { return makeNumber(ValueType::Ratio, r); }
+  static Value feedPerRev(double mmPerRev) { return makeNumber(ValueType::FeedPerRev, mmPerRev); }
+  static Value power(double watts) { return makeNumber(ValueType::Power, watts); }
+  static Value massFlow(double gPerMin) { return makeNumber(ValueType::MassFlow, gPerMin); }
   static Value integer(int64_t n);
   static Value boolean(bool b);
   static Value word(std::string w);

@@ -91,7 +91,10 @@ bool parseToken(std::string_view tok, const AttrSpec &a, Value &out) {
   case ValueType::Feed:
   case ValueType::Spindle:
   case ValueType::Time:
-  case ValueType::Ratio: return parseNumber(tok, a.type, out);
+  case ValueType::Ratio:
+  case ValueType::FeedPerRev:
+  case ValueType::Power:
+  case ValueType::MassFlow: return parseNumber(tok, a.type, out);
   case ValueType::Count:
     out = Value::integer(0);
     return parseInteger(tok, out.count);

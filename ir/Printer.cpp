@@ -16,8 +16,10 @@ constexpr std::string_view kHeader =
 int decimalsOf(ValueType t) {
   switch (t) {
   case ValueType::Feed:
-  case ValueType::Spindle: return 1;
-  case ValueType::Time: return 3;
+  case ValueType::Spindle:
+  case ValueType::Power: return 1;
+  case ValueType::Time:
+  case ValueType::MassFlow: return 3;
   case ValueType::Direction: return 6;
   default: return 4;
   }
@@ -104,6 +106,9 @@ std::string_view unitSuffix(ValueType t) {
   case ValueType::Feed: return "mm/min";
   case ValueType::Spindle: return "rev/min";
   case ValueType::Time: return "s";
+  case ValueType::FeedPerRev: return "mm/rev";
+  case ValueType::Power: return "W";
+  case ValueType::MassFlow: return "g/min";
   default: return {};
   }
 }
@@ -116,6 +121,9 @@ void printValue(const Value &v, std::string &out) {
   case ValueType::Spindle:
   case ValueType::Time:
   case ValueType::Ratio:
+  case ValueType::FeedPerRev:
+  case ValueType::Power:
+  case ValueType::MassFlow:
     out += formatFixed(v.number, decimalsOf(v.type));
     out += unitSuffix(v.type);
     break;
@@ -156,6 +164,9 @@ std::string describeValue(const AttrSpec &a) {
   case ValueType::Direction: return "a direction (x,y,z)";
   case ValueType::Real: return "a number";
   case ValueType::Reals: return "a list of numbers (a,b,...)";
+  case ValueType::FeedPerRev: return "a feed per revolution in mm/rev";
+  case ValueType::Power: return "a power in W";
+  case ValueType::MassFlow: return "a mass flow in g/min";
   }
   return "a value";
 }

@@ -11,7 +11,7 @@ void collectExecutables(const Node &plan, std::vector<const Node *> &out) {
     if (e.kind == Kind::Workplan)
       collectExecutables(e, out);
     else if (e.kind == Kind::Workingstep || e.kind == Kind::RapidMovement || e.kind == Kind::ProgramStop ||
-             e.kind == Kind::OptionalStop || e.kind == Kind::DisplayMessage)
+             e.kind == Kind::OptionalStop || e.kind == Kind::DisplayMessage || e.is(Trait::ControlFlow))
       out.push_back(&e);
   }
 }
@@ -32,7 +32,62 @@ const Node *findIn(const Node &n, std::string_view symbol, const Node **parent) 
   return nullptr;
 }
 
+std::string quotedKind(const Node &n) { return "'" + n.kindName() + "'"; }
+
+/// What of `n` itself (not its subtree) a 3-axis milling reader cannot take.
+std::optional<std::string> beyond(const Node &n) {
+  if (n.is(Trait::ControlFlow))
+    return "control flow (" + quotedKind(n) + ")";
+  if (n.category() == Category::Operation && !n.spec().isAny(Trait::Milling | Trait::HoleMaking))
+    return std::string("an operation of another process (") + quotedKind(n) + ")";
+  switch (n.kind) {
+  case Kind::Moves:
+    if (n.has("axis"))
+      return std::string("a tool axis");
+    if (n.has("x_mode"))
+      return std::string("a lathe's X mode");
+    break;
+  case Kind::State: return std::string("a change of process state ('state')");
+  case Kind::Dwell: return std::string("a dwell");
+  case Kind::Rapid:
+  case Kind::Linear:
+  case Kind::Arc:
+    if (n.has("axis"))
+      return std::string("a tool axis per move");
+    if (n.has("feed_per_rev"))
+      return std::string("a feed per revolution");
+    if (auto normal = n.vec("normal"); normal && *normal != Vec3::UnitZ())
+      return std::string("an arc out of the XY plane");
+    break;
+  default: break;
+  }
+  return std::nullopt;
+}
+
+std::optional<Beyond> firstBeyond(const Node &n) {
+  if (auto what = beyond(n))
+    return Beyond{&n, *what};
+  for (const Node &c : n.children)
+    if (auto found = firstBeyond(c))
+      return found;
+  return std::nullopt;
+}
+
 } // namespace
+
+std::optional<Beyond> beyondThreeAxisMilling(const Module &module) { return firstBeyond(module.root); }
+
+bool requireThreeAxisMilling(const Module &module, std::string_view consumer, DiagnosticEngine &diags) {
+  const std::optional<Beyond> b = beyondThreeAxisMilling(module);
+  if (!b)
+    return true;
+  std::string subject = b->node->kindName();
+  if (!b->node->symbol.empty())
+    subject += " " + b->node->symbol;
+  diags.error(b->node->origin.loc, subject + ": " + std::string(consumer) + " cannot take " + b->what + " yet")
+      .entity(b->node->origin.entityId);
+  return false;
+}
 
 std::vector<const Node *> programOrder(const Module &module) {
   std::vector<const Node *> out;

@@ -5,7 +5,10 @@
 #pragma once
 
 #include "ir/Node.h"
+#include "support/Diagnostics.h"
 
+#include <optional>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -13,7 +16,11 @@ namespace stepnc::ir {
 
 /// The executables the machine runs, in program order: every workingstep,
 /// rapid movement, program stop, optional stop and display message of the
-/// module's workplans, nested workplans flattened where they stand.
+/// module's workplans, nested workplans flattened where they stand. A control
+/// flow executable (if, while, parallel, selective, assignment) is listed
+/// itself, its branches not flattened: which of them run is decided when the
+/// program runs, so a reader that writes one straight program must refuse it
+/// (requireThreeAxisMilling).
 std::vector<const Node *> programOrder(const Module &module);
 
 /// A workingstep's operation (its child of category operation), or null.
@@ -38,5 +45,26 @@ const Node *workpieceOf(const Module &module, const Node &feature);
 /// feed only to what the machine reaches on the move (which changes nothing
 /// the machine does).
 bool runsAsWritten(const Node &executable);
+
+/// A construct that a consumer of straight 3-axis milling programs does not
+/// take yet, and the node that has it.
+struct Beyond {
+  const Node *node = nullptr;
+  std::string what;  ///< "control flow ('if')", "a tool axis per move", ...
+};
+
+/// The first construct, in tree order, that the readers of today's 3-axis
+/// milling programs (the G-code targets, plan-motion, the cutting passes,
+/// verify-toolpaths, the STEP-NC writer) cannot take: control flow, an
+/// operation of another process than milling and hole making, a tool axis,
+/// an arc out of the XY plane, a feed per revolution, a dwell, a change of
+/// process state, a lathe's X mode. The IR expresses all of them
+/// (docs/ir.md); each reader takes them as it learns to.
+std::optional<Beyond> beyondThreeAxisMilling(const Module &module);
+
+/// Reports the first construct `consumer` cannot take as an error at its
+/// node ("<consumer> cannot take <what> yet") and returns false; true when
+/// there is none.
+bool requireThreeAxisMilling(const Module &module, std::string_view consumer, DiagnosticEngine &diags);
 
 } // namespace stepnc::ir

@@ -43,6 +43,8 @@ const RefRule kRefRules[] = {
     {Kind::Island, "feature", Kind::Boss},
     {Kind::Moves, "tool", Kind::Tool},
     {Kind::Moves, "setup", Kind::Setup},
+    {Kind::Assignment, "variable", Kind::NcVariable},
+    {Kind::Read, "variable", Kind::NcVariable},
 };
 
 /// Children an operation has at most one of; the kinds of one entry count together.
@@ -67,7 +69,8 @@ bool isDimension(std::string_view name) {
 
 bool isNumber(ValueType t) {
   return t == ValueType::Length || t == ValueType::Angle || t == ValueType::Feed || t == ValueType::Spindle ||
-         t == ValueType::Time || t == ValueType::Ratio || t == ValueType::Real;
+         t == ValueType::Time || t == ValueType::Ratio || t == ValueType::Real || t == ValueType::FeedPerRev ||
+         t == ValueType::Power || t == ValueType::MassFlow;
 }
 
 std::string quoted(std::string_view s) {
@@ -116,6 +119,7 @@ private:
   void checkValue(const Node &n, const Attr &a);
   void checkRef(const Node &n, const KindSpec &spec, const Attr &a);
   void checkChildren(const Node &n, const KindSpec &spec);
+  void checkFlow(const Node &n, const KindSpec &spec);
   void checkToolFit(const Node &workingstep);
   const Node *lookup(const std::optional<std::string> &symbol) const;
   InFlightDiagnostic report(const Node &n, const std::string &message);
@@ -258,6 +262,12 @@ void Verifier::checkValue(const Node &n, const Attr &a) {
     report(n, attr() + " must have finite coordinates");
   else if (v.type == ValueType::Direction && !(std::abs(v.vec.norm() - 1) <= kUnitTolerance))
     report(n, attr() + " must be a unit vector, found length " + formatFixed(v.vec.norm(), 6));
+  else if ((v.type == ValueType::FeedPerRev || (n.kind == Kind::Dwell && a.name == "time")) && v.number <= 0)
+    report(n, attr() + " must be positive, found " + printed(v));
+  else if ((v.type == ValueType::Power || v.type == ValueType::MassFlow ||
+            (n.kind == Kind::State && v.type != ValueType::Word)) &&
+           v.number < 0)
+    report(n, attr() + " must not be negative, found " + printed(v));
 }
 
 /// The reference resolves, and names the kind its rule asks for.
@@ -287,6 +297,13 @@ void Verifier::checkChildren(const Node &n, const KindSpec &spec) {
     if (moves > 1)
       report(n, "expected at most one 'moves', found " + std::to_string(moves));
   }
+  if (spec.category == Category::Move && spec.id != Kind::Rapid && spec.id != Kind::Dwell &&
+      n.has("feed") == n.has("feed_per_rev"))
+    report(n, n.has("feed") ? "has both 'feed' and 'feed_per_rev', expected one"
+                            : "missing its feed: expected 'feed' (mm/min) or 'feed_per_rev' (mm/rev)");
+  if (spec.id == Kind::State && n.attrs.empty())
+    report(n, "changes nothing: expected at least one attribute");
+  checkFlow(n, spec);
   if (spec.is(Trait::PatternStrategy)) {
     auto guides = count([](const Node &c) { return c.kind == Kind::Strategy; });
     if (guides != 1)
@@ -302,6 +319,58 @@ void Verifier::checkChildren(const Node &n, const KindSpec &spec) {
         names += (names.empty() ? "" : " ") + std::string(kindName(k));
       report(n, "expected at most one " + joinWords(names) + ", found " + std::to_string(found));
     }
+  }
+}
+
+/// Control flow and expressions: a condition first where one is taken, the
+/// branches each kind needs, and expressions of the right arity and type.
+void Verifier::checkFlow(const Node &n, const KindSpec &spec) {
+  auto count = [&](auto matches) { return std::count_if(n.children.begin(), n.children.end(), matches); };
+  const auto expressions = count([](const Node &c) { return c.category() == Category::Expression; });
+  auto expectCondition = [&](bool boolean) {
+    const char *what = boolean ? "a boolean condition" : "a numeric expression";
+    if (expressions != 1)
+      report(n, std::string("expected one expression, ") + what + ", found " + std::to_string(expressions));
+    else if (n.children.front().category() != Category::Expression)
+      report(n, std::string("expected ") + what + " as its first child");
+    else if (n.children.front().is(Trait::Boolean) != boolean)
+      report(n, std::string("expected ") + what + ", found " + quoted(n.children.front().kindName()));
+  };
+  auto expectOperands = [&](size_t least, size_t most, bool boolean) {
+    const size_t found = n.children.size();
+    const std::string amount = least == most ? std::to_string(least) : std::to_string(least) + " or more";
+    if (found < least || found > most)
+      report(n, "expected " + amount + (boolean ? " boolean" : " numeric") + " operand" + (most == 1 ? "" : "s") +
+                    ", found " + std::to_string(found));
+    for (const Node &c : n.children)
+      if (c.is(Trait::Boolean) != boolean)
+        report(n, std::string("expected ") + (boolean ? "boolean" : "numeric") + " operands, found " +
+                      quoted(c.kindName()));
+  };
+  switch (spec.id) {
+  case Kind::If: {
+    expectCondition(true);
+    const auto thens = count([](const Node &c) { return c.kind == Kind::Then; });
+    const auto elses = count([](const Node &c) { return c.kind == Kind::Else; });
+    if (thens != 1 || elses > 1)
+      report(n, "expected one 'then' and at most one 'else', found " + std::to_string(thens) + " and " +
+                    std::to_string(elses));
+    break;
+  }
+  case Kind::While: expectCondition(true); break;
+  case Kind::Assignment: expectCondition(false); break;
+  case Kind::Parallel:
+  case Kind::Selective: {
+    const auto branches = count([](const Node &c) { return c.kind == Kind::Branch; });
+    if (branches < 2)
+      report(n, "expected two or more 'branch'es, found " + std::to_string(branches));
+    break;
+  }
+  case Kind::Arith:
+  case Kind::Compare: expectOperands(2, 2, false); break;
+  case Kind::Logic: expectOperands(2, SIZE_MAX, true); break;
+  case Kind::Not: expectOperands(1, 1, true); break;
+  default: break;
   }
 }
 

@@ -16,6 +16,7 @@
 // comments and the
 // `--stats` report.
 #include "passes/CuttingModel.h"
+#include "ir/Program.h"
 #include "passes/CuttingPass.h"
 #include "ir/motion/MotionIR.h"
 
@@ -80,6 +81,8 @@ public:
   std::string_view name() const override { return "adapt-feed"; }
 
   PassResult run(ir::Module &module, DiagnosticEngine &diags, PassStats &stats) override {
+    if (!ir::requireThreeAxisMilling(module, name(), diags))
+      return {false, false};
     const auto data = start(diags);
     if (!data)
       return {false, false};

@@ -26,6 +26,7 @@
 // two lines, both run to where their offset lines cross; elsewhere a short
 // connecting line joins them.
 #include "passes/CuttingModel.h"
+#include "ir/Program.h"
 #include "passes/CuttingPass.h"
 
 #include "support/Format.h"
@@ -249,6 +250,8 @@ public:
   std::string_view name() const override { return "compensate-deflection"; }
 
   PassResult run(ir::Module &module, DiagnosticEngine &diags, PassStats &stats) override {
+    if (!ir::requireThreeAxisMilling(module, name(), diags))
+      return {false, false};
     const auto data = start(diags);
     if (!data)
       return {false, false};

@@ -6,6 +6,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
+#include <optional>
 
 namespace stepnc::passes {
 
@@ -19,6 +20,8 @@ std::optional<double> parseLengthOption(std::string_view text) {
   return value;
 }
 
+void PassManager::add(std::unique_ptr<Pass> pass) { passes_.push_back(std::move(pass)); }
+
 void PassManager::add(const std::vector<PipelineEntry> &pipeline) {
   for (const PipelineEntry &entry : pipeline)
     if (auto pass = createPass(entry))
@@ -31,6 +34,10 @@ bool PassManager::run(ir::Module &module, DiagnosticEngine &diags) {
   for (const auto &pass : passes_) {
     PassStats stats;
     const unsigned errorsBefore = diags.errorCount();
+    // When verifying, the IR before the pass is kept to show what it broke.
+    std::optional<ir::Module> before;
+    if (verifyEach)
+      before = module;
     const PassResult result = pass->run(module, diags, stats);
     stats_.emplace_back(std::string(pass->name()), std::move(stats));
     if (std::vector<std::string> lines = pass->report(); !lines.empty())
@@ -38,8 +45,14 @@ bool PassManager::run(ir::Module &module, DiagnosticEngine &diags) {
     if (!result.ok || diags.errorCount() > errorsBefore)
       return false;
     if (verifyEach && !ir::verifyModule(module, diags)) {
-      diags.error({}, "pass '" + std::string(pass->name()) + "' broke verification")
-          .note("run with --print-after=" + std::string(pass->name()) + " to see the IR it produced");
+      const std::string name(pass->name());
+      InFlightDiagnostic d = diags.error({}, "pass '" + name + "' broke verification");
+      if (options_.print) {
+        d.note("the IR before it follows on standard error; --print-after=" + name + " shows the IR it produced");
+        options_.print("; *** IR before " + name + ", which broke verification ***\n" + ir::printModule(*before));
+        if (options_.printAfterAll || options_.printAfter.count(name))
+          options_.print("; *** IR after " + name + " (does not verify) ***\n" + ir::printModule(module));
+      }
       return false;
     }
     if (options_.print && (options_.printAfterAll || options_.printAfter.count(pass->name()))) {

@@ -26,6 +26,8 @@ public:
   explicit PassManager(PassManagerOptions options) : options_(std::move(options)) {}
   /// Builds the passes of `pipeline` (already parsed and checked).
   void add(const std::vector<PipelineEntry> &pipeline);
+  /// Appends one pass (tests run passes of their own this way).
+  void add(std::unique_ptr<Pass> pass);
   /// Runs every pass in order; stops at the first failing pass. True on success.
   bool run(ir::Module &module, DiagnosticEngine &diags);
   /// Counters per pass, in pipeline order.

@@ -1,6 +1,7 @@
 // plan-motion: plans the whole program's moves on a machine (runtime/Planner)
 // and writes the trajectory into the IR as `motion` nodes (ir/motion/MotionIR).
 #include "ir/motion/MotionIR.h"
+#include "ir/Program.h"
 #include "passes/Pass.h"
 #include "runtime/Machine.h"
 #include "support/Format.h"
@@ -21,6 +22,8 @@ public:
       diags.error({}, error_);
       return {false, false};
     }
+    if (!ir::requireThreeAxisMilling(module, "plan-motion", diags))
+      return {false, false};
     // Kept for the life of the pass: diagnostics point into it.
     const auto machine = runtime::loadMachine(machinePath_, machineFile_, diags);
     if (!machine)

@@ -25,6 +25,7 @@
 
 #include "geom/Boolean.h"
 #include "ir/Kinds.h"
+#include "ir/Program.h"
 #include "ir/geom/FeatureShape.h"
 #include "ir/geom/MoveWalk.h"
 #include "support/Format.h"
@@ -795,6 +796,8 @@ public:
       diags.error({}, optionError_);
       return {false, false};
     }
+    if (!ir::requireThreeAxisMilling(module, "verify-toolpaths", diags))
+      return {false, false};
     return ToolpathChecker(module, diags, stats, tolerance_).run();
   }
 

@@ -1,6 +1,6 @@
 # lit configuration for stepnc's golden tests.
 #
-# Tests are *.test files and Part 21 inputs (*.p21) carrying their own RUN
+# Tests are *.test files, Part 21 inputs (*.p21) and IR text (*.ir) carrying their own RUN
 # lines. Tests that read the third-party sample corpus say `REQUIRES: corpus`;
 # the corpus is found at $STEPNC_CORPUS, else at the path given to CMake
 # (STEPNC_CORPUS_DIR, default ../shared/corpus beside the checkout). When it
@@ -11,7 +11,7 @@ import lit.formats
 
 config.name = "stepnc"
 config.test_format = lit.formats.ShTest(execute_external=True)
-config.suffixes = [".test", ".p21"]
+config.suffixes = [".test", ".p21", ".ir"]
 config.test_source_root = os.path.dirname(__file__)
 config.test_exec_root = os.path.join(config.stepnc_obj_root, "tests")
 config.excludes = ["Inputs", "unit", "fuzz", "CMakeLists.txt", "lit.cfg.py", "update-corpus-checks.py"]

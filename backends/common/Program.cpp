@@ -1,6 +1,7 @@
 #include "backends/common/Program.h"
 
 #include "ir/Kinds.h"
+#include "ir/Program.h"
 #include "ir/geom/FeatureShape.h"
 #include "ir/geom/MoveWalk.h"
 
@@ -237,6 +238,8 @@ double Move::sweep() const {
 }
 
 std::optional<Program> buildProgram(const ir::Module &module, const ToolTable *table, DiagnosticEngine &diags) {
+  if (!ir::requireThreeAxisMilling(module, "the G-code targets", diags))
+    return std::nullopt;
   return Builder(module, table, diags).build();
 }
 

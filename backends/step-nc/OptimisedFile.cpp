@@ -15,6 +15,7 @@
 #include "frontend/lowering/Lowering.h"
 #include "frontend/part21/Writer.h"
 #include "ir/Kinds.h"
+#include "ir/Program.h"
 #include "ir/geom/FeatureShape.h"
 
 #include <algorithm>
@@ -468,6 +469,8 @@ std::string writeOptimisedPart21(const p21::Part21File &input, const ir::Module 
 std::unique_ptr<p21::Part21File> buildOptimisedFile(const p21::Part21File &input, const ir::Module &module,
                                                     const OptimisedFileOptions &options,
                                                     std::unique_ptr<SourceFile> &text, DiagnosticEngine &diags) {
+  if (!ir::requireThreeAxisMilling(module, "the STEP-NC writer", diags))
+    return nullptr;
   std::string written = writeOptimisedPart21(input, module, options, diags);
   if (written.empty())
     return nullptr;

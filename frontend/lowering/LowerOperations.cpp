@@ -308,11 +308,11 @@ std::optional<Node> Lowerer::operation(const Instance &op) {
       n.add(std::move(*lowered));
     }
   }
-  for (auto [which, kind] : {std::pair{"approach", ir::Kind::Approach}, {"retract", ir::Kind::Retract}}) {
+  for (auto [which, irKind] : {std::pair{"approach", ir::Kind::Approach}, {"retract", ir::Kind::Retract}}) {
     Instance ar = op.ref(which);
     if (!ar)
       continue;
-    Node a{kind};
+    Node a{irKind};
     stamp(a, ar, "");
     std::string_view type;
     for (std::string_view t : {"plunge_toolaxis", "plunge_ramp", "plunge_helix", "plunge_zigzag", "along_path"})

@@ -15,6 +15,7 @@
 #include "ir/Printer.h"
 #include "ir/Verifier.h"
 #include "passes/PassManager.h"
+#include "support/VerifyDiagnostics.h"
 #include "runtime/Machine.h"
 #include "tools/stepnc/Compile.h"
 #include "tools/stepnc/Driver.h"
@@ -56,6 +57,9 @@ struct CompileOptions {
   bool verifyEach = false;
   bool listPasses = false;
   bool stats = false;
+  /// Match the diagnostics against the expectations in the input's comments
+  /// instead of printing them (docs/diagnostics.md).
+  bool verifyDiagnostics = false;
   SchemaOptions schema;
   DiagnosticOptions diag;
 };
@@ -144,46 +148,11 @@ int writeOptimised(const CompileOptions &opts, const SchemaSelection &schemas, c
   return kExitOk;
 }
 
-int runCompile(const CompileOptions &opts) {
-  const std::string emit = !opts.emit.empty() ? opts.emit : opts.target.empty() ? "feature-ir" : "program";
-  std::unique_ptr<backends::Backend> backend;
-  if (emit == "program") {
-    if (opts.target.empty()) {
-      printToolError("compile: --emit=program needs a --target (" + targetList() + ")");
-      return kExitUsage;
-    }
-    backend = backends::createBackend(opts.target);
-    if (!backend) {
-      printToolError("compile: unknown target '" + opts.target + "' (" + targetList() + ")");
-      return kExitUsage;
-    }
-    if (opts.tolerance && !(*opts.tolerance > 0 && *opts.tolerance < 10)) {
-      printToolError("compile: --tolerance " + formatShortest(*opts.tolerance) +
-                     " is not a contour tolerance: give a number of mm above 0 and below 10, such as 0.01");
-      return kExitUsage;
-    }
-    std::vector<std::string> overrides = opts.targetOptions;
-    if (opts.noCycles)
-      overrides.push_back("cycles=off");
-    if (std::string error = backends::applyOverrides(backend->descriptor(), overrides); !error.empty()) {
-      printToolError("compile: " + error);
-      return kExitUsage;
-    }
-  }
+/// Reads, lowers, runs the pipeline and writes what `emit` asks for, all
+/// diagnostics going to `diags`.
+int compileSource(const CompileOptions &opts, const std::string &emit, std::unique_ptr<SourceFile> &source,
+                  backends::Backend *backend, DiagnosticEngine &diags) {
   const bool needsMotion = emit == "motion-ir" || opts.target == "native";
-  if (needsMotion && opts.machine.empty()) {
-    std::string names;
-    for (const std::string &n : runtime::shippedMachineNames())
-      names += (names.empty() ? "" : ", ") + n;
-    printToolError("compile: " + std::string(emit == "motion-ir" ? "--emit=motion-ir" : "--target=native") +
-                   " plans the motion on a machine: give --machine FILE.toml or a shipped machine (" + names + ")");
-    return kExitUsage;
-  }
-  auto source = openInput(opts.input);
-  if (!source)
-    return kExitUsage;
-  DiagnosticSession session(opts.diag);
-  DiagnosticEngine &diags = session.engine();
   SchemaSelection schemas(opts.schema);
   bool usage = false;
   if (!schemas.load(diags, usage))
@@ -267,6 +236,57 @@ int runCompile(const CompileOptions &opts) {
   return writeText(opts.output, ir::printModule(*module, printOptions));
 }
 
+int runCompile(const CompileOptions &opts) {
+  const std::string emit = !opts.emit.empty() ? opts.emit : opts.target.empty() ? "feature-ir" : "program";
+  std::unique_ptr<backends::Backend> backend;
+  if (emit == "program") {
+    if (opts.target.empty()) {
+      printToolError("compile: --emit=program needs a --target (" + targetList() + ")");
+      return kExitUsage;
+    }
+    backend = backends::createBackend(opts.target);
+    if (!backend) {
+      printToolError("compile: unknown target '" + opts.target + "' (" + targetList() + ")");
+      return kExitUsage;
+    }
+    if (opts.tolerance && !(*opts.tolerance > 0 && *opts.tolerance < 10)) {
+      printToolError("compile: --tolerance " + formatShortest(*opts.tolerance) +
+                     " is not a contour tolerance: give a number of mm above 0 and below 10, such as 0.01");
+      return kExitUsage;
+    }
+    std::vector<std::string> overrides = opts.targetOptions;
+    if (opts.noCycles)
+      overrides.push_back("cycles=off");
+    if (std::string error = backends::applyOverrides(backend->descriptor(), overrides); !error.empty()) {
+      printToolError("compile: " + error);
+      return kExitUsage;
+    }
+  }
+  const bool needsMotion = emit == "motion-ir" || opts.target == "native";
+  if (needsMotion && opts.machine.empty()) {
+    std::string names;
+    for (const std::string &n : runtime::shippedMachineNames())
+      names += (names.empty() ? "" : ", ") + n;
+    printToolError("compile: " + std::string(emit == "motion-ir" ? "--emit=motion-ir" : "--target=native") +
+                   " plans the motion on a machine: give --machine FILE.toml or a shipped machine (" + names + ")");
+    return kExitUsage;
+  }
+  auto source = openInput(opts.input);
+  if (!source)
+    return kExitUsage;
+  DiagnosticSession session(opts.diag);
+  if (!opts.verifyDiagnostics)
+    return compileSource(opts, emit, source, backend.get(), session.engine());
+  // --verify-diagnostics: collect instead of printing, then match the
+  // expectations written in the input's comments (docs/diagnostics.md).
+  DiagnosticCollector collector;
+  DiagnosticEngine collecting(collector);
+  const int rc = compileSource(opts, emit, source, backend.get(), collecting);
+  if (rc == kExitUsage)
+    return rc;
+  return verifyDiagnostics(*source, collector.diags, std::cerr) ? kExitOk : kExitDiagnostics;
+}
+
 std::string targetList() {
   std::string names;
   for (const backends::TargetInfo &t : backends::registeredTargets())
@@ -297,6 +317,9 @@ void addCommonOptions(CLI::App &cmd, const std::shared_ptr<CompileOptions> &opts
   cmd.add_option("-o,--output", opts->output, "Output file ('-', the default, for standard output)");
   cmd.add_flag("--print-locs", opts->printLocations, "Print each IR node's source location (file:line:col #id)");
   cmd.add_flag("--stats", opts->stats, "Print each pass's counters to stderr");
+  cmd.add_flag("--verify-diagnostics", opts->verifyDiagnostics,
+               "Check the diagnostics against the expected-error/warning comments in the input\n"
+               "(exit 0 when they match) instead of printing them");
   addSchemaOptions(cmd, opts->schema);
   addDiagnosticOptions(cmd, opts->diag);
   cmd.callback([opts, setResult] { setResult(runCompile(*opts)); });

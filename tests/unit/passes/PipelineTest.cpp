@@ -1,3 +1,4 @@
+#include "passes/PassManager.h"
 #include "passes/PassRegistry.h"
 
 #include <catch2/catch.hpp>
@@ -35,4 +36,48 @@ TEST_CASE("every registered pass can be built", "[passes]") {
     REQUIRE(pass);
     CHECK(pass->name() == info.name);
   }
+}
+
+namespace {
+
+/// A pass with a bug: it gives the first tool a negative diameter.
+class BreaksTheIR : public Pass {
+public:
+  std::string_view name() const override { return "break-the-ir"; }
+  PassResult run(stepnc::ir::Module &module, stepnc::DiagnosticEngine &, PassStats &) override {
+    for (stepnc::ir::Node &n : module.root.children)
+      if (n.kind == stepnc::ir::Kind::Tool) {
+        n.set("diameter", stepnc::ir::Value::length(-1));
+        break;
+      }
+    return {true, true};
+  }
+};
+
+} // namespace
+
+TEST_CASE("a pass that breaks verification is named, and the IR before it printed", "[passes]") {
+  using namespace stepnc;
+  ir::Module m;
+  ir::Node &tool = m.root.add(ir::Node(ir::Kind::Tool));
+  tool.symbol = "%t";
+  tool.set("type", ir::Value::word("endmill")).set("diameter", ir::Value::length(10));
+  std::string printed;
+  PassManagerOptions options;
+  options.verifyEach = true;
+  options.print = [&](std::string_view text) { printed += text; };
+  PassManager manager(options);
+  manager.add(std::make_unique<BreaksTheIR>());
+  DiagnosticCollector sink;
+  DiagnosticEngine diags(sink);
+  CHECK_FALSE(manager.run(m, diags));
+  REQUIRE(sink.diags.size() == 2);  // the verifier's error, then the pass manager's
+  CHECK(sink.diags[0].message == "tool %t: attribute 'diameter' must be positive, found -1.0000mm");
+  CHECK(sink.diags[1].message == "pass 'break-the-ir' broke verification");
+  REQUIRE(sink.diags[1].notes.size() == 1);
+  CHECK(sink.diags[1].notes[0].message.find("the IR before it follows") != std::string::npos);
+  CHECK(printed == "; *** IR before break-the-ir, which broke verification ***\n"
+                   "; stepnc feature IR (lengths mm, angles deg, feeds mm/min, spindle rev/min, times s)\n"
+                   "project\n"
+                   "  tool %t type=endmill diameter=10.0000mm\n");
 }
