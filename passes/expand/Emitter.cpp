@@ -1,0 +1,72 @@
+// The move writer of expand-strategies (see Emitter.h). Moves shorter than
+// geom::kEps are dropped here, once, so that no family writes a move that
+// goes nowhere (a backend would write a block that does nothing, and the
+// verifier would measure a zero-length sweep).
+#include "passes/expand/Emitter.h"
+
+namespace stepnc::passes::expand {
+
+using ir::Node;
+using ir::Value;
+using ir::Vec3;
+
+namespace {
+Vec3 at(const geom::Vec2 &p, double z) { return {p.x(), p.y(), z}; }
+} // namespace
+
+void Emitter::rapid(const Vec3 &to, const char *role) {
+  if (positioned_ && (to - pos_).norm() <= geom::kEps)
+    return;
+  Node &m = moves_.add(Node(ir::Kind::Rapid));
+  m.set("to", Value::point(to));
+  m.set("role", Value::word(role));
+  pos_ = to;
+  positioned_ = true;
+}
+
+void Emitter::linear(const Vec3 &to, double feed, const char *role, bool smooth) {
+  if ((to - pos_).norm() <= geom::kEps)
+    return;
+  Node &m = moves_.add(Node(ir::Kind::Linear));
+  m.set("to", Value::point(to));
+  m.set("feed", Value::feed(feed));
+  m.set("role", Value::word(role));
+  if (smooth)
+    m.set("smooth", Value::boolean(true));
+  pos_ = to;
+}
+
+void Emitter::arc(const Vec3 &to, const geom::Vec2 &centre, bool ccw, int64_t turns, double feed, const char *role) {
+  Node &m = moves_.add(Node(ir::Kind::Arc));
+  m.set("to", Value::point(to));
+  m.set("center", Value::point(at(centre, pos_.z())));
+  m.set("dir", Value::word(ccw ? "ccw" : "cw"));
+  if (turns > 0)
+    m.set("turns", Value::integer(turns));
+  m.set("feed", Value::feed(feed));
+  m.set("role", Value::word(role));
+  pos_ = to;
+}
+
+void Emitter::seg(const geom::Seg &s, double z, double feed, const char *role) {
+  if (s.isArc())
+    arc(at(s.b, z), s.c, s.turn > 0, 0, feed, role);
+  else
+    linear(at(s.b, z), feed, role);
+}
+
+void Emitter::travel(const geom::Vec2 &xy, double z) {
+  if (!positioned_)
+    rapid(at(xy, secplane_), "position");
+  else if (pos_.z() < secplane_)
+    rapid(Vec3(pos_.x(), pos_.y(), secplane_), "retract");
+  rapid(at(xy, secplane_));
+  rapid(at(xy, z), "approach");
+}
+
+void Emitter::retract() {
+  if (positioned_ && pos_.z() < secplane_)
+    rapid(Vec3(pos_.x(), pos_.y(), secplane_), "retract");
+}
+
+} // namespace stepnc::passes::expand

@@ -1,0 +1,53 @@
+// The move writer of expand-strategies: every family writes its moves under
+// a `moves` node through an Emitter, which keeps track of where the tool is,
+// drops moves that go nowhere, and knows the one safe way to travel: up to
+// the security plane, across, and down along the tool axis.
+#pragma once
+
+#include "geom/Boolean.h"
+#include "ir/Node.h"
+
+#include <cstdint>
+
+namespace stepnc::passes::expand {
+
+/// Writes moves under a `moves` node and keeps track of where the tool is.
+class Emitter {
+public:
+  Emitter(ir::Node &moves, double secplane) : moves_(moves), secplane_(secplane) {}
+
+  /// Where the last move ended (meaningful once positioned()).
+  const ir::Vec3 &position() const { return pos_; }
+  /// Whether any move was written: before it the tool's place is unknown.
+  bool positioned() const { return positioned_; }
+  /// The security plane, a height in workpiece coordinates.
+  double secplane() const { return secplane_; }
+
+  /// A rapid to `to`; none when the tool is already there.
+  void rapid(const ir::Vec3 &to, const char *role = "position");
+
+  /// A line at feed to `to`; none when the tool is already there.
+  /// `smooth`: a chord of a curvature-continuous curve (IR `smooth`).
+  void linear(const ir::Vec3 &to, double feed, const char *role, bool smooth = false);
+
+  /// An arc (a helix when `to` is at another height) about `centre`,
+  /// after `turns` whole turns.
+  void arc(const ir::Vec3 &to, const geom::Vec2 &centre, bool ccw, int64_t turns, double feed, const char *role);
+
+  /// A plane segment cut at height z (the tool is at its start).
+  void seg(const geom::Seg &s, double z, double feed, const char *role = "cut");
+
+  /// Up to the security plane (if below it), across, and down along the axis to `z`.
+  void travel(const geom::Vec2 &xy, double z);
+
+  /// Up to the security plane along the axis, when below it.
+  void retract();
+
+private:
+  ir::Node &moves_;
+  double secplane_;
+  ir::Vec3 pos_ = ir::Vec3::Zero();
+  bool positioned_ = false;
+};
+
+} // namespace stepnc::passes::expand

@@ -1,0 +1,319 @@
+// expand-strategies: from features to moves.
+//
+// Each machining workingstep gets a `moves` child: the tool-centre path in
+// workpiece coordinates, made from the feature's shape (ir/geom/FeatureShape),
+// the operation (allowances, depths of cut, stepover), its strategy, approach
+// and retract. This file is the pass: it walks the workplans, finds each
+// step's operation, feature and tool, builds the Plan (feeds, allowances,
+// the clearance height), and hands the step to the family registered for the
+// kind of its strategy node (see kFamilies below). It also says, with a
+// warning at the node the file gives, where the moves do not follow what the
+// operation asks: an approach or retract stepnc does not make, a pattern
+// strategy it does not know. Warnings never change the moves.
+#include "passes/expand/Expand.h"
+
+#include "support/Format.h"
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+
+namespace stepnc::passes {
+
+namespace expand {
+
+namespace {
+
+// What each family does with the operation's approach. The families write
+// the moves; these lists only say which approach types those moves follow.
+constexpr std::string_view kAxisOnly[] = {"plunge_toolaxis"};
+constexpr std::string_view kAxisHelixRamp[] = {"plunge_toolaxis", "plunge_helix", "plunge_ramp"};
+constexpr std::string_view kAxisHelix[] = {"plunge_toolaxis", "plunge_helix"};
+
+/// The registry: one family per kind of the node that selects it. An
+/// operation's toolpaths select explicit toolpaths, hole making its
+/// (optional) drilling strategy, milling its strategy or pattern strategy.
+constexpr Family kFamilies[] = {
+    {ir::Kind::Toolpath, "explicit toolpaths", false, kAxisOnly, "reaching each toolpath's start down the tool axis",
+     expandExplicitToolpaths},
+    {ir::Kind::DrillingStrategy, "hole making", true, kAxisOnly, "feeding down the hole's axis", expandHoleMaking},
+    {ir::Kind::Strategy, "2.5D milling", true, kAxisHelixRamp, "plunging along the tool axis", expandMilling2D},
+    // The loops enter by a helix, or along the axis when asked; the wall
+    // pass after them enters as 2.5D milling does.
+    {ir::Kind::TrochoidalStrategy, "trochoidal milling", true, kAxisHelix, "entering each guide path by a helix",
+     expandTrochoidal},
+    // The plunges are along the axis by nature, whatever the approach; the
+    // approach is the wall pass's, which follows a helix or ramp.
+    {ir::Kind::PlungeStrategy, "plunge milling", true, kAxisHelixRamp, "plunging along the tool axis",
+     expandPlunging},
+};
+
+/// The retract stepnc makes in every family: along the tool axis, up to the
+/// security plane (at rapid, or at feed out of a bored or tapped hole).
+constexpr std::string_view kRetractFollowed = "plunge_toolaxis";
+
+/// The node whose kind selects the family of operation `op`, and that kind.
+struct Selected {
+  ir::Kind key;
+  const Node *node;
+};
+
+Selected select(const Node &op) {
+  // An operation's toolpaths win over its strategy.
+  if (const std::vector<const Node *> tps = op.childrenOf(ir::Kind::Toolpath); !tps.empty())
+    return {ir::Kind::Toolpath, tps.front()};
+  if (op.is(ir::Trait::HoleMaking))
+    return {ir::Kind::DrillingStrategy, op.child(ir::Kind::DrillingStrategy)};
+  for (const Node &c : op.children)
+    if (c.is(ir::Trait::PatternStrategy))
+      return {c.kind, &c};
+  return {ir::Kind::Strategy, op.child(ir::Kind::Strategy)};
+}
+
+std::string coolant(const Node &op) {
+  const Node *mf = op.child(ir::Kind::MachineFunctions);
+  if (!mf)
+    return "off";
+  if (mf->flag("through_spindle_coolant").value_or(false))
+    return "through_tool";
+  if (mf->flag("mist").value_or(false))
+    return "mist";
+  return mf->flag("coolant").value_or(false) ? "flood" : "off";
+}
+
+/// Warns where the operation's approach or retract is not what `family`'s
+/// moves do, saying what they do instead.
+void reportApproachRetract(Expander &x, const Step &step, const Family &family) {
+  if (const Node *a = step.op.child(ir::Kind::Approach)) {
+    const std::string type = a->text("type").value_or("");
+    if (std::ranges::find(family.approaches, type) == family.approaches.end())
+      x.assumed(step.ws, *a,
+                "approach " + type + " is not supported by " + std::string(family.name) + ": " +
+                    std::string(family.otherApproach));
+  }
+  if (const Node *r = step.op.child(ir::Kind::Retract)) {
+    const std::string type = r->text("type").value_or("");
+    if (type != kRetractFollowed)
+      x.assumed(step.ws, *r,
+                "retract " + type + " is not supported: leaving along the tool axis to the security plane");
+  }
+}
+
+} // namespace
+
+const Family *findFamily(ir::Kind key) {
+  for (const Family &f : kFamilies)
+    if (f.key == key)
+      return &f;
+  return nullptr;
+}
+
+Node makeMoves(const Node &exec, const std::string &tool, double spindle, const std::string &coolant,
+               const std::string &setup) {
+  Node moves(ir::Kind::Moves);
+  moves.set("tool", Value::ref(tool));
+  moves.set("spindle", Value::spindle(spindle));
+  moves.set("coolant", Value::word(coolant));
+  if (!setup.empty())
+    moves.set("setup", Value::ref(setup));
+  moves.set("secplane", Value::length(exec.number("secplane").value_or(0)));
+  moves.origin = exec.origin;
+  return moves;
+}
+
+void Expander::attach(Node &ws, Node moves) {
+  (*stats)["workingsteps expanded"]++;
+  (*stats)["moves"] += static_cast<long long>(moves.children.size());
+  lastTool = moves.text("tool").value_or("");
+  ws.add(std::move(moves));
+  result.changed = true;
+}
+
+void Expander::report(const Node &ws, const Node &at, const std::string &message) {
+  diags->error(at.origin.loc, ws.kindName() + " " + ws.symbol + ": " + message).entity(at.origin.entityId);
+  result.ok = false;
+}
+
+void Expander::unsupported(const Node &ws, const std::string &reason) {
+  diags->warning(ws.origin.loc, "workingstep " + ws.symbol + " is not expanded: " + reason)
+      .entity(ws.origin.entityId);
+  (*stats)["workingsteps not expanded"]++;
+}
+
+void Expander::assumed(const Node &ws, const Node &at, const std::string &message) {
+  // Located at what the file gives (the approach, the strategy); a node
+  // made by the pass or without an origin falls back to the step's.
+  const Node &where = at.origin.loc.valid() ? at : ws;
+  diags->warning(where.origin.loc, ws.kindName() + " " + ws.symbol + ": " + message).entity(where.origin.entityId);
+}
+
+namespace {
+
+class ExpandStrategiesPass final : public Pass {
+public:
+  ExpandStrategiesPass(double maxEngagement, double chordTolerance, std::string optionError)
+      : optionError_(std::move(optionError)) {
+    x_.maxEngagement = maxEngagement;
+    x_.chordTolerance = chordTolerance;
+  }
+
+  std::string_view name() const override { return "expand-strategies"; }
+
+  PassResult run(ir::Module &module, DiagnosticEngine &diags, PassStats &stats) override {
+    if (!optionError_.empty()) {
+      diags.error({}, optionError_);
+      return {false, false};
+    }
+    x_.module = &module;
+    x_.diags = &diags;
+    x_.stats = &stats;
+    x_.result = {};
+    for (Node &n : module.root.children)
+      if (n.kind == ir::Kind::Workplan)
+        workplan(n, n.text("setup").value_or(""));
+    return x_.result;
+  }
+
+private:
+  void workplan(Node &plan, const std::string &setup) {
+    for (Node &e : plan.children) {
+      if (e.kind == ir::Kind::Workplan)
+        workplan(e, e.text("setup").value_or(setup));
+      else if ((e.kind == ir::Kind::Workingstep || e.kind == ir::Kind::RapidMovement) && !e.child(ir::Kind::Moves))
+        executable(e, setup);
+    }
+  }
+
+  void executable(Node &ws, const std::string &setup) {
+    if (ws.kind == ir::Kind::RapidMovement) {
+      expandRapidMovement(x_, ws, setup);
+      return;
+    }
+    const Node *op = ir::operationOf(ws);
+    if (!op)
+      return;
+    const Node *feature = ir::findFeature(*x_.module, ws.text("feature").value_or(""));
+    const Node *tool = ir::findTool(*x_.module, op->text("tool").value_or(""));
+    if (!feature || !tool)
+      return;  // the IR verifier reports dangling references
+    Plan p;
+    p.feature = feature;
+    p.op = op;
+    p.tool = tool;
+    p.radius = tool->number("diameter").value_or(0) / 2;
+    const Node *tech = op->child(ir::Kind::Technology);
+    p.feed = tech ? tech->number("feed").value_or(0) : 0;
+    p.spindle = tech ? tech->number("spindle").value_or(0) : 0;
+    p.plungeFeed = p.feed;
+    p.allowanceSide = op->number("allowance_side").value_or(0);
+    p.allowanceBottom = op->number("allowance_bottom").value_or(0);
+    if (p.feed <= 0) {
+      x_.report(ws, tech && tech->has("feed") ? "its operation's feed is 0 mm/min"
+                                              : "has no feed for its moves (run resolve-feeds first, or give the "
+                                                "operation a feed)");
+      return;
+    }
+    if (p.radius <= 0) {
+      x_.report(ws, "its tool " + tool->symbol + " has no diameter");
+      return;
+    }
+    // The family, by the kind of the node that selects it. A pattern
+    // strategy stepnc has no family for is followed as its guide alone.
+    Selected sel = select(*op);
+    const Family *family = findFamily(sel.key);
+    if (!family && sel.node && sel.node->is(ir::Trait::PatternStrategy)) {
+      if (const Node *guide = sel.node->child(ir::Kind::Strategy)) {
+        x_.assumed(ws, *sel.node,
+                   sel.node->kindName() + " is not supported: following its guide strategy " +
+                       guide->text("type").value_or("") + " without the pattern");
+        sel = {ir::Kind::Strategy, guide};
+        family = findFamily(sel.key);
+      }
+    }
+    if (!family) {
+      x_.unsupported(ws, (sel.node ? sel.node->kindName() : std::string(ir::kindName(sel.key))) +
+                             " has no expansion in stepnc");
+      return;
+    }
+    // Axial approaches start the retract plane above the feature's top, never
+    // above the security plane.
+    auto clearanceAbove = [&](double top) {
+      return std::min(top + op->number("retract_plane").value_or(kDefaultClearance),
+                      ws.number("secplane").value_or(1e300));
+    };
+    Node moves = makeMoves(ws, tool->symbol, p.spindle, coolant(*op), setup);
+    bool expanded = false;
+    if (!family->needsShape) {
+      // Explicit toolpaths need no shape: they are in the feature's frame.
+      ir::FrameResult fr = ir::planeFrame(*feature);
+      if (!fr.frame) {
+        x_.unsupported(ws, fr.error);
+        return;
+      }
+      p.clearanceZ = clearanceAbove(fr.frame->z);
+      expanded = dispatch(*family, Step{ws, *op, sel.node, nullptr, &*fr.frame, p, moves});
+    } else {
+      ir::ShapeResult shape = ir::featureShape(*x_.module, *feature);
+      if (!shape.shape) {
+        x_.unsupported(ws, shape.error);
+        return;
+      }
+      const ir::FeatureShape &s = *shape.shape;
+      const double secplane = ws.number("secplane").value_or(0);
+      if (secplane < s.top) {
+        x_.report(ws, "its security plane z=" + formatFixed(secplane, 4) + " mm is below the top of " + s.symbol +
+                          " (z=" + formatFixed(s.top, 4) + " mm): there is no safe height to travel at");
+        return;
+      }
+      p.clearanceZ = clearanceAbove(s.top);
+      expanded = dispatch(*family, Step{ws, *op, sel.node, &s, nullptr, p, moves});
+    }
+    if (expanded)
+      x_.attach(ws, std::move(moves));
+  }
+
+  /// Runs the family on the step; when it made moves without an error,
+  /// says where they do not follow the operation's approach or retract.
+  bool dispatch(const Family &family, const Step &step) {
+    const unsigned errorsBefore = x_.diags->errorCount();
+    if (!family.expand(x_, step))
+      return false;
+    if (x_.diags->errorCount() == errorsBefore)
+      reportApproachRetract(x_, step, family);
+    return true;
+  }
+
+  Expander x_;
+  std::string optionError_;
+};
+
+} // namespace
+
+} // namespace expand
+
+std::unique_ptr<Pass> createExpandStrategiesPass(const PassOptions &options) {
+  double maxEngagement = expand::kDefaultMaxEngagement, chord = expand::kDefaultChordTolerance;
+  std::string error;
+  if (auto it = options.find("max-engagement"); it != options.end()) {
+    double v = 0;
+    const char *first = it->second.data(), *last = first + it->second.size();
+    std::string_view unit;
+    auto [end, ec] = std::from_chars(first, last, v);
+    unit = std::string_view(end, size_t(last - end));
+    if (ec != std::errc() || !(v > 0 && v <= 180) || !(unit.empty() || unit == "deg"))
+      error = "expand-strategies: max-engagement='" + it->second +
+              "' is not an angle: expected degrees in (0, 180], such as max-engagement=60";
+    else
+      maxEngagement = v;
+  }
+  if (auto it = options.find("chord-tolerance"); it != options.end()) {
+    if (auto v = parseLengthOption(it->second))
+      chord = *v;
+    else
+      error = "expand-strategies: chord-tolerance='" + it->second +
+              "' is not a length: expected a positive number of mm, such as chord-tolerance=0.005";
+  }
+  return std::make_unique<expand::ExpandStrategiesPass>(maxEngagement, chord, std::move(error));
+}
+
+} // namespace stepnc::passes

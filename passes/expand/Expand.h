@@ -1,0 +1,222 @@
+// What the files of expand-strategies share (private to passes/expand/).
+//
+// The pass (Expand.cpp) walks the workingsteps, builds a Plan from the
+// operation, its tool and its feature, and hands the step to the family of
+// code that expands its strategy, found in a registry keyed by the kind of
+// the strategy node (ir::Kind): explicit toolpaths, hole making, the 2.5D
+// milling strategies and the pattern strategies. The families write their
+// moves through an Emitter and report through the Expander, which holds
+// the state of one run of the pass. Geometry helpers that several families
+// use (centre areas, contour rings, zigzag strokes, cutting a path with its
+// approach) are declared here and defined in the file of their family.
+#pragma once
+
+#include "geom/Boolean.h"
+#include "ir/Kinds.h"
+#include "ir/Program.h"
+#include "ir/geom/Curves.h"
+#include "ir/geom/FeatureShape.h"
+#include "passes/Pass.h"
+#include "passes/expand/Emitter.h"
+
+#include <numbers>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace stepnc::passes::expand {
+
+using geom::Loop;
+using geom::Region;
+using geom::Seg;
+using geom::Vec2;
+using ir::Node;
+using ir::Value;
+using ir::Vec3;
+
+/// A path in the plane: segments, each starting where the one before ends.
+using Path2D = std::vector<Seg>;
+
+inline constexpr double kPi = std::numbers::pi;
+/// Height above a feature's top where plunges start when the operation gives no retract plane (mm).
+inline constexpr double kDefaultClearance = 2.0;
+/// Largest engagement angle of a trochoid's tool (deg) when the pass is not given max-engagement.
+inline constexpr double kDefaultMaxEngagement = 90.0;
+/// How far the line segments of a curve the strategy makes (trochoids,
+/// rounded links) may stray from it (mm) when the pass is not given chord-tolerance.
+inline constexpr double kDefaultChordTolerance = 0.005;
+/// Overlap of neighbouring guide paths of a pattern strategy that gives none:
+/// a share of the width one pass of the motif cuts.
+inline constexpr double kPatternOverlap = 0.2;
+/// Extra depth past the floor of a through hole, beyond the tool's point, when
+/// the operation's overcut is smaller (mm).
+inline constexpr double kBreakthrough = 1.0;
+
+/// A plane point at height z.
+inline Vec3 at(const Vec2 &p, double z) { return {p.x(), p.y(), z}; }
+
+/// What the operation, its tool and its feature fix for every move of a step.
+struct Plan {
+  const Node *feature = nullptr;
+  const Node *op = nullptr;
+  const Node *tool = nullptr;
+  double radius = 0;
+  double feed = 0;
+  double plungeFeed = 0;
+  double spindle = 0;
+  double allowanceSide = 0;
+  double allowanceBottom = 0;
+  double clearanceZ = 0;  ///< where axial approaches start
+};
+
+/// The state of one run of the pass, and the ways it reports: every family
+/// reads its options and module and reports through it.
+class Expander {
+public:
+  double maxEngagement = kDefaultMaxEngagement;   ///< deg
+  double chordTolerance = kDefaultChordTolerance; ///< mm
+  ir::Module *module = nullptr;
+  DiagnosticEngine *diags = nullptr;
+  PassStats *stats = nullptr;
+  PassResult result;
+  /// The tool of the last step expanded: a rapid movement keeps it.
+  std::string lastTool;
+
+  /// Gives executable `ws` its moves and counts them.
+  void attach(Node &ws, Node moves);
+
+  /// An error about workingstep `ws`, located at it; the pass fails.
+  void report(const Node &ws, const std::string &message) { report(ws, ws, message); }
+  /// An error about workingstep `ws` located at `at` (a part of it the file gives, such as its strategy).
+  void report(const Node &ws, const Node &at, const std::string &message);
+  /// A warning that workingstep `ws` gets no moves, and why.
+  void unsupported(const Node &ws, const std::string &reason);
+  /// A warning at `at` (what the file gives and stepnc does not follow, such
+  /// as the operation's approach) that workingstep `ws` is expanded on an
+  /// assumption: "workingstep @w: approach plunge_zigzag is not supported:
+  /// plunging along the tool axis". The moves are those the message names;
+  /// the warning only says so (--warnings-as-errors stops the compile there).
+  void assumed(const Node &ws, const Node &at, const std::string &message);
+};
+
+/// An empty `moves` for the executable `exec`, with the state in force.
+Node makeMoves(const Node &exec, const std::string &tool, double spindle, const std::string &coolant,
+               const std::string &setup);
+
+/// One workingstep as a family expands it.
+struct Step {
+  const Node &ws;                          ///< the workingstep
+  const Node &op;                          ///< its operation
+  const Node *strategy;                    ///< the node the family was found by (may be null)
+  const ir::FeatureShape *shape;           ///< null for families that need no shape
+  const ir::PlaneFrame *frame;             ///< the feature's frame (explicit toolpaths only)
+  const Plan &plan;
+  Node &moves;                             ///< the `moves` node the family fills
+};
+
+/// Expands one step into `step.moves`; false (after a diagnostic) when the
+/// step gets no moves.
+using ExpandFn = bool (*)(Expander &, const Step &);
+
+/// A family of strategies, as the registry holds it.
+struct Family {
+  ir::Kind key;                              ///< the kind of the node that selects it
+  std::string_view name;                     ///< for messages: "2.5D milling"
+  bool needsShape;                           ///< the feature's shape, not only its frame
+  /// The approach types the family follows; any other is reported.
+  std::span<const std::string_view> approaches;
+  /// What the family does instead of an approach it does not follow.
+  std::string_view otherApproach;
+  ExpandFn expand;
+};
+
+/// The family registered for strategy kind `key`; null when none is.
+const Family *findFamily(ir::Kind key);
+
+// --- The families' entry points (one file each) ---------------------------------
+
+/// ExplicitToolpaths.cpp: an operation's `toolpath` children, lowered exactly.
+bool expandExplicitToolpaths(Expander &x, const Step &step);
+/// ExplicitToolpaths.cpp: a `rapid_movement`'s points as rapids.
+void expandRapidMovement(Expander &x, Node &rm, const std::string &setup);
+/// HoleMaking.cpp: axial moves on a round hole's axis.
+bool expandHoleMaking(Expander &x, const Step &step);
+/// Milling2D.cpp: levels, the strategy's paths at each, approaches and links.
+bool expandMilling2D(Expander &x, const Step &step);
+/// PatternStrategies.cpp: trochoids along the guide strategy's paths.
+bool expandTrochoidal(Expander &x, const Step &step);
+/// PatternStrategies.cpp: plunges along the guide strategy's paths.
+bool expandPlunging(Expander &x, const Step &step);
+
+// --- Shared by the milling families ---------------------------------------------
+
+/// Milling2D.cpp: the heights a milling operation cuts at, from the top down
+/// to the floor plus its allowance, in equal steps no deeper than the axial
+/// depth of cut; none (after a warning) when the allowance leaves nothing.
+std::vector<double> levelsOf(Expander &x, const Node &ws, const Node &op, const ir::FeatureShape &s, const Plan &p);
+
+/// Milling2D.cpp: where the tool centre may be at one level: away from walls
+/// and islands by the radius plus the side allowance; for faces, over the
+/// face and past it.
+Region centreArea(const ir::FeatureShape &s, const Region &area, const std::vector<Region> &islands, const Plan &p);
+
+/// Milling2D.cpp: the islands standing at height z, grown by the side allowance.
+std::vector<Region> islandsAt(const ir::FeatureShape &s, double z, double allowance);
+
+/// Milling2D.cpp: the tool centre's path along a slot: its course of travel,
+/// stopped the tool radius (and side allowance) short of flat ends, short of
+/// radiused ends as far as the tool is narrower than the slot, and run a
+/// radius past open ends. None when the tool is wider than the slot less its
+/// allowances.
+std::optional<Path2D> slotCentreline(const ir::FeatureShape::SlotPath &slot, const Plan &p);
+
+/// Milling2D.cpp: the plane paths of strategy `type` in the centre area;
+/// none for a strategy not expanded yet.
+std::optional<std::vector<Path2D>> strategyPaths(const std::string &type, bool face, bool unbounded, bool sideOnly,
+                                                 const Region &centres, const Vec2 &strokeDir, double stepover,
+                                                 bool followOrientation, double radius);
+
+/// Milling2D.cpp: one plane path at height z, reached by a link at depth when
+/// allowed and inside the centre area, else from the security plane by the
+/// operation's approach.
+/// `fallbacks` counts the paths whose helix or ramp did not fit and that
+/// were entered along the tool axis instead.
+void cutPath(Emitter &e, const Path2D &path, double z, const Plan &p, const Node &op, const Region &centres,
+             bool mayLink, bool unbounded, int &fallbacks);
+
+/// Milling2D.cpp: the warning, once per step, that `fallbacks` paths were
+/// entered along the tool axis because the operation's helix or ramp did
+/// not fit there.
+void reportApproachFallbacks(Expander &x, const Step &step, int fallbacks);
+
+/// Milling2D.cpp: whether a strategy's paths turn counter-clockwise (the
+/// orientation of a Region's outer loops): climb keeps the wall on the
+/// tool's right for a clockwise (M3) spindle, conventional on its left;
+/// without a cut mode, the rotation it names; else counter-clockwise.
+bool counterClockwise(const Node *strategy, double spindle);
+
+/// Contour.cpp: a loop started at the point nearest to p (the segment there is split).
+Loop startNearest(const Loop &l, const Vec2 &p);
+
+/// Contour.cpp: the widest stepover between rings of a tool of radius
+/// `radius` that leaves no material at the target's sharpest convex corner
+/// (R (1 + sin(theta / 2)), REFERENCES), with 2 % to spare.
+double ringCoverLimit(const ir::FeatureShape &s, double radius);
+
+/// Contour.cpp: contour-parallel rings, the boundaries of the centre area
+/// shrunk by 0, s, 2s, ... innermost first (all) or the outermost ring only.
+std::vector<Path2D> rings(const Region &centres, double stepover, bool followOrientation, bool all, double radius);
+
+/// Zigzag.cpp: the stroke direction: the strategy's feed direction, else
+/// the face's course of travel, else the feature's x axis.
+Vec2 strokeDirection(const Node &feature, const ir::FeatureShape &s, const Node *strategy);
+
+/// Zigzag.cpp: parallel strokes across the area in direction `dir`,
+/// `stepover` apart, each clipped to the area; alternate strokes reversed
+/// when bidirectional.
+std::vector<Path2D> strokes(const Region &area, const Vec2 &dir, double stepover, bool bidirectional,
+                            double overtravel);
+
+} // namespace stepnc::passes::expand

@@ -1,0 +1,348 @@
+// 2.5D milling with an ordinary strategy (ISO 14649-11 two5D_milling_strategy):
+// the levels from the feature's top to its floor, at each level the paths of
+// the strategy in the area the tool centre may reach (contour rings, zigzag
+// or one-way strokes, both, or the course of travel of a slot), each path
+// reached by a link at depth or from the security plane by the operation's
+// approach (along the axis, a helix or a ramp). The geometry of the rings
+// and strokes is in Contour.cpp and Zigzag.cpp; the pattern strategies reuse
+// the centre area, the paths and cutPath from here.
+#include "passes/expand/Expand.h"
+
+#include "support/Format.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace stepnc::passes::expand {
+
+namespace {
+
+/// Whether side milling follows strategy `type` on a feature (face or not):
+/// it goes round the walls, which is what the contour strategies do, and
+/// strokes on faces.
+bool sideMillingFollows(const std::string &type, bool face) {
+  if (type == "contour_parallel" || type == "contour_spiral")
+    return true;
+  return face && (type == "bidirectional" || type == "unidirectional");
+}
+
+/// Down to height z at the start of `path`: along the tool axis, or by a
+/// helix or a ramp when the operation asks and there is room; `fallbacks`
+/// counts a helix or ramp that did not fit.
+void approach(Emitter &e, const Path2D &path, double z, const Plan &p, const Node &op, const Region &centres,
+              int &fallbacks) {
+  const Vec2 start = path.front().a;
+  const Node *a = op.child(ir::Kind::Approach);
+  const std::string type = a ? a->text("type").value_or("plunge_toolaxis") : "plunge_toolaxis";
+  if (type == "plunge_helix") {
+    const double radius = a->number("radius").value_or(p.radius / 2);
+    const Vec2 centre = start - Vec2(radius, 0);
+    const geom::SegIndex walls = geom::SegIndex::of(centres);
+    if (radius > 1e-3 && centres.contains(centre) && walls.distance(centre) >= radius - 1e-9) {
+      e.travel(start, p.clearanceZ);
+      const double angle = a->number("angle").value_or(5.0) * kPi / 180;
+      const double perTurn = 2 * kPi * radius * std::tan(std::max(angle, 0.5 * kPi / 180));
+      const int64_t turns = static_cast<int64_t>(std::ceil((p.clearanceZ - z) / perTurn - 1e-9));
+      e.arc(at(start, z), centre, true, std::max<int64_t>(turns - 1, 0), p.plungeFeed, "plunge");
+      return;
+    }
+    ++fallbacks;
+  } else if (type == "plunge_ramp") {
+    // Down along the path's first segment and back, as often as needed.
+    const double angle = std::max(a->number("angle").value_or(3.0), 0.5) * kPi / 180;
+    const Seg &first = path.front();
+    if (!first.isArc() && first.length() > 2 * p.radius) {
+      e.travel(start, p.clearanceZ);
+      double height = p.clearanceZ;
+      const double drop = first.length() * std::tan(angle);
+      bool out = true;
+      while (height > z + 1e-9) {
+        height = std::max(z, height - drop);
+        e.linear(at(out ? first.b : first.a, height), p.plungeFeed, "plunge");
+        out = !out;
+      }
+      if (!out)
+        e.linear(at(first.a, z), p.feed, "plunge");
+      return;
+    }
+    ++fallbacks;
+  }
+  // Along the tool axis: asked for, or (reported by the caller) a helix or
+  // ramp that does not fit, or an approach type the family does not follow.
+  e.travel(start, p.clearanceZ);
+  e.linear(at(start, z), p.plungeFeed, "plunge");
+}
+
+} // namespace
+
+std::vector<double> levelsOf(Expander &x, const Node &ws, const Node &op, const ir::FeatureShape &s, const Plan &p) {
+  const double floorZ = s.bottom + p.allowanceBottom;
+  if (floorZ >= s.top - 1e-9) {
+    x.unsupported(ws, "the bottom allowance leaves nothing to cut");
+    return {};
+  }
+  const double ap = op.number("axial_depth").value_or(0);
+  const int count = ap > 1e-9 ? std::max(1, static_cast<int>(std::ceil((s.top - floorZ) / ap - 1e-9))) : 1;
+  std::vector<double> out;
+  for (int i = 1; i <= count; ++i)
+    out.push_back(s.top - (s.top - floorZ) * i / count);
+  return out;
+}
+
+bool expandMilling2D(Expander &x, const Step &step) {
+  const Node &ws = step.ws, &op = step.op;
+  const ir::FeatureShape &s = *step.shape;
+  const Plan &p = step.plan;
+  const Node *strategy = step.strategy;
+  std::string type = strategy ? strategy->text("type").value_or("") : "";
+  const bool face = op.is(ir::Trait::FaceOperation) || ir::hasTraits(s.kind, ir::Trait::FaceFeature);
+  if (type.empty())
+    type = face ? "bidirectional" : "contour_parallel";
+  const bool sideOnly = op.is(ir::Trait::SideOnly);
+
+  const std::vector<double> levels = levelsOf(x, ws, op, s, p);
+  if (levels.empty())
+    return false;
+
+  // The stepover: the radial depth of cut, else the overlap; never so wide
+  // that a ring leaves material at the region's sharpest convex corner.
+  double stepover = op.number("radial_depth").value_or(0);
+  const double overlap = strategy ? strategy->number("overlap").value_or(-1) : -1;
+  if (stepover <= 0 && overlap > 0 && overlap < 1)
+    stepover = 2 * p.radius * (1 - overlap);
+  if (stepover <= 0)
+    stepover = p.radius;
+  const double coverLimit = ringCoverLimit(s, p.radius);
+  const double limitBidir = 2 * p.radius * 0.98;
+  stepover = std::min(stepover, type == "bidirectional" || type == "unidirectional" ? limitBidir : coverLimit);
+
+  const bool followOrientation = counterClockwise(strategy, p.spindle);
+
+  const Vec2 strokeDir = strokeDirection(*p.feature, s, strategy);
+  const bool linkAtDepth = type == "contour_spiral" || type == "contour_parallel" || type == "bidirectional" ||
+                           type == "contour_bidirectional" || type == "bidirectional_contour";
+  // What the file asked for and is not what the moves do: said once per step.
+  bool saidSlotLine = false, saidSideMilling = false;
+  int fallbacks = 0;
+  Emitter e(step.moves, ws.number("secplane").value_or(0));
+  // The centre area and the paths depend on the level only through the
+  // islands standing at it: they are made again only when that set changes.
+  std::optional<std::vector<bool>> standing;
+  Region centres;
+  std::vector<Path2D> paths;
+  for (size_t i = 0; i < levels.size(); ++i) {
+    const double z = levels[i];
+    std::vector<bool> here;
+    for (const ir::IslandShape &isl : s.islands)
+      here.push_back(isl.top > z + 1e-9);
+    if (standing != here) {
+      standing = here;
+      std::vector<Region> islands;
+      for (size_t k = 0; k < s.islands.size(); ++k)
+        if (here[k])
+          islands.push_back(geom::offset(s.islands[k].region, p.allowanceSide));
+      centres = centreArea(s, s.unbounded ? s.target : s.limit, islands, p);
+      paths.clear();
+      // Center milling, and slots exactly as wide as the tool: along the course of travel.
+      if (s.slot && (type == "center_milling" || centres.empty())) {
+        std::optional<Path2D> line = slotCentreline(*s.slot, p);
+        if (!line) {
+          x.report(ws, "its tool " + p.tool->symbol + " (diameter " + formatFixed(2 * p.radius, 3) +
+                           " mm) does not fit in slot " + s.symbol + " (width " + formatFixed(s.slot->width, 3) +
+                           " mm) with the side allowance");
+          return false;
+        }
+        if (strategy && type != "center_milling" && !saidSlotLine) {
+          x.assumed(ws, *strategy,
+                    "strategy " + type + " is not supported in slot " + s.symbol + ", no wider than tool " +
+                        p.tool->symbol + " with the side allowance: center milling along its course of travel");
+          saidSlotLine = true;
+        }
+        centres = geom::offset(s.target, -geom::kEps);  // links stay in the slot
+        paths.push_back(std::move(*line));
+      } else if (type == "center_milling") {
+        x.unsupported(ws, "center milling follows the course of travel of a slot; " + s.symbol + " is a " +
+                              s.kindName());
+        return false;
+      } else if (!centres.empty()) {
+        auto made = strategyPaths(type, face, s.unbounded, sideOnly, centres, strokeDir, stepover,
+                                  followOrientation, p.radius);
+        if (!made) {
+          x.unsupported(ws, "strategy '" + type + "' is not expanded yet");
+          return false;
+        }
+        if (sideOnly && strategy && !sideMillingFollows(type, face) && !saidSideMilling) {
+          x.assumed(ws, *strategy,
+                    "strategy " + type + " is not supported by " + op.kindName() + ": one contour along " +
+                        (face || s.unbounded ? "each island" : "the walls"));
+          saidSideMilling = true;
+        }
+        paths = std::move(*made);
+      } else if (!(s.holeCentre && 2 * p.radius <= s.holeDiameter + 1e-6)) {
+        x.report(ws, "its tool " + p.tool->symbol + " (diameter " + formatFixed(2 * p.radius, 3) +
+                         " mm) does not fit in " + s.symbol + " with the side allowance");
+        return false;
+      }
+    }
+    if (centres.empty()) {
+      // A cutter as wide as the hole: straight down its axis.
+      e.travel(*s.holeCentre, p.clearanceZ);
+      e.linear(at(*s.holeCentre, z), p.plungeFeed, "plunge");
+      e.retract();
+      continue;
+    }
+    if (s.slot && paths.size() == 1 && !geom::Chain{paths[0]}.closed()) {
+      // One open path per level (center milling): down at the end where the
+      // level before finished, and back along it.
+      if (i > 0) {
+        Loop back{paths[0]};
+        back.reverse();
+        paths[0] = std::move(back.segs);
+      }
+      cutPath(e, paths[0], z, p, op, centres, false, false, fallbacks);
+      continue;
+    }
+    for (size_t k = 0; k < paths.size(); ++k)
+      cutPath(e, paths[k], z, p, op, centres, linkAtDepth && k > 0, s.unbounded, fallbacks);
+  }
+  e.retract();
+  reportApproachFallbacks(x, step, fallbacks);
+  return true;
+}
+
+std::optional<Path2D> slotCentreline(const ir::FeatureShape::SlotPath &slot, const Plan &p) {
+  const double reach = p.radius + p.allowanceSide;
+  if (2 * reach > slot.width + 1e-6)
+    return std::nullopt;
+  auto inset = [&](const std::string &end) {
+    if (end == "open")
+      return -p.radius;
+    if (end == "radiused")
+      return std::max(0.0, reach - slot.width / 2);
+    return reach;
+  };
+  const Vec2 along = (slot.to - slot.from).normalized();
+  const double length = (slot.to - slot.from).norm();
+  const double in1 = inset(slot.end1), in2 = inset(slot.end2);
+  if (length - in1 - in2 < -1e-9)
+    return std::nullopt;
+  const Vec2 a = slot.from + along * in1;
+  const Vec2 b = slot.from + along * std::max(in1, length - in2);
+  return Path2D{Seg::line(a, b)};
+}
+
+std::optional<std::vector<Path2D>> strategyPaths(const std::string &type, bool face, bool unbounded, bool sideOnly,
+                                                 const Region &centres, const Vec2 &strokeDir, double stepover,
+                                                 bool followOrientation, double radius) {
+  const bool strokesOnly = type == "bidirectional" || type == "unidirectional";
+  if (face && strokesOnly)
+    return strokes(centres, strokeDir, stepover, type == "bidirectional", radius);
+  if (sideOnly) {
+    // Side milling follows the walls; with no walls around (outside
+    // profiles, faces) only the rings round what stands.
+    std::vector<Path2D> out = rings(centres, stepover, followOrientation, /*all=*/false, radius);
+    if (face || unbounded)
+      std::erase_if(out, [&](const Path2D &ring) { return (Loop{ring}.area() > 0) == followOrientation; });
+    return out;
+  }
+  if (type == "contour_parallel" || type == "contour_spiral")
+    return rings(centres, stepover, followOrientation, /*all=*/true, radius);
+  if (strokesOnly)
+    return strokes(centres, strokeDir, stepover, type == "bidirectional", 0);
+  if (type == "contour_bidirectional" || type == "bidirectional_contour") {
+    // Zigzag inside the first ring, and the ring: before or after.
+    std::vector<Path2D> ring = rings(centres, stepover, followOrientation, false, radius);
+    std::vector<Path2D> zig = strokes(geom::offset(centres, -stepover), strokeDir, stepover, true, 0);
+    std::vector<Path2D> paths = type == "contour_bidirectional" ? ring : zig;
+    const auto &rest = type == "contour_bidirectional" ? zig : ring;
+    paths.insert(paths.end(), rest.begin(), rest.end());
+    return paths;
+  }
+  return std::nullopt;
+}
+
+Region centreArea(const ir::FeatureShape &s, const Region &area, const std::vector<Region> &islands, const Plan &p) {
+  const double reach = p.radius + p.allowanceSide;
+  Region centres;
+  if (s.unbounded) {
+    centres = geom::offset(area, p.radius);  // overtravel: the tool's edge reaches the face's edge
+  } else {
+    centres = geom::offset(area, -reach);
+    // Open sides: only where the tool touches the material.
+    if (s.limit.area() > s.target.area() + 1e-6)
+      centres = geom::intersect(centres, geom::offset(s.target, p.radius - 1e-6));
+  }
+  for (const Region &isl : islands)
+    centres = geom::subtract(centres, geom::offset(isl, p.radius));
+  return centres;
+}
+
+std::vector<Region> islandsAt(const ir::FeatureShape &s, double z, double allowance) {
+  std::vector<Region> out;
+  for (const ir::IslandShape &isl : s.islands)
+    if (isl.top > z + 1e-9)
+      out.push_back(geom::offset(isl.region, allowance));
+  return out;
+}
+
+bool counterClockwise(const Node *strategy, double spindle) {
+  const std::string cutmode = strategy ? strategy->text("cutmode").value_or("") : "";
+  const std::string rotation = strategy ? strategy->text("rotation").value_or("") : "";
+  if (!cutmode.empty())
+    return (cutmode == "climb") == (spindle <= 0);
+  return rotation.empty() || rotation == "ccw";
+}
+
+void cutPath(Emitter &e, const Path2D &given, double z, const Plan &p, const Node &op, const Region &centres,
+             bool mayLink, bool unbounded, int &fallbacks) {
+  if (given.empty())
+    return;
+  // A closed ring starts where it is nearest to the tool.
+  Path2D nearest;
+  if (e.positioned() && given.size() > 1 && (given.front().a - given.back().b).norm() < 1e-7) {
+    Loop ring;
+    ring.segs = given;
+    nearest = startNearest(ring, e.position().head<2>()).segs;
+  }
+  const Path2D &path = nearest.empty() ? given : nearest;
+  const Vec2 start = path.front().a;
+  bool linked = false;
+  if (mayLink && e.positioned() && std::abs(e.position().z() - z) < 1e-9) {
+    const Vec2 here = e.position().head<2>();
+    std::vector<Seg> inside = geom::clip(centres, here, start);
+    double len = 0;
+    for (const Seg &sg : inside)
+      len += sg.length();
+    if (unbounded || std::abs(len - (start - here).norm()) < 1e-6) {
+      e.linear(at(start, z), p.feed, "link");
+      linked = true;
+    }
+  }
+  const Node *a = op.child(ir::Kind::Approach);
+  const bool straightDown = !a || a->text("type").value_or("plunge_toolaxis") == "plunge_toolaxis";
+  if (!linked && straightDown && e.positioned() && (e.position().head<2>() - start).norm() <= geom::kEps &&
+      e.position().z() > z) {
+    // Already over the start, in what the level above cut: straight down.
+    e.linear(at(start, z), p.plungeFeed, "plunge");
+    linked = true;
+  }
+  if (!linked)
+    approach(e, path, z, p, op, centres, fallbacks);
+  for (const Seg &sg : path)
+    e.seg(sg, z, p.feed);
+}
+
+void reportApproachFallbacks(Expander &x, const Step &step, int fallbacks) {
+  const Node *a = step.op.child(ir::Kind::Approach);
+  if (fallbacks == 0 || !a)
+    return;
+  const std::string type = a->text("type").value_or("");
+  x.assumed(step.ws, *a,
+            "approach " + type + " does not fit at " + std::to_string(fallbacks) + " path start" +
+                (fallbacks == 1 ? "" : "s") +
+                (type == "plunge_helix" ? " (the helix leaves the area the tool centre may reach)"
+                                        : " (no straight first segment longer than the tool's diameter)") +
+                ": plunging along the tool axis there");
+}
+
+} // namespace stepnc::passes::expand
