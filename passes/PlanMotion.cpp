@@ -28,6 +28,12 @@ public:
     const auto machine = runtime::loadMachine(machinePath_, machineFile_, diags);
     if (!machine)
       return {false, false};
+    // The planner moves x, y and z: a lathe or a generic chain is refused
+    // rather than planned with its axes taken for x, y, z.
+    if (const std::string why = machine->whyNotThreeAxis(); !why.empty()) {
+      diags.error({}, "plan-motion: " + why);
+      return {false, false};
+    }
     const ir::ProgramPath program = ir::programPath(module);
     if (program.path.moves.empty()) {
       diags.warning({}, "plan-motion: the program has no moves to plan (run expand-strategies first)");

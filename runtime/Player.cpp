@@ -25,6 +25,8 @@
 //    planner that misreads a move is caught.
 #include "runtime/Player.h"
 
+#include "runtime/Kinematics.h"
+
 #include "support/Format.h"
 
 #include <algorithm>
@@ -167,6 +169,12 @@ std::string_view violationKindName(ViolationKind kind) {
     return "deviation";
   case ViolationKind::EndState:
     return "end state";
+  case ViolationKind::Travel:
+    return "travel";
+  case ViolationKind::Extent:
+    return "extent";
+  case ViolationKind::Spindle:
+    return "spindle";
   }
   return "?";
 }
@@ -231,6 +239,83 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
     ++r.violationCount;
     if (r.violations.size() < options.maxViolations)
       r.violations.push_back({kind, axis, t, segment, value, limit});
+  };
+
+  // The spindle: each change of speed, where the move that makes it starts.
+  if (!options.spindleRpm.empty()) {
+    r.spindleChecked = true;
+    double t = 0, last = -1;
+    bool any = false;
+    for (size_t i = 0; i < n; ++i) {
+      const uint32_t move = trajectory.info[i].move;
+      const double rpm = move < options.spindleRpm.size() ? std::abs(options.spindleRpm[move]) : 0;
+      if (rpm > 0) {
+        r.spindleMinRpm = any ? std::min(r.spindleMinRpm, rpm) : rpm;
+        r.spindleMaxRpm = any ? std::max(r.spindleMaxRpm, rpm) : rpm;
+        any = true;
+      }
+      if (rpm != last && rpm > 0) {
+        if (rpm > machine.spindleMax)
+          violate(ViolationKind::Spindle, -1, t, static_cast<uint32_t>(i), rpm, machine.spindleMax);
+        else if (rpm < machine.spindleMin)
+          violate(ViolationKind::Spindle, -1, t, static_cast<uint32_t>(i), rpm, machine.spindleMin);
+      }
+      last = rpm;
+      t += durations[i];
+    }
+  }
+
+  // Travel: each sample's axis positions through the kinematics, the tool
+  // along +z (the rotary axes stay at 0).
+  r.travelNotChecked = machine.whyNotThreeAxis();
+  std::unique_ptr<Kinematics> kinematics;
+  if (r.travelNotChecked.empty() && machine.kinematics.chain != Chain::Xyz) {
+    std::string error;
+    kinematics = makeKinematics(machine, error);
+    if (!kinematics)
+      r.travelNotChecked = error;
+  }
+  const bool checkTravel = r.travelNotChecked.empty() && !machine.axes.empty();
+  r.workOffsetMm = options.workOffsetMm;
+  const Vec3 offset = options.workOffsetMm.value_or(Vec3::Zero());
+  std::vector<bool> outside(machine.axes.size(), false), spanReported(machine.axes.size(), false);
+  Joints joints = Joints::Zero(static_cast<Eigen::Index>(machine.axes.size()));
+  bool haveJoints = false;
+  auto checkTravelAt = [&](const Vec3 &p, double t, uint32_t sg) {
+    if (!checkTravel)
+      return;
+    const ToolPose pose{p + offset, Vec3::UnitZ()};
+    if (kinematics) {
+      const InverseResult ir = kinematics->inverse(pose, haveJoints ? &joints : nullptr);
+      if (!ir.joints)
+        return;  // not on a chain whose rotary axes can stay at 0 (whyNotThreeAxis says so)
+      joints = *ir.joints;
+    } else {
+      joints = pose.tipMm;  // xyz: the axes are the tip's coordinates
+    }
+    for (size_t k = 0; k < machine.axes.size(); ++k) {
+      const Axis &axis = machine.axes[k];
+      const double q = joints[static_cast<Eigen::Index>(k)];
+      if (!haveJoints) {
+        r.axisMin.push_back(q);
+        r.axisMax.push_back(q);
+      }
+      r.axisMin[k] = std::min(r.axisMin[k], q);
+      r.axisMax[k] = std::max(r.axisMax[k], q);
+      const double slack = 1e-9 * (1 + std::max(std::abs(axis.travelMin), std::abs(axis.travelMax)));
+      if (options.workOffsetMm) {
+        // Once per excursion: where the axis leaves its travel.
+        const bool out = q < axis.travelMin - slack || q > axis.travelMax + slack;
+        if (out && !outside[k])
+          violate(ViolationKind::Travel, static_cast<int>(k), t, sg, q, q < axis.travelMin ? axis.travelMin : axis.travelMax);
+        outside[k] = out;
+      } else if (!spanReported[k] && r.axisMax[k] - r.axisMin[k] > axis.travelMax - axis.travelMin + slack) {
+        violate(ViolationKind::Extent, static_cast<int>(k), t, sg, r.axisMax[k] - r.axisMin[k],
+                axis.travelMax - axis.travelMin);
+        spanReported[k] = true;
+      }
+    }
+    haveJoints = true;
   };
 
   // The segment under the samples, and what is known of it.
@@ -383,6 +468,7 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
       }
     }
 
+    checkTravelAt(s.p, s.t, s.segment);
     if (onSample)
       onSample(s);
     prev = s;
@@ -512,6 +598,39 @@ std::string formatReport(const SimReport &report, const Trajectory &trajectory, 
            formatFixed(report.maxJerk[k], 1) + " mm/s^3" + of(report.maxJerk[k], axis.jerk) + "\n";
   }
 
+  // Travel: the range each axis covers, against its travel.
+  if (!report.travelNotChecked.empty()) {
+    out += "travel: not checked (" + report.travelNotChecked + ")\n";
+  } else if (report.axisMin.size() == machine.axes.size()) {
+    auto mm = [](double v) { return formatFixed(v, 3); };
+    if (report.workOffsetMm) {
+      const Vec3 &o = *report.workOffsetMm;
+      out += "travel (program origin at machine " + mm(o.x()) + ", " + mm(o.y()) + ", " + mm(o.z()) + " mm):";
+    } else {
+      out += "travel (program origin not given: extents only):";
+    }
+    for (size_t k = 0; k < machine.axes.size(); ++k) {
+      const Axis &axis = machine.axes[k];
+      const std::string unit = axis.rotary ? " deg" : " mm";
+      out += std::string(k ? "," : "") + " " + axis.name + " ";
+      if (report.workOffsetMm)
+        out += mm(report.axisMin[k]) + " to " + mm(report.axisMax[k]) + unit + " in [" + mm(axis.travelMin) + ", " +
+               mm(axis.travelMax) + "]";
+      else
+        out += mm(report.axisMax[k] - report.axisMin[k]) + " of " + mm(axis.travelMax - axis.travelMin) + unit;
+    }
+    out += "\n";
+  }
+  if (!report.spindleChecked)
+    out += "spindle: not checked (the motion carries no spindle speeds)\n";
+  else if (report.spindleMaxRpm == 0)
+    out += "spindle: stopped throughout (machine " + formatTrimmed(machine.spindleMin, 6) + " to " +
+           formatTrimmed(machine.spindleMax, 6) + " rev/min)\n";
+  else
+    out += "spindle: " + formatTrimmed(report.spindleMinRpm, 6) + " to " + formatTrimmed(report.spindleMaxRpm, 6) +
+           " rev/min (machine " + formatTrimmed(machine.spindleMin, 6) + " to " + formatTrimmed(machine.spindleMax, 6) +
+           " rev/min)\n";
+
   if (report.deviationChecked)
     out += "contour deviation: max " + formatFixed(report.maxDeviation, 4) + " mm (tolerance " +
            formatFixed(report.tolerance, 4) + " mm)\n";
@@ -552,6 +671,26 @@ std::string formatReport(const SimReport &report, const Trajectory &trajectory, 
                " mm)";
       else
         out += ", axis " + axisName(machine, v.axis) + ": not at rest at the end (" + perMinute(v.value) + ")";
+      break;
+    case ViolationKind::Travel: {
+      const Axis *axis = v.axis >= 0 && static_cast<size_t>(v.axis) < machine.axes.size()
+                             ? &machine.axes[static_cast<size_t>(v.axis)]
+                             : nullptr;
+      const std::string unit = axis && axis->rotary ? " deg" : " mm";
+      out += ", axis " + axisName(machine, v.axis) + ": position " + formatFixed(v.value, 3) + unit +
+             " outside the travel";
+      if (axis)
+        out += " [" + formatFixed(axis->travelMin, 3) + ", " + formatFixed(axis->travelMax, 3) + "]" + unit;
+      break;
+    }
+    case ViolationKind::Extent:
+      out += ", axis " + axisName(machine, v.axis) + ": the program spans " + formatFixed(v.value, 3) +
+             " mm by here, more than the travel's " + formatFixed(v.limit, 3) + " mm (no program origin fits it)";
+      break;
+    case ViolationKind::Spindle:
+      out += ": spindle " + formatTrimmed(v.value, 6) + " rev/min " +
+             (v.value > v.limit ? "above the machine's maximum " : "below the machine's minimum ") +
+             formatTrimmed(v.limit, 6) + " rev/min";
       break;
     }
     out += "\n";

@@ -8,6 +8,14 @@
 // checked against its neighbour sample, |a(t+T) - a(t)| <= j_max T, so a jump
 // between samples (a curvature step, a profile that does not join) cannot hide
 // between two samples.
+//
+// Travel and spindle: each sample's position is mapped through the machine's
+// kinematics (runtime/Kinematics.h; rotary axes at 0, tool along +z) to its
+// axes' positions. With the program origin's place on the machine given
+// (SimOptions::workOffsetMm) each is checked against its travel; without
+// it, only that the program's extent on each axis fits the travel somewhere.
+// The spindle speed of each programmed move, when the caller knows it (the
+// native format does not carry it), is checked against the machine's range.
 #pragma once
 
 #include "runtime/Machine.h"
@@ -16,6 +24,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -38,12 +47,15 @@ enum class ViolationKind : uint8_t {
   Feed,          ///< speed along the path above the programmed feed
   Deviation,     ///< further from the programmed path than the tolerance
   EndState,      ///< not at rest at the programmed end point (see Violation::value)
+  Travel,        ///< an axis's position (machine coordinates) outside its travel
+  Extent,        ///< the program's extent on an axis is longer than its travel: no program origin fits
+  Spindle,       ///< a move's spindle speed outside the machine's range
 };
 std::string_view violationKindName(ViolationKind kind);
 
 struct Violation {
   ViolationKind kind = ViolationKind::Velocity;
-  int axis = -1;       ///< 0, 1, 2; -1 when not per axis
+  int axis = -1;       ///< index in Machine::axes; -1 when not per axis
   double t = 0;        ///< s
   uint32_t segment = 0;
   /// What was measured: mm/s, mm/s^2, mm/s^3 for the axis limits (a jump
@@ -51,6 +63,10 @@ struct Violation {
   /// for Feed, mm for Deviation. EndState: with axis -1 the distance in mm
   /// from where the motion should end; with axis 0-2 that axis has not come
   /// to rest, value its |v| in mm/s (the axis may instead still accelerate).
+  /// Travel: the axis's position (mm, or deg for a rotary axis) when it
+  /// leaves its travel, limit the bound it crosses. Extent: the extent so far
+  /// (mm), limit the travel's length. Spindle: rev/min, limit the bound of
+  /// the machine's range that it is beyond; t is where the move starts.
   double value = 0;
   double limit = 0;    ///< what was allowed, in the same unit
 };
@@ -80,6 +96,15 @@ struct SimOptions {
   double slowFraction = 0.95;
   size_t maxViolations = 20;  ///< violations kept in the report (all are counted)
   size_t maxSlowSpots = 10;   ///< slowest places kept
+  /// Where the program's origin is on the machine (mm, machine coordinates
+  /// with the rotary axes at 0): positions are then checked against the
+  /// travel. Unknown (stepnc does not know the setups' work offsets yet): only
+  /// the program's extent is checked.
+  std::optional<Vec3> workOffsetMm;
+  /// Per programmed move (SegmentInfo::move), its spindle speed in rev/min
+  /// (the sign, the direction, is ignored; 0 = stopped, allowed). Empty: the
+  /// spindle is not checked.
+  std::vector<double> spindleRpm;
 };
 
 struct SimReport {
@@ -100,6 +125,14 @@ struct SimReport {
   Vec3 maxJerk = Vec3::Zero();          ///< |j| per axis
   double maxDeviation = 0;  ///< mm; 0 without a programmed path
   Vec3 endPosition = Vec3::Zero();
+  /// Per machine axis, the lowest and highest position the samples reach
+  /// (mm or deg): machine coordinates with a work offset, else the
+  /// program's. Empty when the travel was not checked.
+  std::vector<double> axisMin, axisMax;
+  std::string travelNotChecked;  ///< why the travel was not checked (empty when it was)
+  std::optional<Vec3> workOffsetMm;  ///< as given: positions checked, else extents only
+  bool spindleChecked = false;
+  double spindleMinRpm = 0, spindleMaxRpm = 0;  ///< over moves with the spindle turning (when checked)
   // The settings the figures were taken with, for the report's wording.
   double period = 0;         ///< s between samples
   double slowFraction = 0;   ///< of the programmed feed, below which speed counts as slow

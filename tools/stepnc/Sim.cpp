@@ -2,7 +2,13 @@
 // (runtime/Player.h) and reports its cycle time, the feed it actually
 // reaches, where and why it is slower, and any limit it breaks. IN may be the
 // native format, IR text (with motion, or moves to plan) or STEP-NC (compiled
-// to moves and planned first).
+// to moves and planned first). Besides the axes' dynamics it checks the
+// spindle speed of every move against the machine's range (IR and STEP-NC in:
+// the native format has no spindle speeds) and the axes' travel: each
+// position where the program origin is on the machine (--work-offset), else
+// only that the program's extent fits the travel. Machines whose chain the
+// player cannot move a 3-axis program on (lathes, generic chains) are
+// refused with the reason.
 #include "ir/motion/MotionIR.h"
 #include "ir/geom/MoveWalk.h"
 #include "runtime/Machine.h"
@@ -14,6 +20,8 @@
 #include "tools/stepnc/Driver.h"
 
 #include <CLI/CLI.hpp>
+#include <cmath>
+#include <cstdlib>
 #include <iostream>
 
 namespace stepnc::tool {
@@ -27,11 +35,30 @@ struct SimCommandOptions {
   std::string machine;
   std::optional<double> tolerance;
   std::optional<double> period;
+  std::string workOffset;  ///< "X,Y,Z" mm: the program origin in machine coordinates
   std::string samples;  ///< CSV of every sample
   std::string output = "-";
   SchemaOptions schema;
   DiagnosticOptions diag;
 };
+
+/// "X,Y,Z" as three finite numbers.
+std::optional<runtime::Vec3> parseWorkOffset(const std::string &text) {
+  runtime::Vec3 v;
+  size_t at = 0;
+  for (int k = 0; k < 3; ++k) {
+    const size_t comma = text.find(',', at);
+    if ((k < 2) != (comma != std::string::npos))
+      return std::nullopt;
+    const std::string part = text.substr(at, k < 2 ? comma - at : std::string::npos);
+    char *end = nullptr;
+    v[k] = std::strtod(part.c_str(), &end);
+    if (part.empty() || *end != '\0' || !std::isfinite(v[k]))
+      return std::nullopt;
+    at = comma + 1;
+  }
+  return v;
+}
 
 std::string label(const ir::Node &e) {
   std::string s = e.kindName() + " " + e.symbol;
@@ -51,6 +78,19 @@ int runSim(const SimCommandOptions &opts) {
   const auto machine = runtime::loadMachine(machineName, machineFile, diags);
   if (!machine)
     return kExitUsage;
+  if (const std::string why = machine->whyNotThreeAxis(); !why.empty()) {
+    printToolError("sim: " + why);
+    return kExitUsage;
+  }
+  std::optional<runtime::Vec3> workOffset;
+  if (!opts.workOffset.empty()) {
+    workOffset = parseWorkOffset(opts.workOffset);
+    if (!workOffset) {
+      printToolError("sim: --work-offset='" + opts.workOffset +
+                     "' is not a position: expected three numbers of mm, X,Y,Z, such as --work-offset=100,50,-300");
+      return kExitUsage;
+    }
+  }
 
   std::optional<runtime::Trajectory> trajectory;
   std::unique_ptr<ir::Module> module;
@@ -103,6 +143,15 @@ int runSim(const SimCommandOptions &opts) {
     simOptions.programmed = &program->path;
   if (opts.tolerance)
     simOptions.tolerance = *opts.tolerance;
+  simOptions.workOffsetMm = workOffset;
+  if (program) {
+    // Each move's spindle speed, from the `moves` node that holds it.
+    simOptions.spindleRpm.reserve(program->owners.size());
+    for (const ir::Node *owner : program->owners) {
+      const ir::Node *moves = owner ? owner->child(ir::Kind::Moves) : nullptr;
+      simOptions.spindleRpm.push_back(moves ? moves->number("spindle").value_or(0) : 0);
+    }
+  }
 
   OutputFile samplesOut;
   std::string error;
@@ -155,9 +204,13 @@ void registerSim(CLI::App &app, std::function<void(int)> setResult) {
   cmd->add_option("input", opts->input, "Native motion file, IR text or STEP-NC file")->required();
   cmd->add_option("--machine", opts->machine,
                   "Machine: a TOML file (docs/machine-model.md) or a shipped machine (hsc-3axis, the\n"
-                  "default, or conventional-3axis)");
+                  "default, conventional-3axis or table-table-5axis; lathe-2axis is refused)");
   cmd->add_option("--tolerance", opts->tolerance, "Path tolerance for blending and the deviation check, mm");
   cmd->add_option("--period", opts->period, "Sampling period, s (default: the machine's cycle time)");
+  cmd->add_option("--work-offset", opts->workOffset,
+                  "Where the program's origin is on the machine, X,Y,Z in mm (machine coordinates):\n"
+                  "every axis position is then checked against its travel (without it, only that\n"
+                  "the program's extent fits the travel)");
   cmd->add_option("--samples", opts->samples, "Write every sample (position, velocity, acceleration, jerk) as CSV");
   cmd->add_option("-o,--output", opts->output, "Report file ('-', the default, for standard output)");
   addSchemaOptions(*cmd, opts->schema);

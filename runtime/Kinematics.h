@@ -1,0 +1,92 @@
+// Kinematic transforms: from a machine's joint values (its axes' positions,
+// mm for linear axes and deg for rotary ones, in Machine::axes order) to the
+// tool's pose in the workpiece's frame (forward), and back (inverse). Built
+// from a Machine's KinematicsSpec: xyz, the 5-axis chains table-table,
+// head-table and head-head (any two of a, b, c), and the lathe. A generic
+// chain (a parallel-kinematic machine, a hexapod) is moved by a solver that
+// the program linking this library registers by name.
+//
+// Conventions (docs/machine-model.md): with every axis at 0 the workpiece's
+// frame is the machine's, and the tool's tip is at (x, y, z); so on a 5-axis
+// chain with its rotary axes at 0 a 3-axis program's positions are the
+// joints'. Positive angles turn right-handed about the axis's direction (a
+// table turns the workpiece, a head the tool); a machine that counts the
+// other way writes its rotary axis's direction in the solver's terms or
+// negates its programs' angles.
+#pragma once
+
+#include "runtime/Machine.h"
+
+#include <Eigen/Core>
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace stepnc::runtime {
+
+/// Joint values in Machine::axes order: mm for linear axes, deg for rotary.
+using Joints = Eigen::VectorXd;
+
+/// Where the tool is, in the workpiece's frame.
+struct ToolPose {
+  Eigen::Vector3d tipMm = Eigen::Vector3d::Zero();  ///< the tool tip (the controlled point)
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();  ///< unit, from the tip towards the spindle
+};
+
+/// What an inverse transform found.
+struct InverseResult {
+  std::optional<Joints> joints;  ///< nullopt when the pose cannot be reached
+  /// The pose is at a singularity (the tool along a rotary axis, a lathe's
+  /// tip on the spindle axis): one rotary axis was free, and kept the value
+  /// it has in `near` (or 0 without one).
+  bool singular = false;
+  /// Every solution found leaves some axis's travel; `joints` is the nearest
+  /// to `near` anyway.
+  bool outsideTravel = false;
+  std::string why;  ///< for nullopt: why the pose cannot be reached
+};
+
+/// A machine's kinematic transform. Implementations are immutable after
+/// construction and safe to call from several threads.
+class Kinematics {
+public:
+  virtual ~Kinematics() = default;
+  /// The chain's name ("table-table"; a generic solver's own name).
+  virtual std::string_view name() const = 0;
+  /// Number of joints (= Machine::axes.size()).
+  virtual size_t jointCount() const = 0;
+  /// The tool's pose at `joints`.
+  virtual ToolPose forward(const Joints &joints) const = 0;
+  /// Joint values that put the tool at `pose`. Where there are several
+  /// (two branches of a 5-axis chain, rotary angles 360 deg apart), the
+  /// solution inside every axis's travel nearest to `near` (the previous
+  /// joints; 0 when null) is taken; at a singularity the free rotary axis
+  /// keeps its value from `near`.
+  virtual InverseResult inverse(const ToolPose &pose, const Joints *near = nullptr) const = 0;
+};
+
+/// Makes a solver for a generic chain; `error` says why not when it returns
+/// null (a parameter missing, the axes not what it moves).
+using KinematicsFactory = std::function<std::unique_ptr<Kinematics>(const Machine &machine, std::string &error)>;
+
+/// Registers the solver a generic chain names by `solver = "NAME"` (a
+/// parallel-kinematic machine's, say). Registering a name again replaces
+/// it. Returns false when the name is empty.
+bool registerKinematicsSolver(const std::string &name, KinematicsFactory factory);
+
+/// The names registered so far, sorted.
+std::vector<std::string> kinematicsSolverNames();
+
+/// The transform of `machine`'s chain; null with `error` set when its
+/// generic solver is not registered or refuses the machine.
+std::unique_ptr<Kinematics> makeKinematics(const Machine &machine, std::string &error);
+
+/// Lathes: the X a program writes for a radius, and the radius for a
+/// programmed X (a diameter when the machine programs diameters).
+double programmedX(const Machine &machine, double radiusMm);
+double radiusFromProgrammedX(const Machine &machine, double programmedXMm);
+
+} // namespace stepnc::runtime
