@@ -82,8 +82,6 @@ std::string Machine::whyNotThreeAxis() const {
 
 namespace {
 
-bool isFiveAxis(Chain c) { return c == Chain::TableTable || c == Chain::HeadTable || c == Chain::HeadHead; }
-
 /// The direction a rotary axis named a, b or c turns about (ISO 841: about
 /// x, y, z); nullopt for other names.
 std::optional<Eigen::Vector3d> rotaryDirection(std::string_view name) {
