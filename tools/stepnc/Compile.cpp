@@ -461,7 +461,8 @@ void registerCompile(CLI::App &app, std::function<void(int)> setResult) {
       ->check(CLI::IsMember({"feature-ir", "toolpath-ir", "motion-ir", "program", "stepnc"}));
   cmd->add_option("--machine", opts->machine,
                   "Machine to plan the motion on, for --target=native and --emit=motion-ir: a TOML\n"
-                  "file (docs/machine-model.md) or a shipped machine (hsc-3axis, conventional-3axis);\n"
+                  "file (docs/machine-model.md) or a shipped machine (hsc-3axis, conventional-3axis,\n"
+                  "table-table-5axis; lathe-2axis is refused: the planner moves x, y, z);\n"
                   "feed adaptation also keeps feeds within its dynamics and spindle");
   cmd->add_flag("--no-adapt-feed", opts->noAdaptFeed,
                 "Keep the programmed feeds: leave out the adapt-feed pass (docs/feed-adaptation.md)");
