@@ -147,7 +147,6 @@ std::string_view categoryName(Category c);
 /// True if `kind` has every trait in `t`.
 inline bool hasTraits(Kind kind, Traits t) { return specOf(kind).is(t); }
 inline bool isOperation(Kind k) { return categoryOf(k) == Category::Operation; }
-inline bool isHoleMaking(Kind k) { return hasTraits(k, Trait::HoleMaking); }
 
 /// True if a child of kind `child` may appear under a node of kind `parent`.
 bool childAllowed(const KindSpec &parent, const KindSpec &child);

@@ -264,8 +264,9 @@ void Verifier::checkValue(const Node &n, const Attr &a) {
     report(n, attr() + " must be a unit vector, found length " + formatFixed(v.vec.norm(), 6));
   else if ((v.type == ValueType::FeedPerRev || (n.kind == Kind::Dwell && a.name == "time")) && v.number <= 0)
     report(n, attr() + " must be positive, found " + printed(v));
+  // (A state's spindle speed keeps its sign: negative is clockwise, as everywhere.)
   else if ((v.type == ValueType::Power || v.type == ValueType::MassFlow ||
-            (n.kind == Kind::State && v.type != ValueType::Word)) &&
+            (n.kind == Kind::State && v.type == ValueType::Feed)) &&
            v.number < 0)
     report(n, attr() + " must not be negative, found " + printed(v));
 }
