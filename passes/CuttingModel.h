@@ -85,11 +85,16 @@ struct CutStep {
   std::vector<CutMove> moves;
 
   /// The move of `moves` whose node is `node`, searching on from `cursor`
-  /// (moves are met in the order of their nodes); null for other children.
+  /// (moves are met in the order of their nodes); null for other children
+  /// (a state, a canned cycle, whose moves the cutting passes leave as they
+  /// are), which leave the cursor where it was.
   const CutMove *moveOf(const ir::Node &node, size_t &cursor) const {
-    while (cursor < moves.size() && moves[cursor].move.node != &node)
-      ++cursor;
-    return cursor < moves.size() ? &moves[cursor] : nullptr;
+    for (size_t k = cursor; k < moves.size(); ++k)
+      if (moves[k].move.node == &node) {
+        cursor = k;
+        return &moves[k];
+      }
+    return nullptr;
   }
 };
 

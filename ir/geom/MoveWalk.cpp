@@ -51,7 +51,16 @@ bool degenerateArc(const Move &m) { return (xy(*m.from) - xy(m.center)).norm() <
 Move readMove(const ir::Node &n, PathKind path) {
   Move m;
   m.node = &n;
-  m.kind = n.kind == ir::Kind::Rapid ? MoveKind::Rapid : n.kind == ir::Kind::Linear ? MoveKind::Linear : MoveKind::Arc;
+  switch (n.kind) {
+  case ir::Kind::Rapid: m.kind = MoveKind::Rapid; break;
+  case ir::Kind::Linear: m.kind = MoveKind::Linear; break;
+  case ir::Kind::Dwell:
+    m.kind = MoveKind::Dwell;
+    m.dwell = n.number("time").value_or(0);
+    m.role = "dwell";
+    return m;
+  default: m.kind = MoveKind::Arc; break;
+  }
   std::optional<ir::Vec3> to = path == PathKind::Predicted ? n.vec("nominal") : std::nullopt;
   m.to = to ? *to : n.vec("to").value_or(ir::Vec3::Zero());
   std::optional<ir::Vec3> center = path == PathKind::Predicted ? n.vec("nominal_center") : std::nullopt;
@@ -116,17 +125,39 @@ ir::Vec3 Move::pointAt(double s) const {
   return {p.x(), p.y(), a.z()};
 }
 
-std::vector<Move> walkMoves(const ir::Node &moves, std::optional<ir::Vec3> start, PathKind path) {
-  std::vector<Move> out;
-  std::optional<ir::Vec3> at = start;
-  for (const ir::Node &n : moves.children) {
-    if (n.kind != ir::Kind::Rapid && n.kind != ir::Kind::Linear && n.kind != ir::Kind::Arc)
+namespace {
+
+void walk(const ir::Node &parent, const ir::Node *cycle, std::optional<ir::Vec3> &at, PathKind path,
+          std::vector<Move> &out) {
+  for (const ir::Node &n : parent.children) {
+    switch (n.kind) {
+    case ir::Kind::Cycle:
+      walk(n, &n, at, path, out);
       continue;
+    case ir::Kind::Rapid:
+    case ir::Kind::Linear:
+    case ir::Kind::Arc:
+    case ir::Kind::Dwell:
+      break;
+    default:
+      continue;
+    }
     Move m = readMove(n, path);
+    m.cycle = cycle;
     m.from = at;
+    if (m.kind == MoveKind::Dwell)
+      m.to = at.value_or(ir::Vec3::Zero());
     at = m.to;
     out.push_back(std::move(m));
   }
+}
+
+} // namespace
+
+std::vector<Move> walkMoves(const ir::Node &moves, std::optional<ir::Vec3> start, PathKind path) {
+  std::vector<Move> out;
+  std::optional<ir::Vec3> at = start;
+  walk(moves, nullptr, at, path, out);
   return out;
 }
 

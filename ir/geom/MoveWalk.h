@@ -14,7 +14,8 @@
 
 namespace stepnc::ir {
 
-enum class MoveKind : uint8_t { Rapid, Linear, Arc };
+/// Dwell: the tool waits where it is (`to` is where it stands, `dwell` the time).
+enum class MoveKind : uint8_t { Rapid, Linear, Arc, Dwell };
 
 struct Move {
   const ir::Node *node = nullptr;
@@ -29,8 +30,11 @@ struct Move {
   int64_t turns = 0;
   double feed = 0;                     ///< mm/min; 0 for rapids
   std::string role;                    ///< "position", "cut", ... (default: position for rapids, cut otherwise)
+  double dwell = 0;                    ///< dwells: s
+  const ir::Node *cycle = nullptr;     ///< the canned cycle the move belongs to, if any
 
-  bool isFeed() const { return kind != MoveKind::Rapid; }
+  /// True for a move that cuts at a feed (a line or an arc).
+  bool isFeed() const { return kind == MoveKind::Linear || kind == MoveKind::Arc; }
   /// True when the move changes height (a plunge, a ramp, a helix).
   bool changesHeight() const;
   double length() const;  ///< in space; helices included
@@ -51,7 +55,10 @@ struct Move {
 enum class PathKind : uint8_t { Programmed, Predicted };
 
 /// The moves of `moves` in order, each knowing where it starts (`start` is
-/// where the tool is before the first one, when known).
+/// where the tool is before the first one, when known). The moves of a
+/// canned cycle are walked in place, each knowing its cycle; a dwell is a
+/// move that stays where the tool is (where the first move of a program
+/// starts unknown, at the origin).
 std::vector<Move> walkMoves(const ir::Node &moves, std::optional<ir::Vec3> start = std::nullopt,
                             PathKind path = PathKind::Programmed);
 
