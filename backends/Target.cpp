@@ -14,6 +14,16 @@ bool parseInt(const std::string &text, long lo, long hi, long &out) {
 
 } // namespace
 
+const char *cycleKindName(CycleKind kind) {
+  switch (kind) {
+  case CycleKind::Drill: return "drill";
+  case CycleKind::Peck: return "peck";
+  case CycleKind::Bore: return "bore";
+  case CycleKind::Tap: return "tap";
+  }
+  return "?";
+}
+
 std::string overrideHelp() {
   return "decimals=N (coordinates, 0..6), line-numbers=none|every, number-step=N, "
          "max-line-length=N (0: none), arcs=ijk|radius, cycles=on|off, splines=on|off";

@@ -5,7 +5,7 @@
 // words that are its own.
 #pragma once
 
-#include <set>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -35,6 +35,18 @@ enum class SplineForm {
 /// Canned cycles a controller has, by what they do.
 enum class CycleKind { Drill, Peck, Bore, Tap };
 
+/// "drill", "peck", "bore", "tap".
+const char *cycleKindName(CycleKind kind);
+
+/// What a target's canned cycle of one family can do beyond feeding in and
+/// out: a cycle that needs more is written as its moves (dwells as the
+/// controller's dwell block, reduced feeds as lines at those feeds).
+struct CycleForm {
+  bool dwell = false;         ///< a dwell at the bottom (G82, CYCLE82's DTB, Q211)
+  bool dwellStep = false;     ///< a dwell at the bottom of every peck
+  bool reducedFeeds = false;  ///< reduced feeds over the top or the bottom of the hole
+};
+
 struct TargetDescriptor {
   std::string name;         ///< as given to --target
   std::string description;  ///< one line, for --list-targets
@@ -42,7 +54,8 @@ struct TargetDescriptor {
   ArcForm arcs = ArcForm::IncrementalCentre;
   bool helix = true;         ///< helical arcs (a z change along an arc) in one block
   bool helixTurns = true;    ///< several turns of a helix in one block
-  std::set<CycleKind> cycles;  ///< canned cycles used when they reproduce the planned moves
+  /// Canned cycles used when they make the planned moves, and what each can do.
+  std::map<CycleKind, CycleForm> cycles;
   SplineForm splines = SplineForm::None;
   Numbering numbering = Numbering::None;
   int numberStep = 10;

@@ -48,7 +48,6 @@ std::optional<std::string> beyond(const Node &n) {
       return std::string("a lathe's X mode");
     break;
   case Kind::State: return std::string("a change of process state ('state')");
-  case Kind::Dwell: return std::string("a dwell");
   case Kind::Rapid:
   case Kind::Linear:
   case Kind::Arc:

@@ -120,6 +120,7 @@ private:
   void checkRef(const Node &n, const KindSpec &spec, const Attr &a);
   void checkChildren(const Node &n, const KindSpec &spec);
   void checkFlow(const Node &n, const KindSpec &spec);
+  void checkCycle(const Node &cycle);
   void checkToolFit(const Node &workingstep);
   const Node *lookup(const std::optional<std::string> &symbol) const;
   InFlightDiagnostic report(const Node &n, const std::string &message);
@@ -305,6 +306,8 @@ void Verifier::checkChildren(const Node &n, const KindSpec &spec) {
   if (spec.id == Kind::State && n.attrs.empty())
     report(n, "changes nothing: expected at least one attribute");
   checkFlow(n, spec);
+  if (spec.id == Kind::Cycle)
+    checkCycle(n);
   if (spec.is(Trait::PatternStrategy)) {
     auto guides = count([](const Node &c) { return c.kind == Kind::Strategy; });
     if (guides != 1)
@@ -321,6 +324,52 @@ void Verifier::checkChildren(const Node &n, const KindSpec &spec) {
       report(n, "expected at most one " + joinWords(names) + ", found " + std::to_string(found));
     }
   }
+}
+
+/// A canned cycle says what its moves do: they stay on its axis, reach its
+/// bottom and no lower; its pecks go down to the bottom; a feed out is
+/// given for the families that feed out; reduced feeds come with their
+/// depths; the feeds and times are positive.
+void Verifier::checkCycle(const Node &cycle) {
+  constexpr double kSame = 1e-6;
+  const std::optional<Vec3> at = cycle.vec("at");
+  const std::optional<double> clearance = cycle.number("clearance"), bottom = cycle.number("bottom");
+  if (!at || !clearance || !bottom)
+    return;  // reported as missing attributes
+  if (*bottom >= *clearance)
+    report(cycle, "its bottom (z=" + formatShortest(*bottom) + ") is not below its clearance height (z=" +
+                      formatShortest(*clearance) + ")");
+  std::optional<double> lowest;
+  for (const Node &m : cycle.children)
+    if (std::optional<Vec3> to = m.vec("to")) {
+      if ((to->head<2>() - at->head<2>()).norm() > kSame) {
+        report(m, "leaves its cycle's axis: (" + formatShortest(to->x()) + "," + formatShortest(to->y()) +
+                      ") is not the cycle's position (" + formatShortest(at->x()) + "," + formatShortest(at->y()) + ")");
+        return;
+      }
+      lowest = std::min(lowest.value_or(to->z()), to->z());
+    }
+  if (lowest && std::abs(*lowest - *bottom) > kSame)
+    report(cycle, "its moves reach z=" + formatShortest(*lowest) + ", not its bottom (z=" + formatShortest(*bottom) + ")");
+  if (const Value *pecks = cycle.get("pecks")) {
+    const std::vector<double> &z = pecks->numbers;
+    if (z.empty() || std::abs(z.back() - *bottom) > kSame || !std::is_sorted(z.rbegin(), z.rend()) ||
+        std::adjacent_find(z.begin(), z.end()) != z.end())
+      report(cycle, "its pecks must go down, each deeper than the last, to its bottom");
+  }
+  const bool feedsOut = cycle.text("type") == "bore" || cycle.text("type") == "tap";
+  if (feedsOut != cycle.has("feed_out"))
+    report(cycle, feedsOut ? "a " + *cycle.text("type") + " cycle feeds out: expected 'feed_out'"
+                           : "a " + cycle.text("type").value_or("") + " cycle leaves at rapid: 'feed_out' is not taken");
+  for (auto [feed, depth] : {std::pair{"start_feed", "start_depth"}, std::pair{"end_feed", "end_depth"}}) {
+    if (cycle.has(feed) != cycle.has(depth))
+      report(cycle, attribute(feed) + " and " + attribute(depth) + " go together");
+    if (cycle.number(depth).value_or(1) <= 0)
+      report(cycle, attribute(depth) + " must be positive");
+  }
+  for (const char *a : {"feed", "feed_out", "start_feed", "end_feed", "dwell", "dwell_step", "reapproach"})
+    if (cycle.number(a).value_or(1) <= 0)
+      report(cycle, attribute(a) + " must be positive, found " + formatShortest(*cycle.number(a)));
 }
 
 /// Control flow and expressions: a condition first where one is taken, the

@@ -42,6 +42,9 @@ public:
     runtime::PlanOptions options;
     if (tolerance_)
       options.tolerance = *tolerance_;
+    if (program.trailingDwell > 0)
+      diags.warning({}, "plan-motion: the program ends with a dwell of " + formatFixed(program.trailingDwell, 3) +
+                            " s after its last move; the planned motion ends at rest without it");
     const runtime::Trajectory trajectory = runtime::plan(program.path, *machine, options);
     ir::attachMotion(module, program, trajectory);
     long long blends = 0, stops = 0;

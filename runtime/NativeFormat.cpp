@@ -124,6 +124,8 @@ std::string writeNative(const Trajectory &trajectory, const std::string &source)
     out += " move " + std::to_string(info.move);
     out += " next " + std::to_string(info.nextMove);
     out += " stop " + std::string(stopReasonName(info.stop));
+    if (info.stop == StopReason::Dwell)
+      out += " wait " + number(info.wait);
     out += " limits";
     appendNumbers(out, {info.limits.v, info.limits.a, info.limits.j});
     out += " limited_by " + std::string(speedLimitName(info.limitedBy));
@@ -548,6 +550,10 @@ void Reader::segment(Trajectory &t, bool first) {
   info.nextMove = integer("the next move index");
   keyword("stop");
   info.stop = choice(kStopReasons, stopReasonName, "stop reason");
+  if (info.stop == StopReason::Dwell) {
+    keyword("wait");
+    info.wait = positive("the dwell's wait (s)");
+  }
   keyword("limits");
   info.limits.v = nonNegative("the speed limit");
   info.limits.a = nonNegative("the acceleration limit");

@@ -59,6 +59,7 @@ struct Piece {
   SegmentKind kind = SegmentKind::Line;
   bool ccw = true;
   bool stopBefore = false;
+  double waitBefore = 0;  ///< s at rest before it (a dwell)
   bool hasMidCurvature = false;
   /// How it meets the piece before it (join): through a blend, or at rest
   /// for `stopReason`; neither when tangent and curvature already agree.
@@ -339,7 +340,7 @@ double blendDeviation(const std::array<Vec3, 6> &ctrl, const Segment &a, double 
 /// (b.stopReason).
 void join(Piece &a, const Segment &sa, Piece &b, const Segment &sb, double tolerance) {
   if (b.stopBefore) {
-    b.stopReason = StopReason::Program;
+    b.stopReason = b.waitBefore > 0 ? StopReason::Dwell : StopReason::Program;
     return;
   }
   const PathPoint ea = sa.at(sa.length), bs = sb.at(0);
@@ -626,9 +627,11 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   pieces.reserve(input.moves.size());
   Vec3 at = input.start;
   bool pendingStop = false;
+  double pendingWait = 0;  // dwells before moves of no length wait before the next piece
   for (size_t i = 0; i < input.moves.size(); ++i) {
     const PathMove &m = input.moves[i];
-    pendingStop = pendingStop || m.stopBefore;
+    pendingStop = pendingStop || m.stopBefore || m.waitBefore > 0;
+    pendingWait += m.waitBefore;
     const Segment seg = m.kind == PathMove::Kind::Line ? Segment::line(at, m.to)
                                                        : Segment::arcTurns(at, m.to, m.center, m.ccw, m.turns);
     at = m.to;
@@ -637,7 +640,9 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
     Piece &p = pieces.emplace_back(seg, uint32_t(i));
     p.feed = m.feed > 0 ? m.feed / 60 : 0;
     p.stopBefore = pendingStop;
+    p.waitBefore = pendingWait;
     pendingStop = false;
+    pendingWait = 0;
   }
 
   // 2. Junctions: blends or stops.
@@ -665,25 +670,33 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   lengths.reserve(count);
   // d is the last segment's demand().
   const SpeedBudget budget(machine);
-  auto push = [&](double feed, uint32_t move, uint32_t next, StopReason stop, const AxisDemand &d) {
+  auto push = [&](double feed, uint32_t move, uint32_t next, StopReason stop, double wait, const AxisDemand &d) {
     lengths.push_back(out.segments.back().length);
     SegmentInfo &info = out.info.emplace_back();
     info.feed = feed;
     info.move = move;
     info.nextMove = next;
     info.stop = stop;
+    info.wait = wait;
     budget.limitsFor(d, feed, info);
   };
   StopReason stop = StopReason::Start;
+  double wait = 0;  // before the next segment pushed (a dwell)
   {
     Segment segments[2];  // piece i's in segments[i % 2]
     for (size_t i = 0; i < pieces.size(); ++i) {
       const Piece &p = pieces[i];
       const Segment &before = segments[(i + 1) % 2], &here = segments[i % 2];
       p.segment(input, segments[i % 2]);
+      if (i == 0 && p.waitBefore > 0) {
+        stop = StopReason::Dwell;  // a dwell before the first move: at rest from the start anyway
+        wait = p.waitBefore;
+      }
       if (i > 0) {
-        if (p.stopReason != StopReason::None)
+        if (p.stopReason != StopReason::None) {
           stop = p.stopReason;
+          wait = p.waitBefore;
+        }
         if (p.blendBefore) {
           const Piece &prev = pieces[i - 1];
           double feed = 0;  // the slower of the two; a rapid takes the feed of the other
@@ -693,14 +706,16 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
             feed = std::max(prev.feed, p.feed);
           AxisDemand demand;
           out.segments.push_back(Segment::blend(blendBetween(prev, before, p, here), demand));
-          push(feed, prev.move, p.move, stop, demand);
+          push(feed, prev.move, p.move, stop, wait, demand);
           stop = StopReason::None;
+          wait = 0;
         }
       }
       if (p.keepsMiddle()) {
         out.segments.push_back(here.part(p.cutStart, here.length - p.cutEnd));
-        push(p.feed, p.move, p.move, stop, out.segments.back().demand());
+        push(p.feed, p.move, p.move, stop, wait, out.segments.back().demand());
         stop = StopReason::None;
+        wait = 0;
       }
     }
   }

@@ -37,6 +37,7 @@ struct PathMove {
   int64_t turns = 0;           ///< arcs: whole turns before the last arc to `to`
   double feed = 0;             ///< mm/min; 0 = rapid (the axes' speed)
   bool stopBefore = false;     ///< the tool is at rest before this move
+  double waitBefore = 0;       ///< s it waits there first (a dwell; with stopBefore)
 };
 
 struct PathInput {

@@ -204,8 +204,9 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
   double duration = 0, programmedFeedTime = 0;
   for (size_t i = 0; i < n; ++i) {
     const double d = trajectory.profiles[i].duration();
-    durations[i] = d;
-    duration += d;
+    durations[i] = trajectory.info[i].wait + d;
+    duration += durations[i];
+    r.dwellTime += trajectory.info[i].wait;
     const double feed = trajectory.info[i].feed;
     if (feed > 0) {
       r.feedTime += d;
@@ -344,7 +345,8 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
     const bool fromRest = i == 0 || info.stop != StopReason::None;
     const bool toRest = i + 1 == n || trajectory.info[i + 1].stop != StopReason::None;
     if (fromRest)
-      cur.riseEnd = profile.phases[0].duration + profile.phases[1].duration + profile.phases[2].duration;
+      cur.riseEnd =
+          info.wait + profile.phases[0].duration + profile.phases[1].duration + profile.phases[2].duration;
     cur.fallStart = kInf;
     if (toRest)
       cur.fallStart =
@@ -393,7 +395,8 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
       }
       // The end is the last profile's own end, not a difference of sums.
       const double local = final ? durations[seg] : t - segStart;
-      const PathState ps = trajectory.profiles[seg].at(local);
+      // A dwell: at rest at the segment's start for its wait first.
+      const PathState ps = trajectory.profiles[seg].at(std::max(0.0, local - trajectory.info[seg].wait));
       const PathPoint pp = trajectory.segments[seg].at(ps.s);
       s.segment = static_cast<uint32_t>(seg);
       s.p = pp.p;
@@ -559,7 +562,8 @@ std::string formatReport(const SimReport &report, const Trajectory &trajectory, 
 
   out += "cycle time: " + seconds(report.duration) + " (feed moves " + seconds(report.feedTime) + " over " +
          formatFixed(report.feedDistance, 1) + " mm, rapids " + seconds(report.rapidTime) + " over " +
-         formatFixed(report.rapidDistance, 1) + " mm)\n";
+         formatFixed(report.rapidDistance, 1) + " mm" +
+         (report.dwellTime > 0 ? ", dwells " + seconds(report.dwellTime) : std::string()) + ")\n";
 
   if (report.feedTime > 0) {
     out += "feed on feed moves: mean " + perMinute(report.meanFeed) + " of " + perMinute(report.meanProgrammedFeed) +

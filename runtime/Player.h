@@ -112,6 +112,7 @@ struct SimReport {
   size_t samples = 0;
   double feedTime = 0;      ///< s on feed moves
   double rapidTime = 0;     ///< s on rapids
+  double dwellTime = 0;     ///< s waiting at rest for dwells
   double feedDistance = 0;  ///< mm on feed moves
   double rapidDistance = 0;
   double meanFeed = 0;      ///< mm/s, feed distance / feed time

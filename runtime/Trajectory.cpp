@@ -31,6 +31,7 @@ std::string_view stopReasonName(StopReason reason) {
   case StopReason::Reversal: return "reversal";
   case StopReason::Tiny: return "tiny";
   case StopReason::Program: return "program";
+  case StopReason::Dwell: return "dwell";
   }
   return "none";
 }
@@ -51,8 +52,8 @@ std::optional<StopReason> stopReasonNamed(std::string_view name) {
 
 double Trajectory::duration() const {
   double t = 0;
-  for (const Profile &p : profiles)
-    t += p.duration();
+  for (size_t k = 0; k < profiles.size(); ++k)
+    t += info[k].duration(profiles[k]);
   return t;
 }
 

@@ -37,9 +37,10 @@ enum class StopReason : uint8_t {
   Reversal,  ///< the path turns back on itself (no blend can stay in tolerance)
   Tiny,      ///< the pieces are too short to blend within tolerance
   Program,   ///< a tool change, a change of setup or spindle, a stop in the program
+  Dwell,     ///< a dwell: the tool waits at rest (SegmentInfo::wait) before the segment
 };
-inline constexpr StopReason kStopReasons[] = {StopReason::None, StopReason::Start, StopReason::Reversal,
-                                              StopReason::Tiny, StopReason::Program};
+inline constexpr StopReason kStopReasons[] = {StopReason::None, StopReason::Start,   StopReason::Reversal,
+                                              StopReason::Tiny, StopReason::Program, StopReason::Dwell};
 std::string_view stopReasonName(StopReason reason);
 std::optional<StopReason> stopReasonNamed(std::string_view name);
 
@@ -50,6 +51,10 @@ struct SegmentInfo {
   uint32_t move = 0;                    ///< index of the programmed move it follows
   uint32_t nextMove = 0;                ///< blends: the move it joins to (else = move)
   StopReason stop = StopReason::None;   ///< why the segment starts at rest
+  double wait = 0;                      ///< s at rest before the segment starts (stop dwell), else 0
+
+  /// The segment's time: the wait, then its profile's.
+  double duration(const Profile &profile) const { return wait + profile.duration(); }
 };
 
 struct Trajectory {

@@ -7,7 +7,7 @@ import math
 import sys
 
 KEYS = {"to", "center", "radius", "start_angle", "sweep", "dir", "ctrl", "length", "programmed_feed",
-        "move", "next", "stop", "limits", "limited_by", "v0", "a0", "phases"}
+        "move", "next", "stop", "wait", "limits", "limited_by", "v0", "a0", "phases"}
 GX = (0.0, -0.5384693101056831, 0.5384693101056831, -0.906179845938664, 0.906179845938664)
 GW = (0.5688888888888889, 0.4786286704993665, 0.4786286704993665, 0.2369268850561891, 0.2369268850561891)
 
@@ -79,6 +79,10 @@ def main(path):
         seg = (words[0], at, f)
         ph = [float(x) for x in f["phases"][1:]]
         phases = list(zip(ph[0::2], ph[1::2]))
+        t0 += float(f["wait"][0]) if "wait" in f else 0.0  # a dwell: at rest at the start first
+        while k * cycle < t0:
+            print(fmt(k * cycle), *map(fmt, at))
+            k += 1
         t1 = t0 + sum(d for d, _ in phases)
         while k * cycle < t1:
             p = point(seg, distance(float(f["v0"][0]), float(f["a0"][0]), phases, k * cycle - t0))

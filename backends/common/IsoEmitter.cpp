@@ -58,14 +58,14 @@ std::optional<std::string> IsoEmitter::run(const Program &p) {
       out_.block(coolant(s.coolant));
       coolant_ = s.coolant;
     }
-    if (s.cycle && d_.cycles.count(s.cycle->kind) && cycle(s, *s.cycle))
+    const std::string whyNot = s.cycle ? whyNotCycle(d_, *s.cycle) : "its moves are not one canned cycle";
+    if (whyNot.empty() && cycle(s, *s.cycle))
       continue;
     if (s.taps()) {
       // Written as moves, a tap would be driven out without the spindle reversed.
       diags_.error(s.exec->origin.loc, "workingstep " + s.exec->symbol + " (" + s.operationName() +
-                                           ") can only be written as the controller's tapping cycle, which " +
-                                           (d_.cycles.count(CycleKind::Tap) ? "does not make its planned moves"
-                                                                             : "is off (--no-cycles)"))
+                                           ") can only be written as the controller's tapping cycle, and " +
+                                           (whyNot.empty() ? "that cycle does not make its planned moves" : whyNot))
           .entity(s.exec->origin.entityId);
       continue;
     }
@@ -134,7 +134,7 @@ void IsoEmitter::assumeAt(const Vec3 &p) {
 
 void IsoEmitter::positionFor(const Step &s) {
   for (const Move &m : s.moves) {
-    if (m.role == "approach")
+    if (m.kind != Move::Kind::Rapid || m.role != "position")
       break;
     move(m);
   }
@@ -143,6 +143,10 @@ void IsoEmitter::positionFor(const Step &s) {
 void IsoEmitter::move(const Move &m) {
   if (m.kind == Move::Kind::Arc) {
     arc(m);
+    return;
+  }
+  if (m.kind == Move::Kind::Dwell) {
+    out_.block(dwell(m.dwell));
     return;
   }
   if (afterToolChange_ && m.kind == Move::Kind::Rapid) {

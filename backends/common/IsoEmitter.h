@@ -44,6 +44,8 @@ protected:
   virtual std::string turnsWord(int64_t turns) const = 0;
   /// The radius word of the radius arc form ("R-12.5", "CR=12.5").
   virtual std::string radiusWord(double signedRadius) const;
+  /// The block that makes the tool wait `seconds` where it is ("G4 P0.5").
+  virtual std::string dwell(double seconds) const = 0;
   /// Writes `c` as the controller's canned cycle; false when the cycle would
   /// not make exactly the planned moves (the moves are written instead).
   virtual bool cycle(const Step &s, const HoleCycle &c) = 0;

@@ -16,75 +16,35 @@ namespace {
 constexpr double kTwoPi = 2 * std::numbers::pi;
 constexpr double kSame = 1e-9;
 
-std::optional<CycleKind> cycleKindOf(std::optional<ir::Kind> op) {
-  if (!op)
-    return std::nullopt;
-  const ir::KindSpec &spec = ir::specOf(*op);
-  if (spec.is(ir::Trait::DrillCycle))
-    return CycleKind::Drill;
-  if (spec.is(ir::Trait::PeckCycle))
-    return CycleKind::Peck;
-  if (spec.is(ir::Trait::BoreCycle))
-    return CycleKind::Bore;
-  if (spec.is(ir::Trait::TapCycle))
-    return CycleKind::Tap;
-  return std::nullopt;
+CycleKind cycleKindOf(const ir::Node &cycle) {
+  const std::string type = cycle.text("type").value_or("");
+  return type == "peck" ? CycleKind::Peck : type == "bore" ? CycleKind::Bore : type == "tap" ? CycleKind::Tap
+                                                                                              : CycleKind::Drill;
 }
 
-/// The cycle a hole-making step's moves make, when they are exactly: to the
-/// position at the security plane, down to R, feeds down (with rapids out to
-/// R and back between pecks), then out (rapid, or at feed to R) and up to the
-/// security plane.
-std::optional<HoleCycle> recogniseCycle(const Step &s, CycleKind kind, double surfaceZ) {
-  if (s.moves.size() < 3)
-    return std::nullopt;
-  const geom::Vec2 at = s.moves.front().to.head<2>();
-  for (const Move &m : s.moves)
-    if (m.kind == Move::Kind::Arc || (m.to.head<2>() - at).norm() > kSame)
-      return std::nullopt;
+/// The canned cycle expansion recorded (the IR verifier checked it).
+HoleCycle holeCycle(const ir::Node &cycle, double secplane) {
   HoleCycle c;
-  c.kind = kind;
-  c.at = at;
-  c.initialZ = s.secplane;
-  c.surfaceZ = surfaceZ;
-  size_t i = 0;
-  // The position (and any other rapid at the security plane), then down to R.
-  while (i < s.moves.size() && s.moves[i].kind == Move::Kind::Rapid && s.moves[i].role != "approach")
-    ++i;
-  if (i == s.moves.size() || std::abs(s.moves[i > 0 ? i - 1 : 0].to.z() - s.secplane) > kSame)
-    return std::nullopt;
-  c.retractZ = s.moves[i].to.z();
-  ++i;
-  // Feeds down; between them out to R at rapid and back down at rapid.
-  while (i < s.moves.size() && s.moves[i].kind == Move::Kind::Linear && s.moves[i].role == "plunge") {
-    if (c.feed == 0)
-      c.feed = s.moves[i].feed;
-    else if (std::abs(c.feed - s.moves[i].feed) > kSame)
-      return std::nullopt;
-    c.pecks.push_back(s.moves[i].to.z());
-    ++i;
-    if (i + 1 < s.moves.size() && s.moves[i].kind == Move::Kind::Rapid && s.moves[i].role == "retract" &&
-        std::abs(s.moves[i].to.z() - c.retractZ) <= kSame && s.moves[i + 1].kind == Move::Kind::Rapid &&
-        s.moves[i + 1].role == "approach" && i + 2 < s.moves.size() && s.moves[i + 2].kind == Move::Kind::Linear)
-      i += 2;
-  }
-  if (c.pecks.empty())
-    return std::nullopt;
-  c.depthZ = c.pecks.back();
-  // Out: at feed to R (bores, taps), then at rapid to the security plane.
-  if (i < s.moves.size() && s.moves[i].kind == Move::Kind::Linear) {
-    if (std::abs(s.moves[i].to.z() - c.retractZ) > kSame)
-      return std::nullopt;
-    c.feedOut = s.moves[i].feed;
-    ++i;
-  }
-  if (i + 1 != s.moves.size() || s.moves[i].kind != Move::Kind::Rapid ||
-      std::abs(s.moves[i].to.z() - s.secplane) > kSame)
-    return std::nullopt;
-  if ((kind == CycleKind::Bore || kind == CycleKind::Tap) != (c.feedOut > 0))
-    return std::nullopt;
-  if (kind != CycleKind::Peck && c.pecks.size() != 1)
-    return std::nullopt;
+  c.kind = cycleKindOf(cycle);
+  const ir::Vec3 at = cycle.vec("at").value_or(ir::Vec3::Zero());
+  c.at = at.head<2>();
+  c.surfaceZ = at.z();
+  c.initialZ = secplane;
+  c.retractZ = cycle.number("clearance").value_or(0);
+  c.depthZ = cycle.number("bottom").value_or(0);
+  if (const ir::Value *pecks = cycle.get("pecks"))
+    c.pecks = pecks->numbers;
+  else
+    c.pecks = {c.depthZ};
+  c.reapproach = cycle.number("reapproach").value_or(0);
+  c.feed = cycle.number("feed").value_or(0);
+  c.feedOut = cycle.number("feed_out").value_or(0);
+  c.dwell = cycle.number("dwell").value_or(0);
+  c.dwellStep = cycle.number("dwell_step").value_or(0);
+  c.startFeed = cycle.number("start_feed").value_or(0);
+  c.startDepth = cycle.number("start_depth").value_or(0);
+  c.endFeed = cycle.number("end_feed").value_or(0);
+  c.endDepth = cycle.number("end_depth").value_or(0);
   return c;
 }
 
@@ -164,9 +124,13 @@ private:
       mv.from = m.from.value_or(position_);
       mv.to = m.to;
       mv.role = m.role;
-      mv.kind = m.kind == ir::MoveKind::Rapid   ? Move::Kind::Rapid
-                : m.kind == ir::MoveKind::Arc ? Move::Kind::Arc
-                                                  : Move::Kind::Linear;
+      switch (m.kind) {
+      case ir::MoveKind::Rapid: mv.kind = Move::Kind::Rapid; break;
+      case ir::MoveKind::Linear: mv.kind = Move::Kind::Linear; break;
+      case ir::MoveKind::Arc: mv.kind = Move::Kind::Arc; break;
+      case ir::MoveKind::Dwell: mv.kind = Move::Kind::Dwell; break;
+      }
+      mv.dwell = m.dwell;
       mv.feed = m.feed;
       mv.smooth = mv.kind == Move::Kind::Linear && m.node && m.node->flag("smooth").value_or(false);
       mv.centre = m.center.head<2>();
@@ -176,12 +140,11 @@ private:
     }
     if (!s.moves.empty())
       position_ = s.moves.back().to;
-    if (auto kind = cycleKindOf(s.operation)) {
-      const ir::Node *feature = ir::findFeature(module_, e.text("feature").value_or(""));
-      auto frame = feature ? ir::planeFrame(*feature) : ir::FrameResult{};
-      if (frame.frame)
-        s.cycle = recogniseCycle(s, *kind, frame.frame->z);
-    }
+    // A step that is one canned cycle is written as the controller's cycle
+    // where the target has it; cycles among other moves are written as
+    // their moves (expansion makes none yet).
+    if (moves->children.size() == 1 && moves->children.front().kind == ir::Kind::Cycle)
+      s.cycle = holeCycle(moves->children.front(), s.secplane);
     program_.steps.push_back(std::move(s));
   }
 
@@ -235,6 +198,20 @@ double Move::sweep() const {
   if ((to.head<2>() - from.head<2>()).norm() <= kSame)
     angle = kTwoPi;  // over the start: a whole turn
   return angle + kTwoPi * static_cast<double>(turns);
+}
+
+std::string whyNotCycle(const TargetDescriptor &d, const HoleCycle &c) {
+  auto form = d.cycles.find(c.kind);
+  if (form == d.cycles.end())
+    return d.cycles.empty() ? "cycles are off (--no-cycles or cycles=off)"
+                            : d.name + " writes no " + std::string(cycleKindName(c.kind)) + " cycle";
+  if (c.dwell > 0 && !form->second.dwell)
+    return "its " + std::string(cycleKindName(c.kind)) + " cycle has no dwell at the bottom";
+  if (c.dwellStep > 0 && !form->second.dwellStep)
+    return "its " + std::string(cycleKindName(c.kind)) + " cycle has no dwell at every peck";
+  if ((c.startFeed > 0 || c.endFeed > 0) && !form->second.reducedFeeds)
+    return "its " + std::string(cycleKindName(c.kind)) + " cycle has no reduced feeds near the top or bottom";
+  return "";
 }
 
 std::optional<Program> buildProgram(const ir::Module &module, const ToolTable *table, DiagnosticEngine &diags) {

@@ -1,8 +1,8 @@
 // The program every backend writes, flattened from the toolpath IR: the tools
 // with their numbers, and in execution order each step's tool, spindle,
-// coolant and moves, with hole-making steps also described as a canned cycle
-// when their moves are one. Emitters only choose words; what to do was
-// decided by the passes.
+// coolant and moves, with hole-making steps also described as the canned
+// cycle expansion recorded for them (the IR's `cycle`). Emitters only choose
+// words; what to do was decided by the passes.
 #pragma once
 
 #include "backends/Target.h"
@@ -28,7 +28,8 @@ struct ToolCall {
 };
 
 struct Move {
-  enum class Kind { Rapid, Linear, Arc } kind = Kind::Rapid;
+  /// Dwell: the tool waits where it is for `dwell` seconds.
+  enum class Kind { Rapid, Linear, Arc, Dwell } kind = Kind::Rapid;
   Vec3 from = Vec3::Zero();  ///< where the tool is before the move
   Vec3 to = Vec3::Zero();
   geom::Vec2 centre = geom::Vec2::Zero();  ///< arcs: the axis through the centre, parallel to z
@@ -36,6 +37,7 @@ struct Move {
   int64_t turns = 0;  ///< arcs: full turns before the last arc (toolpath IR rule)
   double feed = 0;    ///< mm/min; 0 for rapids
   bool smooth = false;  ///< a line that is a chord of a smooth curve (toolpath IR `smooth`)
+  double dwell = 0;     ///< dwells: s
   std::string role;
   const ir::Node *node = nullptr;
 
@@ -44,7 +46,8 @@ struct Move {
   double sweep() const;
 };
 
-/// A hole-making step whose moves are one axial cycle on one position.
+/// A hole-making step whose moves are one axial cycle on one position, as
+/// strategy expansion recorded it (the IR's `cycle`, ir/Kinds.def).
 struct HoleCycle {
   CycleKind kind = CycleKind::Drill;
   geom::Vec2 at = geom::Vec2::Zero();
@@ -53,9 +56,19 @@ struct HoleCycle {
   double surfaceZ = 0;  ///< the top of the hole
   double depthZ = 0;    ///< the lowest point of the tool tip
   std::vector<double> pecks;  ///< the bottom of each feed in (the last is depthZ)
+  double reapproach = 0;  ///< pecks: the tool comes back down at rapid to this far above the last peck, mm
   double feed = 0;      ///< in, mm/min
   double feedOut = 0;   ///< out (bore, tap), mm/min; 0 for drills (rapid out)
+  double dwell = 0;     ///< at the bottom, s
+  double dwellStep = 0; ///< at the bottom of every peck but the last, s
+  double startFeed = 0, startDepth = 0;  ///< a reduced feed over the first mm below the top (0: none)
+  double endFeed = 0, endDepth = 0;      ///< a reduced feed over the last mm above the bottom (0: none)
 };
+
+/// Why target `d` cannot write `c` as its canned cycle ("" when it can, by
+/// its descriptor: the family, dwells and reduced feeds it has); the
+/// emitter may still find that its cycle does not make the planned moves.
+std::string whyNotCycle(const TargetDescriptor &d, const HoleCycle &c);
 
 struct Step {
   enum class Kind { Moves, Message, Stop, OptionalStop } kind = Kind::Moves;

@@ -39,7 +39,10 @@ TargetDescriptor tncDescriptor() {
   d.arcs = ArcForm::ModalCentre;
   d.helix = true;       // CP with IZ
   d.helixTurns = true;  // CP IPA beyond 360 deg
-  d.cycles = {CycleKind::Drill, CycleKind::Peck};
+  // Cycle 200, its Q211 the dwell at the bottom of a hole drilled in one
+  // infeed (with infeeds, whether it dwells after each is not among the
+  // checked facts).
+  d.cycles = {{CycleKind::Drill, {.dwell = true}}, {CycleKind::Peck, {}}};
   d.numbering = Numbering::FromZero;
   // No line limit among the dialect facts; --target-opt max-line-length=N
   // makes the emitter report longer lines.
@@ -281,7 +284,7 @@ private:
       pendingM_.push_back(coolant);
       coolantCode_ = coolant;
     }
-    if (s.cycle && d_.cycles.count(s.cycle->kind) && cycle(s, *s.cycle)) {
+    if (s.cycle && whyNotCycle(d_, *s.cycle).empty() && cycle(s, *s.cycle)) {
       flushM();
       return;
     }
@@ -336,8 +339,16 @@ private:
       arc(m);
       return;
     }
+    if (m.kind == Move::Kind::Dwell) {
+      // Cycle 9 waits where the tool is, from its definition on.
+      out_.block("CYCL DEF 9.0 DWELL TIME");
+      out_.block("CYCL DEF 9.1 DWELL " + seconds(m.dwell));
+      return;
+    }
     line(m.to, m.kind == Move::Kind::Rapid, m.feed);
   }
+
+  static std::string seconds(double s) { return formatNumber(s, {3, false, false}); }
 
   void line(const Vec3 &to, bool rapid, double feed) {
     const std::string words = axes(to);
@@ -525,20 +536,13 @@ private:
       for (size_t k = 0; k < c.pecks.size(); ++k)
         if (std::abs(std::max(c.surfaceZ - q * static_cast<double>(k + 1), c.depthZ) - c.pecks[k]) > 1e-6)
           return false;
-      size_t peck = 0;
-      for (size_t i = 1; i < s.moves.size(); ++i)
-        if (s.moves[i].role == "approach" && s.moves[i - 1].role == "retract" &&
-            s.moves[i - 1].kind == Move::Kind::Rapid) {
-          if (peck >= c.pecks.size() ||
-              std::abs(s.moves[i].to.z() - (c.pecks[peck] + (c.retractZ - c.surfaceZ))) > 1e-6)
-            return false;
-          ++peck;
-        }
+      if (std::abs(c.reapproach - (c.retractZ - c.surfaceZ)) > 1e-6)
+        return false;
       plunging = rounded(q);
     }
     // To the hole at the security plane, as planned.
     for (const Move &m : s.moves) {
-      if (m.role == "approach")
+      if (m.kind != Move::Kind::Rapid || m.role != "position")
         break;
       move(m);
     }
@@ -560,7 +564,7 @@ private:
         {"Q210=+0", "DWELL TIME AT TOP"},
         {"Q203=" + num(surface), "SURFACE COORDINATE"},
         {"Q204=" + num(second), "2ND SET-UP CLEARANCE"},
-        {"Q211=+0", "DWELL TIME AT DEPTH"},
+        {"Q211=+" + seconds(c.dwell), "DWELL TIME AT DEPTH"},
     };
     for (size_t i = 0; i < q.size(); ++i)
       out_.raw("  " + q[i].first + " ;" + q[i].second + (i + 1 < q.size() ? " ~" : ""));

@@ -19,7 +19,11 @@ TargetDescriptor rs274Descriptor() {
   d.arcs = ArcForm::IncrementalCentre;
   d.helix = true;
   d.helixTurns = true;  // P: number of turns
-  d.cycles = {CycleKind::Drill, CycleKind::Peck, CycleKind::Bore, CycleKind::Tap};
+  // G81/G82 (dwell P), G83, G85/G89 (dwell P), G84.
+  d.cycles = {{CycleKind::Drill, {.dwell = true}},
+              {CycleKind::Peck, {}},
+              {CycleKind::Bore, {.dwell = true}},
+              {CycleKind::Tap, {}}};
   d.splines = SplineForm::CubicBezier;  // G5
   d.numbering = Numbering::None;
   d.maxLineLength = 254;  // LinuxCNC rejects lines of 255 characters or more
@@ -67,6 +71,10 @@ private:
 
   std::string turnsWord(int64_t turns) const override { return word("P", std::to_string(turns + 1)); }
 
+  std::string seconds(double s) const { return formatNumber(s, {3, false, true}); }
+
+  std::string dwell(double s) const override { return "G4 P" + seconds(s); }
+
   void message(const std::string &text) override { out_.block(comment("MSG," + text)); }
 
   bool cycle(const Step &s, const HoleCycle &c) override {
@@ -74,15 +82,19 @@ private:
     std::string words;
     const std::string xyzr = word("X", num(c.at.x())) + " Y" + num(c.at.y()) + " Z" + num(c.depthZ) + " R" +
                              num(c.retractZ);
+    // G82 and G89 wait P seconds at the bottom.
+    const std::string dwellWord = c.dwell > 0 ? " P" + seconds(c.dwell) : "";
     switch (c.kind) {
     case CycleKind::Drill:
-      words = "G98 G81 " + xyzr;
+      words = (c.dwell > 0 ? "G98 G82 " : "G98 G81 ") + xyzr + dwellWord;
       break;
     case CycleKind::Bore:
-      // G85 feeds out at the feed in.
+      // G85 and G89 feed out at the feed in.
       if (std::abs(c.feedOut - c.feed) > 1e-9)
         return false;
-      words = "G98 G85 " + xyzr;
+      // LinuxCNC's G89 under G98 feeds out all the way to the first height
+      // (G85 only to R): G99 stops it at R, and the plan's rapid up follows.
+      words = (c.dwell > 0 ? "G99 G89 " : "G98 G85 ") + xyzr + dwellWord;
       break;
     case CycleKind::Peck: {
       // G83 pecks Q deep from R, each time out to R and back to just above
@@ -95,7 +107,7 @@ private:
         if (std::abs(expected - c.pecks[k]) > 1e-6)
           return false;
       }
-      if (!pecksReapproach(s, c))
+      if (std::abs(c.reapproach - kG83Delta) > 1e-6)
         return false;
       words = "G98 G83 " + xyzr + " Q" + num(q);
       break;
@@ -114,25 +126,12 @@ private:
     modal_.forget("F");
     out_.block(words + feedWord(c.feed));
     out_.block("G80");
-    if (c.kind == CycleKind::Tap) {
+    if (words.starts_with("G99")) {
       assumeAt(Vec3(c.at.x(), c.at.y(), c.retractZ));
       move(s.moves.back());
     } else {
       assumeAt(Vec3(c.at.x(), c.at.y(), c.initialZ));
     }
-    return true;
-  }
-
-  /// Whether the plan goes back down between pecks to where G83 does.
-  static bool pecksReapproach(const Step &s, const HoleCycle &c) {
-    size_t peck = 0;
-    for (size_t i = 1; i < s.moves.size(); ++i)
-      if (s.moves[i].role == "approach" && s.moves[i - 1].role == "retract" &&
-          s.moves[i - 1].kind == Move::Kind::Rapid) {
-        if (peck >= c.pecks.size() || std::abs(s.moves[i].to.z() - (c.pecks[peck] + kG83Delta)) > 1e-6)
-          return false;
-        ++peck;
-      }
     return true;
   }
 };

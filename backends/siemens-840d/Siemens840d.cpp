@@ -28,7 +28,9 @@ TargetDescriptor siemensDescriptor() {
   d.arcs = ArcForm::IncrementalCentre;
   d.helix = true;
   d.helixTurns = true;  // TURN=
-  d.cycles = {CycleKind::Drill, CycleKind::Peck, CycleKind::Tap};
+  // CYCLE81/CYCLE82 (dwell DTB), CYCLE83, CYCLE84. CYCLE83's DTB and DTS
+  // are left at 0: where it dwells with them is not among the checked facts.
+  d.cycles = {{CycleKind::Drill, {.dwell = true}}, {CycleKind::Peck, {}}, {CycleKind::Tap, {}}};
   d.splines = SplineForm::Interpolating;  // CSPLINE
   d.numbering = Numbering::None;
   d.maxLineLength = 512;  // conservative: the controller's own limit is not in the sources
@@ -117,7 +119,9 @@ CycleCall cycleCall(const Program &p, const Step &s, const HoleCycle &c, const T
                              num(c.depthZ) + ",";  // DPR empty: the depth is DP
   switch (c.kind) {
   case CycleKind::Drill:
-    call.text = "CYCLE81(" + common + ")";
+    // CYCLE82 waits DTB seconds at the bottom.
+    call.text = c.dwell > 0 ? "CYCLE82(" + common + "," + formatNumber(c.dwell, {3, false, true}) + ")"
+                            : "CYCLE81(" + common + ")";
     return call;
   case CycleKind::Peck: {
     if (c.pecks.size() == 1) {
@@ -192,11 +196,9 @@ private:
       if (s.kind != Step::Kind::Moves || !s.taps())
         continue;
       std::string why;
-      if (!d_.cycles.count(CycleKind::Tap))
-        why = "cycles are off (--no-cycles or cycles=off)";
-      else if (!s.cycle)
-        why = "its moves are not one tapping cycle (to the hole, feed down, feed out)";
-      else
+      if (!s.cycle)
+        why = "its moves are not one tapping cycle";
+      else if (why = whyNotCycle(d_, *s.cycle); why.empty())
         why = cycleCall(p, s, *s.cycle, d_).whyNot;
       if (why.empty())
         continue;
@@ -246,6 +248,9 @@ private:
   std::string turnsWord(int64_t turns) const override { return word("TURN=", std::to_string(turns)); }
 
   std::string radiusWord(double signedRadius) const override { return word("CR=", num(signedRadius)); }
+
+  // G4 F: seconds (G4 S would count spindle revolutions), in a block of its own.
+  std::string dwell(double seconds) const override { return "G4 F" + formatNumber(seconds, {3, false, true}); }
 
   void message(const std::string &text) override { out_.block("MSG(\"" + printable(text, kMaxMessage) + "\")"); }
 

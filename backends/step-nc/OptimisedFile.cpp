@@ -169,7 +169,12 @@ public:
     run_ = {};
     bool smooth = false;
     std::optional<Vec3> at;
-    for (const Node &m : moves.children) {
+    for (const Node *move : moveNodes(moves)) {
+      const Node &m = *move;
+      if (m.kind == ir::Kind::Dwell) {
+        fail(m, "a dwell has no ISO 14649 toolpath form");
+        return std::nullopt;
+      }
       const Vec3 to = *m.vec("to");
       const std::string role = m.text("role").value_or(m.kind == ir::Kind::Rapid ? "position" : "cut");
       smooth = smooth || m.flag("smooth").value_or(false);
@@ -229,10 +234,23 @@ private:
     std::vector<Vec3> points; ///< workpiece coordinates, from the run's start
   };
 
+  /// The moves of `moves`, those of its canned cycles in place.
+  static std::vector<const Node *> moveNodes(const Node &moves) {
+    std::vector<const Node *> out;
+    for (const Node &m : moves.children)
+      if (m.kind == ir::Kind::Cycle)
+        for (const Node &c : m.children)
+          out.push_back(&c);
+      else if (m.category() == ir::Category::Move)
+        out.push_back(&m);
+    return out;
+  }
+
   void fail(const Node &move, const std::string &why) {
+    const std::optional<Vec3> to = move.vec("to");
     diags_
         .error(ws_->origin.loc, "workingstep " + ws_->symbol + ": cannot write its toolpath as STEP-NC: " + why + " (" +
-                                    move.kindName() + " to " + Instances::reals(*move.vec("to")) + ")")
+                                    move.kindName() + (to ? " to " + Instances::reals(*to) : "") + ")")
         .entity(ws_->origin.entityId);
     failed_ = true;
   }
@@ -424,9 +442,16 @@ std::string writeOptimisedPart21(const p21::Part21File &input, const ir::Module 
       ok = false;
       continue;
     }
+    // A step that is canned cycles keeps its operation as written: read
+    // again, it expands to the same cycles, with the dwells and reduced
+    // feeds a cutter-location toolpath cannot carry.
+    const Node &moves = *ws->child(ir::Kind::Moves);
+    if (!moves.children.empty() && std::all_of(moves.children.begin(), moves.children.end(),
+                                               [](const Node &c) { return c.kind == ir::Kind::Cycle; }))
+      continue;
     const Node *tech = op->child(ir::Kind::Technology);
     const std::string reference = tech && tech->text("feed_reference") == "ccp" ? "CCP" : "TCP";
-    if (auto list = writer.write(*ws, *ws->child(ir::Kind::Moves), *frame.frame, reference))
+    if (auto list = writer.write(*ws, moves, *frame.frame, reference))
       toolpathOf[op->origin.entityId] = *list;
   }
   if (!ok || writer.failed())

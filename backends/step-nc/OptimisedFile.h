@@ -2,7 +2,9 @@
 // compiler decided for one machine (docs/feedback.md).
 //
 // Every instance of the input keeps its id and its values, except the
-// operation of each expanded machining workingstep, whose `its_toolpath`
+// operation of each expanded machining workingstep (a hole-making step, its
+// moves canned cycles, keeps its operation: read again it makes the same
+// cycles, dwells and reduced feeds included), whose `its_toolpath`
 // (ISO 14649-10 operation, attribute 1) now names a new TOOLPATH_LIST: the
 // workingstep's moves as cutter-location trajectories in the feature's frame,
 // one per run of moves of one kind, role and feed, each feed in a technology

@@ -25,6 +25,7 @@ ProgramPath programPath(const ir::Module &module) {
   bool stop = false;
   std::string tool, setup;
   std::optional<double> spindle;
+  double wait = 0;  // s of dwells since the last move
   for (const ir::Node *e : programOrder(module)) {
     if (e->kind == ir::Kind::ProgramStop || e->kind == ir::Kind::OptionalStop) {
       stop = true;
@@ -42,6 +43,11 @@ ProgramPath programPath(const ir::Module &module) {
     setup = s;
     spindle = sp;
     for (const Move &m : walkMoves(*moves, position)) {
+      if (m.kind == MoveKind::Dwell) {
+        // The next move starts at rest after the wait.
+        wait += m.dwell;
+        continue;
+      }
       if (!position) {
         out.path.start = m.to;  // the tool starts at rest at the first point named
         position = m.to;
@@ -53,14 +59,17 @@ ProgramPath programPath(const ir::Module &module) {
       pm.ccw = m.ccw;
       pm.turns = m.turns;
       pm.feed = m.isFeed() ? m.feed : 0;
-      pm.stopBefore = stop;
+      pm.stopBefore = stop || wait > 0;
+      pm.waitBefore = wait;
       stop = false;
+      wait = 0;
       out.path.moves.push_back(pm);
       out.owners.push_back(e);
       out.nodes.push_back(m.node);
       position = m.to;
     }
   }
+  out.trailingDwell = wait;
   return out;
 }
 
@@ -89,7 +98,7 @@ void attachMotion(ir::Module &module, const ProgramPath &program, const runtime:
       motion.set("tolerance", ir::Value::length(trajectory.tolerance));
       motion.set("from", ir::Value::reals(numbers(seg.start)));
     }
-    times[owner] += prof.duration();
+    times[owner] += info.duration(prof);
     ir::Node s(ir::Kind::MotionSegment);
     s.set("shape", ir::Value::word(seg.kind == SegmentKind::Line  ? "line"
                                    : seg.kind == SegmentKind::Arc ? "arc"
@@ -114,6 +123,8 @@ void attachMotion(ir::Module &module, const ProgramPath &program, const runtime:
       s.set("next", ir::Value::integer(info.nextMove));
     if (info.stop != runtime::StopReason::None)
       s.set("stop", ir::Value::word(std::string(runtime::stopReasonName(info.stop))));
+    if (info.wait > 0)
+      s.set("wait", ir::Value::real(info.wait));
     s.set("limited_by", ir::Value::word(std::string(runtime::speedLimitName(info.limitedBy))));
     s.set("limits", ir::Value::reals({info.limits.v, info.limits.a, info.limits.j}));
     s.set("v0", ir::Value::real(prof.v0));
@@ -210,6 +221,11 @@ std::optional<runtime::Trajectory> readMotion(const ir::Module &module, Diagnost
       info.nextMove = uint32_t(s.count("next").value_or(info.move));
       // The kind table allows only the names these read.
       info.stop = runtime::stopReasonNamed(s.text("stop").value_or("none")).value_or(runtime::StopReason::None);
+      info.wait = s.number("wait").value_or(0);
+      if ((info.stop == runtime::StopReason::Dwell) != (info.wait > 0) || !(info.wait >= 0)) {
+        fail(s, "a segment waits (a positive 'wait', in s) exactly when it stops for a dwell ('stop=dwell')");
+        continue;
+      }
       info.limitedBy =
           runtime::speedLimitNamed(s.text("limited_by").value_or("feed")).value_or(runtime::SpeedLimit::Feed);
       info.limits = {(*limits)[0], (*limits)[1], (*limits)[2]};

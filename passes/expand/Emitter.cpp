@@ -48,6 +48,12 @@ void Emitter::arc(const Vec3 &to, const geom::Vec2 &centre, bool ccw, int64_t tu
   pos_ = to;
 }
 
+void Emitter::dwell(double seconds) {
+  if (seconds <= 0)
+    return;
+  moves_.add(Node(ir::Kind::Dwell)).set("time", Value::time(seconds));
+}
+
 void Emitter::seg(const geom::Seg &s, double z, double feed, const char *role) {
   if (s.isArc())
     arc(at(s.b, z), s.c, s.turn > 0, 0, feed, role);

@@ -34,6 +34,9 @@ public:
   /// after `turns` whole turns.
   void arc(const ir::Vec3 &to, const geom::Vec2 &centre, bool ccw, int64_t turns, double feed, const char *role);
 
+  /// The tool waits where it is for `seconds` (> 0; none otherwise).
+  void dwell(double seconds);
+
   /// A plane segment cut at height z (the tool is at its start).
   void seg(const geom::Seg &s, double z, double feed, const char *role = "cut");
 

@@ -12,7 +12,8 @@ what the control would reject or do differently:
   * words: every block of a known form; coordinates signed, no exponent, no
     `-0`; `L` blocks made of X/Y/Z, R0/RL/RR, F or FMAX and one M function
     from a whitelist; `TOOL CALL n Z S..`; `BLK FORM 0.1 Z` then `0.2` with
-    MIN below MAX; cycle 32 and cycle 200 with all their Q parameters;
+    MIN below MAX; cycle 32 and cycle 200 with all their Q parameters; cycle
+    9 (`CYCL DEF 9.0 DWELL TIME`, then `CYCL DEF 9.1 DWELL t`, t > 0 s);
   * motion: no motion before a TOOL CALL, no feed move without a feed or
     with the spindle stopped; a `C` needs a `CC` and the tracked position and
     the end as far from it within --arc-tol (default 0.001 mm); `CP` has IPA
@@ -20,7 +21,7 @@ what the control would reject or do differently:
     its second set-up clearance (the security plane).
 
 With --ir TOOLPATH.IR the moves the program makes (cycle 200 expanded as the
-TNC manual describes it: README.md) are also compared with the toolpath
+TNC manual describes it: README.md; its Q211 and cycle 9 as dwells) are also compared with the toolpath
 IR's moves: runs of rapids by where they end, feed moves by end point and
 feed, arcs also by direction, sweep and path (points at eighths of each
 written arc within 0.005 mm of the IR's circle; an arc that keeps that
@@ -226,6 +227,9 @@ class Machine:
             self.motions.append({"kind": "linear", "to": (x, y, target), "feed": q[206], "where": where})
             reached = target
             if target <= bottom + 1e-9:
+                if q[211] > 0:
+                    # Q211: the wait at the bottom of the hole.
+                    self.motions.append({"kind": "dwell", "to": (x, y, target), "time": q[211], "where": where})
                 break
             k += 1
         self.motions.append({"kind": "rapid", "to": (x, y, surface + second), "where": where})
@@ -391,6 +395,22 @@ def check_program(text, arc_tol):
                 if t is not None and t <= 0:
                     problems.add(where, "tolerance T%s is not positive" % m.group(1))
             continue
+        if body == "CYCL DEF 9.0 DWELL TIME":
+            nxt = blocks[i + 1][1] if i + 1 < len(blocks) else ""
+            if not re.fullmatch(r"CYCL DEF 9\.1 DWELL \S+", nxt):
+                problems.add(where, "CYCL DEF 9.0 not followed by CYCL DEF 9.1 DWELL")
+            continue
+        m = re.fullmatch(r"CYCL DEF 9\.1 DWELL (\S+)", body)
+        if m:
+            # Cycle 9 waits where the tool is, from its definition on.
+            if i == 0 or blocks[i - 1][1] != "CYCL DEF 9.0 DWELL TIME":
+                problems.add(where, "CYCL DEF 9.1 not right after CYCL DEF 9.0 DWELL TIME")
+            t = unsigned(m.group(1), where, problems, "dwell time")
+            if t is not None and t <= 0:
+                problems.add(where, "dwell time %s is not positive" % m.group(1))
+            elif t is not None:
+                mach.motions.append({"kind": "dwell", "to": tuple(mach.pos), "time": t, "where": where})
+            continue
         if body.startswith("CYCL DEF 200"):
             check_cycle_200(body, cont, where, mach, problems)
             continue
@@ -495,7 +515,7 @@ def normalise(moves, decimals):
     out = []
     for mv in moves:
         start = mv.get("start")
-        if start is not None and None not in mv["to"]:
+        if start is not None and None not in mv["to"] and mv["kind"] != "dwell":
             near = math.dist(start, mv["to"]) <= 1.5 * 10.0 ** -decimals
             if near and not (mv["kind"] == "arc" and mv["sweep"] > math.pi):
                 continue
@@ -568,7 +588,7 @@ def tiny(mv, decimals):
     """A move too short to compare: a line or an arc (not a near-whole
     circle) whose ends are within three units of the last decimal."""
     start = mv.get("start")
-    if start is None or None in start or mv["kind"] == "rapid":
+    if start is None or None in start or mv["kind"] in ("rapid", "dwell"):
         return False
     if mv["kind"] == "arc" and mv["sweep"] > math.pi:
         return False
@@ -624,6 +644,10 @@ def compare(prog, ir, problems, decimals):
             return
         i += 1
         j += 1
+        if kind_a == "dwell":
+            if abs(a["time"] - b["time"]) > 0.0006:
+                problems.add(where, "a dwell of %g s where the IR has %g s" % (a["time"], b["time"]))
+            continue
         if kind_a != "rapid" and abs((a.get("feed") or 0) - b.get("feed", 0)) > FEED_TOL:
             problems.add(where, "feed %s where the IR has %s" % (a.get("feed"), b.get("feed")))
         if kind_a == "arc":

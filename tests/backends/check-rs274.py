@@ -37,7 +37,7 @@ import toolpath_ir
 
 TOL = 1e-3
 
-CANON_RE = re.compile(r"(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED|SET_FEED_RATE|NURBS_FEED)\(([^)]*)\)")
+CANON_RE = re.compile(r"(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED|SET_FEED_RATE|NURBS_FEED|DWELL)\(([^)]*)\)")
 G5_RE = re.compile(r"^G5 X(\S+) Y(\S+) I(\S+) J(\S+) P(\S+) Q(\S+)")
 SPLINE_TOL = 0.01
 
@@ -61,6 +61,12 @@ def canon_moves(path, program):
             args = [a.strip() for a in m.group(2).split(",")]
             if m.group(1) == "SET_FEED_RATE":
                 feed = float(args[0])
+                continue
+            if m.group(1) == "DWELL" and float(args[0]) == 0:
+                continue  # G84 waits 0 s at the bottom: no wait
+            if m.group(1) == "DWELL":
+                out.append({"kind": "dwell", "to": at, "time": float(args[0]),
+                            "text": "canon line %d: %s" % (n, line.strip())})
                 continue
             if m.group(1) == "NURBS_FEED":
                 x, y, i, j, p, q = next(splines)
@@ -110,7 +116,7 @@ def normalise(moves, feeds_only):
     out = []
     at = None
     for mv in moves:
-        if mv["kind"] != "arc" and at is not None and close(mv["to"], at):
+        if mv["kind"] not in ("arc", "dwell") and at is not None and close(mv["to"], at):
             continue
         at = mv["to"]
         if feeds_only and mv["kind"] == "rapid":
@@ -132,7 +138,9 @@ def compare(ir, canon, feeds_only, feed_tol):
             why = "kind %s != %s" % (x["kind"], y["kind"])
         elif not close(x["to"], y["to"]):
             why = "end point differs"
-        elif x["kind"] != "rapid" and abs(x["feed"] - y["feed"]) > feed_tol:
+        elif x["kind"] == "dwell" and abs(x["time"] - y["time"]) > 0.0006:
+            why = "dwell %.3f s != %.3f s" % (x["time"], y["time"])
+        elif x["kind"] not in ("rapid", "dwell") and abs(x["feed"] - y["feed"]) > feed_tol:
             why = "feed %.3f != %.3f" % (x["feed"], y["feed"])
         elif x["kind"] == "arc" and (not close(x["centre"], y["centre"]) or x["ccw"] != y["ccw"]
                                      or x["turns"] != y["turns"]):

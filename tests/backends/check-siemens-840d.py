@@ -11,7 +11,8 @@ and reports what would be wrong there:
   * every block's words: G and M codes from short lists of the ones stepnc
     may write, address letters X Y Z I J K F S T D with well-formed numbers
     (decimal point on lengths and feeds, no exponent, no -0), `CR=`, `TURN=`,
-    `MSG("...")`, `MCALL`, `CYCLE81/82/83/84(...)` with their argument counts
+    `MSG("...")`, `MCALL`, `CYCLE81/82/83/84(...)` with their argument counts, `G4 F` (a
+    dwell, seconds) in a block of its own
     and the documented signs (RTP/RFP/DP absolute, SDIS/DPR unsigned), and
     `CYCLE832(tol, mode, 1)`;
   * block numbers, when there are any, strictly increasing; lines no longer
@@ -33,8 +34,9 @@ With --ir (one program) the moves the program makes are also compared with
 the toolpath IR's, within the rounding of 3 decimals: feed moves one by one
 (an arc may be written in several pieces, a CR= arc's centre may move with
 its rounded end points), runs of rapids by where they end. A drilling cycle
-makes the moves its documented parameters describe (CYCLE83: strokes as long
-as the first, no degression; CYCLE84: feed pitch times SST in, times SST1
+makes the moves its documented parameters describe (CYCLE82: CYCLE81's and
+a dwell of DTB seconds at the bottom; CYCLE83: strokes as long as the first,
+no degression; CYCLE84: feed pitch times SST in, times SST1
 out); its rapids are the controller's, so in a program with cycles only the
 feed moves are compared.
 
@@ -59,7 +61,7 @@ from toolpath_ir import arc_sweep
 RADIUS_TOL = 1e-3
 MAX_NAME = 24
 
-G_CODES = {0, 1, 2, 3, 17, 40, 64, 71, 90, 94, 642}
+G_CODES = {0, 1, 2, 3, 4, 17, 40, 64, 71, 90, 94, 642}
 MOTION = {0, 1, 2, 3}
 M_CODES = {0, 1, 3, 4, 5, 6, 7, 8, 9, 30}
 LENGTH_WORDS = set("XYZIJK") | {"CR", "F"}
@@ -156,6 +158,9 @@ def compare_moves(planned, made, feeds_only, decimals=3):
     def squeeze(moves):
         out, last = [], None
         for m in moves:
+            if m["kind"] == "dwell":
+                out.append(m)
+                continue
             if None in m["to"]:
                 continue
             if m["kind"] != "arc" and last is not None and printed(m["to"]) == printed(last):
@@ -179,6 +184,12 @@ def compare_moves(planned, made, feeds_only, decimals=3):
         if g["kind"] != w["kind"]:
             problems.append("%s: the plan has a %s, the program a %s" % (where, w["kind"], g["kind"]))
             break
+        if w["kind"] == "dwell":
+            if abs(g["time"] - w["time"]) > 0.0006:
+                problems.append("%s: a dwell of %g s, the plan's %g s" % (where, g["time"], w["time"]))
+                break
+            j += 1
+            continue
         if w["kind"] == "arc":
             # Pieces about the same centre, the same way, until the sweep is made.
             sweep, end = 0.0, None
@@ -353,6 +364,17 @@ class Checker:
                     self.problem(n, "%s written twice in one block" % address)
                     return
                 seen[address] = float(value)
+        if 4 in gs:
+            # G4 F: a dwell of F seconds, in a block of its own; F is a time
+            # there, not the feed (which stays as it was).
+            if len(words) != 2 or "F" not in seen:
+                self.problem(n, "G4 takes F (seconds) in a block of its own")
+            elif seen["F"] <= 0:
+                self.problem(n, "a dwell of G4 F%s" % seen["F"])
+            else:
+                self.made.append(dict(kind="dwell", to=(self.pos["X"], self.pos["Y"], self.pos["Z"]),
+                                      time=seen["F"], feed=0, line=n))
+            return
         if len([g for g in gs if g in MOTION]) > 1:
             self.problem(n, "two motion G codes in one block")
         kinds = [a for a, _ in words]
@@ -664,6 +686,11 @@ class Checker:
             self.make(n, "linear", pitch * sst1, at(c["r"]))
         elif c["cycle"] == "CYCLE81":
             self.make(n, "linear", self.feed, at(c["depth"]))
+        elif c["cycle"] == "CYCLE82":
+            # As CYCLE81, waiting DTB seconds at the bottom.
+            self.make(n, "linear", self.feed, at(c["depth"]))
+            if values[5]:
+                self.made.append(dict(kind="dwell", to=at(c["depth"]), time=values[5], feed=0, line=n))
         else:
             self.problem(n, "%s: its moves are not modelled" % c["cycle"])
         self.pos["Z"] = c["rtp"]

@@ -3,7 +3,7 @@ backend checkers compare programs with them."""
 import math
 import re
 
-MOVE_RE = re.compile(r"^\s*(rapid|linear|arc)\s+(.*)$")
+MOVE_RE = re.compile(r"^\s*(rapid|linear|arc|dwell)\s+(.*)$")
 ATTR_RE = re.compile(r"(\w+)=(\([^)]*\)|\S+)")
 
 
@@ -27,11 +27,12 @@ def arc_sweep(start, end, centre, ccw):
 
 
 def read_moves(path):
-    """Every move of every `moves` block, in order, each a dict: kind (rapid,
-    linear, arc), start and to (x, y, z; the first move starts at the origin,
-    as the program model has it), feed (mm/min, feed moves only), line (in
-    the file) and text; arcs also centre (x, y), ccw, turns, radius and sweep
-    (radians, full turns included)."""
+    """Every move of every `moves` block (those of its canned cycles in place),
+    in order, each a dict: kind (rapid, linear, arc, dwell), start and to (x,
+    y, z; the first move starts at the origin, as the program model has it),
+    feed (mm/min, feed moves only), line (in the file) and text; arcs also
+    centre (x, y), ccw, turns, radius and sweep (radians, full turns
+    included); dwells their time (s), where the tool is."""
     out = []
     pos = (0.0, 0.0, 0.0)
     with open(path) as f:
@@ -41,6 +42,10 @@ def read_moves(path):
             if not m:
                 continue
             attrs = dict(ATTR_RE.findall(m.group(2)))
+            if m.group(1) == "dwell":
+                out.append({"kind": "dwell", "start": pos, "to": pos, "line": n, "text": code.strip(),
+                            "time": float(attrs["time"].replace("s", ""))})
+                continue
             move = {"kind": m.group(1), "start": pos, "to": point(attrs["to"]), "line": n, "text": code.strip()}
             if "feed" in attrs:
                 move["feed"] = float(attrs["feed"].replace("mm/min", ""))

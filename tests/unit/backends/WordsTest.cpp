@@ -116,7 +116,7 @@ TEST_CASE("numbered blocks and overlong lines", "[backends]") {
 TEST_CASE("capability overrides are checked", "[backends]") {
   TargetDescriptor d;
   d.name = "t";
-  d.cycles = {CycleKind::Drill};
+  d.cycles = {{CycleKind::Drill, {}}};
   CHECK(applyOverrides(d, {"decimals=4", "arcs=radius", "cycles=off", "max-line-length=80"}).empty());
   CHECK(d.coordDecimals == 4);
   CHECK(d.arcs == ArcForm::Radius);
@@ -182,17 +182,33 @@ std::optional<Program> holeProgram(const std::string &op, const std::string &mov
   return buildProgram(*keep, nullptr, diags);
 }
 
-const std::string kIn = "        rapid to=(10.0000,10.0000,20.0000)mm role=position\n"
-                        "        rapid to=(10.0000,10.0000,2.0000)mm role=approach\n";
+/// The moves of a drill from the security plane z=20 to R z=2, down to
+/// z=-12 and back up, indented for a cycle (or, with `moveIndent` 8, for
+/// `moves` itself).
+std::string drillMoves(int moveIndent) {
+  const std::string in(static_cast<size_t>(moveIndent), ' ');
+  return in + "rapid to=(10.0000,10.0000,20.0000)mm role=position\n" + in +
+         "rapid to=(10.0000,10.0000,2.0000)mm role=approach\n" + in +
+         "linear to=(10.0000,10.0000,-12.0000)mm feed=100.0mm/min role=plunge\n" + in +
+         "rapid to=(10.0000,10.0000,20.0000)mm role=retract\n";
+}
 
 } // namespace
 
-TEST_CASE("hole cycles are recognised from the moves, and only from them", "[backends]") {
-  auto drill = holeProgram("drilling", kIn +
-                                           "        linear to=(10.0000,10.0000,-12.0000)mm feed=100.0mm/min role=plunge\n"
-                                           "        rapid to=(10.0000,10.0000,20.0000)mm role=retract\n");
+TEST_CASE("hole cycles come from the IR's cycle, never from the moves", "[backends]") {
+  // The moves of a drilling cycle, but no `cycle` says so: moves.
+  auto bare = holeProgram("drilling", drillMoves(8));
+  REQUIRE(bare);
+  REQUIRE(bare->steps.size() == 1);
+  CHECK_FALSE(bare->steps[0].cycle);
+  CHECK(bare->steps[0].moves.size() == 4);
+
+  // The same moves inside a cycle: what it says, read from its attributes.
+  auto drill = holeProgram("drilling", "        cycle type=drill at=(10.0000,10.0000,0.0000)mm clearance=2.0000mm "
+                                       "bottom=-12.0000mm feed=100.0mm/min dwell=0.500s end_feed=50.0mm/min "
+                                       "end_depth=2.0000mm\n" +
+                                           drillMoves(10));
   REQUIRE(drill);
-  REQUIRE(drill->steps.size() == 1);
   REQUIRE(drill->steps[0].cycle);
   const HoleCycle &c = *drill->steps[0].cycle;
   CHECK(c.kind == CycleKind::Drill);
@@ -200,38 +216,48 @@ TEST_CASE("hole cycles are recognised from the moves, and only from them", "[bac
   CHECK(c.retractZ == 2);
   CHECK(c.surfaceZ == 0);
   CHECK(c.depthZ == -12);
+  CHECK(c.pecks == std::vector<double>{-12});
   CHECK(c.feed == 100);
   CHECK(c.feedOut == 0);
+  CHECK(c.dwell == 0.5);
+  CHECK(c.endFeed == 50);
+  CHECK(c.endDepth == 2);
+  // The cycle's moves are the step's moves all the same.
+  CHECK(drill->steps[0].moves.size() == 4);
 
   auto peck = holeProgram("multistep_drilling",
-                          kIn + "        linear to=(10.0000,10.0000,-5.0000)mm feed=100.0mm/min role=plunge\n"
-                                "        rapid to=(10.0000,10.0000,2.0000)mm role=retract\n"
-                                "        rapid to=(10.0000,10.0000,-4.5000)mm role=approach\n"
-                                "        linear to=(10.0000,10.0000,-12.0000)mm feed=100.0mm/min role=plunge\n"
-                                "        rapid to=(10.0000,10.0000,20.0000)mm role=retract\n");
+                          "        cycle type=peck at=(10.0000,10.0000,0.0000)mm clearance=2.0000mm bottom=-12.0000mm "
+                          "feed=100.0mm/min pecks=(-5,-12) reapproach=0.5000mm dwell_step=0.200s\n"
+                          "          rapid to=(10.0000,10.0000,20.0000)mm role=position\n"
+                          "          rapid to=(10.0000,10.0000,2.0000)mm role=approach\n"
+                          "          linear to=(10.0000,10.0000,-5.0000)mm feed=100.0mm/min role=plunge\n"
+                          "          dwell time=0.200s\n"
+                          "          rapid to=(10.0000,10.0000,2.0000)mm role=retract\n"
+                          "          rapid to=(10.0000,10.0000,-4.5000)mm role=approach\n"
+                          "          linear to=(10.0000,10.0000,-12.0000)mm feed=100.0mm/min role=plunge\n"
+                          "          rapid to=(10.0000,10.0000,20.0000)mm role=retract\n");
   REQUIRE(peck);
   REQUIRE(peck->steps[0].cycle);
+  CHECK(peck->steps[0].cycle->kind == CycleKind::Peck);
   CHECK(peck->steps[0].cycle->pecks == std::vector<double>{-5, -12});
+  CHECK(peck->steps[0].cycle->reapproach == 0.5);
+  CHECK(peck->steps[0].cycle->dwellStep == 0.2);
+  // The dwell is a move of the step, where the tool stands.
+  REQUIRE(peck->steps[0].moves.size() == 8);
+  CHECK(peck->steps[0].moves[3].kind == Move::Kind::Dwell);
+  CHECK(peck->steps[0].moves[3].dwell == 0.2);
+  CHECK(peck->steps[0].moves[3].to == ir::Vec3(10, 10, -5));
 
-  auto ream = holeProgram("reaming", kIn +
-                                         "        linear to=(10.0000,10.0000,-12.0000)mm feed=100.0mm/min role=plunge\n"
-                                         "        linear to=(10.0000,10.0000,2.0000)mm feed=50.0mm/min role=retract\n"
-                                         "        rapid to=(10.0000,10.0000,20.0000)mm role=retract\n");
-  REQUIRE(ream);
-  REQUIRE(ream->steps[0].cycle);
-  CHECK(ream->steps[0].cycle->kind == CycleKind::Bore);
-  CHECK(ream->steps[0].cycle->feedOut == 50);
-
-  // A move off the axis, or a drill that leaves at feed: no cycle.
-  auto off = holeProgram("drilling", kIn +
-                                         "        linear to=(10.5000,10.0000,-12.0000)mm feed=100.0mm/min role=plunge\n"
-                                         "        rapid to=(10.5000,10.0000,20.0000)mm role=retract\n");
-  REQUIRE(off);
-  CHECK_FALSE(off->steps[0].cycle);
-  auto slow = holeProgram("drilling", kIn +
-                                          "        linear to=(10.0000,10.0000,-12.0000)mm feed=100.0mm/min role=plunge\n"
-                                          "        linear to=(10.0000,10.0000,2.0000)mm feed=100.0mm/min role=retract\n"
-                                          "        rapid to=(10.0000,10.0000,20.0000)mm role=retract\n");
-  REQUIRE(slow);
-  CHECK_FALSE(slow->steps[0].cycle);
+  // What a target's descriptor lacks to write the cycle.
+  TargetDescriptor d;
+  d.name = "t";
+  CHECK(whyNotCycle(d, c) == "cycles are off (--no-cycles or cycles=off)");
+  d.cycles = {{CycleKind::Peck, {}}};
+  CHECK(whyNotCycle(d, c) == "t writes no drill cycle");
+  d.cycles = {{CycleKind::Drill, {}}};
+  CHECK(whyNotCycle(d, c) == "its drill cycle has no dwell at the bottom");
+  d.cycles = {{CycleKind::Drill, {.dwell = true}}};
+  CHECK(whyNotCycle(d, c) == "its drill cycle has no reduced feeds near the top or bottom");
+  d.cycles = {{CycleKind::Drill, {.dwell = true, .reducedFeeds = true}}};
+  CHECK(whyNotCycle(d, c).empty());
 }

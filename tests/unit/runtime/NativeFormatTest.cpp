@@ -298,7 +298,7 @@ TEST_CASE("native format mistakes are located", "[native]") {
   CHECK(error(replaced(kSmall, "line to", "circle to")) ==
         "10:1: unknown segment kind 'circle' (known: line, arc, blend)");
   CHECK(error(replaced(kSmall, "stop start", "stop halt")) ==
-        "10:63: unknown stop reason 'halt' (known: none, start, reversal, tiny, program)");
+        "10:63: unknown stop reason 'halt' (known: none, start, reversal, tiny, program, dwell)");
   CHECK(error(replaced(kSmall, " 1 2\n", " 1 2 3\n")) == "10:157: unexpected '3' after the last phase");
   CHECK(error(replaced(kSmall, " 1 2\n", " 1\n")) ==
         "10:154: the line ends where a phase's jerk should follow");
@@ -420,4 +420,20 @@ TEST_CASE("native segments join in acceleration", "[native]") {
   CHECK(stopError.rfind("11:", 0) == 0);
   CHECK(stopError.find("a segment that stops first (stop reversal) must start at rest, not at v0 ") !=
         std::string::npos);
+}
+
+TEST_CASE("a dwell's wait reads back, counts in the time, and is checked", "[native]") {
+  const std::string text = replaced(kSmall, "stop start", "stop dwell wait 0.75");
+  Read r = read(text);
+  REQUIRE(r.errors.empty());
+  REQUIRE(r.trajectory);
+  CHECK(r.trajectory->info[0].stop == StopReason::Dwell);
+  CHECK(r.trajectory->info[0].wait == 0.75);
+  CHECK(r.trajectory->duration() == 4.5 + 0.75);
+  // Written again: the same segment line, and the wait in the header's time.
+  CHECK(writeNative(*r.trajectory, "part.stpnc") ==
+        replaced(replaced(text, "; 1 segment, 4.500 s", "; 1 segment, 5.250 s"), "\"part.stpnc\"", "\"part.stpnc\""));
+  // A dwell without its wait, or one that does not wait.
+  CHECK(error(replaced(kSmall, "stop start", "stop dwell")) == "10:69: expected 'wait', found 'limits'");
+  CHECK(error(replaced(kSmall, "stop start", "stop dwell wait 0")) == "10:74: the dwell's wait (s) must be positive (found 0)");
 }

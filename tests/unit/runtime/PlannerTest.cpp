@@ -346,3 +346,45 @@ TEST_CASE("a blend's arc-length table is its curve's length", "[planner]") {
     CHECK(b.length == s);
   }
 }
+
+TEST_CASE("a dwell waits at rest for its time, where the program says", "[planner]") {
+  const Machine m = test::shippedMachine("hsc-3axis");
+  PathInput p;
+  p.moves.push_back(line(0, 0, -10, 300));  // a plunge
+  PathMove out = line(0, 0, 20, 0);         // the rapid out, after 0.5 s at the bottom
+  out.stopBefore = true;
+  out.waitBefore = 0.5;
+  p.moves.push_back(out);
+  const Trajectory t = plan(p, m);
+  REQUIRE(t.segments.size() == 2);
+  CHECK(t.info[1].stop == StopReason::Dwell);
+  CHECK(t.info[1].wait == 0.5);
+  CHECK(t.profiles[1].v0 == 0);
+  CHECK(t.profiles[1].a0 == 0);
+  // The wait counts once in the duration, beside the two rest-to-rest profiles.
+  CHECK(t.duration() == Approx(t.profiles[0].duration() + 0.5 + t.profiles[1].duration()).epsilon(1e-12));
+
+  // Played: at the bottom, at rest, for the whole wait.
+  const SimReport r = check(p, m);
+  CHECK(r.dwellTime == 0.5);
+  CHECK(r.duration == Approx(t.duration()).epsilon(1e-12));
+  const double reached = t.profiles[0].duration();
+  SimOptions options;
+  options.programmed = &p;
+  size_t atRest = 0;
+  simulate(t, m, options, [&](const Sample &s) {
+    if (s.t > reached + 1e-9 && s.t < reached + 0.5 - 1e-9) {
+      CHECK((s.p - Vec3(0, 0, -10)).norm() < 1e-12);
+      CHECK(s.speed == 0);
+      ++atRest;
+    }
+  });
+  CHECK(atRest >= 498);
+
+  // Without the dwell the same path is 0.5 s shorter and does not stop for it.
+  PathInput q = p;
+  q.moves[1].waitBefore = 0;
+  q.moves[1].stopBefore = false;
+  const Trajectory u = plan(q, m);
+  CHECK(u.duration() == Approx(t.duration() - 0.5).epsilon(1e-9));
+}
