@@ -8,7 +8,6 @@
 #include "tests/unit/TestSupport.h"
 #include "tests/unit/ir/SampleModule.h"
 #include "tests/unit/passes/PassTestSupport.h"
-#include "tools/stepnc/Compile.h"
 
 #include <catch2/catch.hpp>
 
