@@ -1,7 +1,8 @@
 // `stepnc opt IN --passes=PIPELINE`: reads IR text (or a STEP-NC file,
 // lowered first), verifies it, runs a pass pipeline over it and writes the
-// IR; the steps are compile's (Compile.cpp). `--list-passes` lists the passes
-// with their options, from the registry (passes/Passes.def).
+// IR; the steps are compile's (Compile.cpp). `--list-passes` and the help
+// list the passes with their options as the registry declares them
+// (passes/Passes.def).
 #include "passes/PassRegistry.h"
 #include "tools/stepnc/Commands.h"
 #include "tools/stepnc/Compile.h"
@@ -14,13 +15,19 @@ namespace stepnc::tool {
 namespace {
 
 int listPasses() {
-  for (const passes::PassInfo &p : passes::registeredPasses()) {
-    std::cout << p.name << "\n    " << p.description << '\n';
-    if (!p.options.empty())
-      std::cout << "    options: " << p.options << '\n';
-  }
+  for (const passes::PassInfo &p : passes::registeredPasses())
+    std::cout << passes::describePass(p);
+  std::cout << passes::describeOptionTypes();
   std::cout.flush();
   return kExitOk;
+}
+
+/// The passes by name, for the end of `opt --help`.
+std::string passNames() {
+  std::string names;
+  for (const passes::PassInfo &p : passes::registeredPasses())
+    names += (names.empty() ? "" : ", ") + std::string(p.name);
+  return "Passes: " + names + " (--list-passes: what each does, its options and their defaults).";
 }
 
 } // namespace
@@ -38,6 +45,7 @@ void registerOpt(CLI::App &app, std::function<void(int)> setResult) {
   cmd->add_flag("--verify-each", opts->verifyEach, "Verify the IR after every pass, naming a pass that breaks it");
   cmd->add_flag("--list-passes", opts->listPasses, "List the passes stepnc knows, with their options, and exit");
   addCommonOptions(*cmd, *opts);
+  cmd->footer(passNames());
   // --list-passes needs no input; everything else does.
   cmd->callback([opts, setResult] {
     if (opts->listPasses)

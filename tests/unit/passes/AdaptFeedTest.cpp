@@ -128,11 +128,3 @@ TEST_CASE("adapt-feed: pocket corners get lower feeds than the walls", "[adapt-f
   // 0.917; in the corners the tool engages over half a turn, a factor of 1.
   CHECK(cornerLow < 0.95 * wallLow);
 }
-
-TEST_CASE("adapt-feed: options are checked", "[adapt-feed]") {
-  ir::test::Parsed p = parsed();
-  std::vector<std::string> errors;
-  CHECK_FALSE(test::runPipeline(*p.module, "adapt-feed<allow-increase=maybe>", &errors));
-  REQUIRE(errors.size() == 1);
-  CHECK(errors[0] == "adapt-feed: allow-increase='maybe' must be true or false");
-}
