@@ -74,9 +74,8 @@ struct StepFigures {
 
 class AdaptFeedPass final : public CuttingPass {
 public:
-  AdaptFeedPass(std::string machine, std::string data, bool allowIncrease, std::string error)
-      : CuttingPass(std::move(data), std::move(error)), machineSpec_(std::move(machine)),
-        allowIncrease_(allowIncrease) {}
+  AdaptFeedPass(std::string machine, std::string data, bool allowIncrease)
+      : CuttingPass(std::move(data)), machineSpec_(std::move(machine)), allowIncrease_(allowIncrease) {}
 
   std::string_view name() const override { return "adapt-feed"; }
 
@@ -428,19 +427,8 @@ private:
 } // namespace
 
 std::unique_ptr<Pass> createAdaptFeedPass(const PassOptions &options) {
-  std::string machine, data, error;
-  bool allowIncrease = false;
-  if (auto it = options.find("machine"); it != options.end())
-    machine = it->second;
-  if (auto it = options.find("data"); it != options.end())
-    data = it->second;
-  if (auto it = options.find("allow-increase"); it != options.end()) {
-    if (it->second == "true")
-      allowIncrease = true;
-    else if (it->second != "false")
-      error = "adapt-feed: allow-increase='" + it->second + "' must be true or false";
-  }
-  return std::make_unique<AdaptFeedPass>(std::move(machine), std::move(data), allowIncrease, std::move(error));
+  return std::make_unique<AdaptFeedPass>(options.text("machine"), options.text("data"),
+                                         options.flag("allow-increase"));
 }
 
 } // namespace stepnc::passes

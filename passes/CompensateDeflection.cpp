@@ -42,7 +42,6 @@ namespace {
 
 using geom::Vec2;
 
-constexpr double kDefaultMaxOffset = 0.05; ///< mm
 /// mm: the programmed offset stays this close to every wall sample's fixed
 /// point (the residual error is then within about as much).
 constexpr double kFitTolerance = 0.001;
@@ -244,8 +243,7 @@ struct MoveFit {
 
 class CompensateDeflectionPass final : public CuttingPass {
 public:
-  CompensateDeflectionPass(std::string data, double maxOffset, std::string error)
-      : CuttingPass(std::move(data), std::move(error)), maxOffset_(maxOffset) {}
+  CompensateDeflectionPass(std::string data, double maxOffset) : CuttingPass(std::move(data)), maxOffset_(maxOffset) {}
 
   std::string_view name() const override { return "compensate-deflection"; }
 
@@ -573,24 +571,13 @@ private:
     }
   }
 
-  double maxOffset_ = kDefaultMaxOffset;
+  double maxOffset_;  ///< mm
 };
 
 } // namespace
 
 std::unique_ptr<Pass> createCompensateDeflectionPass(const PassOptions &options) {
-  std::string data, error;
-  double maxOffset = kDefaultMaxOffset;
-  if (auto it = options.find("data"); it != options.end())
-    data = it->second;
-  if (auto it = options.find("max-offset"); it != options.end()) {
-    if (auto v = parseLengthOption(it->second))
-      maxOffset = *v;
-    else
-      error = "compensate-deflection: max-offset='" + it->second +
-              "' is not a length: expected a positive number of mm, such as max-offset=0.05";
-  }
-  return std::make_unique<CompensateDeflectionPass>(std::move(data), maxOffset, std::move(error));
+  return std::make_unique<CompensateDeflectionPass>(options.text("data"), options.number("max-offset").value());
 }
 
 } // namespace stepnc::passes

@@ -3,22 +3,10 @@
 #include "ir/Printer.h"
 #include "ir/Verifier.h"
 
-#include <charconv>
-#include <cmath>
 #include <cstdlib>
 #include <optional>
 
 namespace stepnc::passes {
-
-std::optional<double> parseLengthOption(std::string_view text) {
-  if (text.size() > 2 && text.substr(text.size() - 2) == "mm")
-    text.remove_suffix(2);
-  double value = 0;
-  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-  if (ec != std::errc() || end != text.data() + text.size() || !std::isfinite(value) || value <= 0)
-    return std::nullopt;
-  return value;
-}
 
 void PassManager::add(std::unique_ptr<Pass> pass) { passes_.push_back(std::move(pass)); }
 

@@ -12,16 +12,12 @@ namespace {
 
 class PlanMotionPass final : public Pass {
 public:
-  PlanMotionPass(std::string machinePath, std::optional<double> tolerance, std::string error)
-      : machinePath_(std::move(machinePath)), tolerance_(tolerance), error_(std::move(error)) {}
+  PlanMotionPass(std::string machinePath, std::optional<double> tolerance)
+      : machinePath_(std::move(machinePath)), tolerance_(tolerance) {}
 
   std::string_view name() const override { return "plan-motion"; }
 
   PassResult run(ir::Module &module, DiagnosticEngine &diags, PassStats &stats) override {
-    if (!error_.empty()) {
-      diags.error({}, error_);
-      return {false, false};
-    }
     if (!ir::requireThreeAxisMilling(module, "plan-motion", diags))
       return {false, false};
     // Kept for the life of the pass: diagnostics point into it.
@@ -64,25 +60,12 @@ private:
   std::string machinePath_;
   std::unique_ptr<SourceFile> machineFile_;
   std::optional<double> tolerance_;
-  std::string error_;
 };
 
 } // namespace
 
 std::unique_ptr<Pass> createPlanMotionPass(const PassOptions &options) {
-  std::string machine, error;
-  std::optional<double> tolerance;
-  if (auto it = options.find("machine"); it != options.end())
-    machine = it->second;
-  else
-    error = "plan-motion needs a machine: plan-motion<machine=FILE> or a shipped machine, plan-motion<machine=hsc-3axis>";
-  if (auto it = options.find("tolerance"); it != options.end()) {
-    tolerance = parseLengthOption(it->second);
-    if (!tolerance)
-      error = "plan-motion: tolerance='" + it->second +
-              "' is not a length: expected a positive number of mm, such as tolerance=0.01";
-  }
-  return std::make_unique<PlanMotionPass>(std::move(machine), tolerance, std::move(error));
+  return std::make_unique<PlanMotionPass>(options.text("machine"), options.number("tolerance"));
 }
 
 } // namespace stepnc::passes

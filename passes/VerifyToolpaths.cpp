@@ -786,16 +786,11 @@ private:
 
 class VerifyToolpathsPass final : public Pass {
 public:
-  VerifyToolpathsPass(std::optional<double> tolerance, std::string optionError)
-      : tolerance_(tolerance), optionError_(std::move(optionError)) {}
+  explicit VerifyToolpathsPass(std::optional<double> tolerance) : tolerance_(tolerance) {}
 
   std::string_view name() const override { return "verify-toolpaths"; }
 
   PassResult run(ir::Module &module, DiagnosticEngine &diags, PassStats &stats) override {
-    if (!optionError_.empty()) {
-      diags.error({}, optionError_);
-      return {false, false};
-    }
     if (!ir::requireThreeAxisMilling(module, "verify-toolpaths", diags))
       return {false, false};
     return ToolpathChecker(module, diags, stats, tolerance_).run();
@@ -803,21 +798,12 @@ public:
 
 private:
   std::optional<double> tolerance_;
-  std::string optionError_;
 };
 
 } // namespace
 
 std::unique_ptr<Pass> createVerifyToolpathsPass(const PassOptions &options) {
-  std::optional<double> tolerance;
-  std::string error;
-  if (auto it = options.find("tolerance"); it != options.end()) {
-    tolerance = parseLengthOption(it->second);
-    if (!tolerance)
-      error = "verify-toolpaths: tolerance='" + it->second +
-              "' is not a length: expected a positive number of mm, such as tolerance=0.01";
-  }
-  return std::make_unique<VerifyToolpathsPass>(tolerance, std::move(error));
+  return std::make_unique<VerifyToolpathsPass>(options.number("tolerance"));
 }
 
 } // namespace stepnc::passes

@@ -21,6 +21,16 @@ forbid backends '#include "(passes|tools)/' "backends depend on ir/, not on pass
 forbid passes '#include "(backends|tools)/' "passes do not depend on backends/ or tools/"
 forbid runtime '#include "(ir|passes|backends|tools|frontend)/' "runtime/ stands alone (support and Eigen only)"
 forbid ir '#include "(passes|backends|tools|frontend|runtime|cutting)/' "ir/ depends on support/ and geom/ (ir/geom) only; ir/motion also on runtime/"
+# The driver (driver/) is the library the commands and the tests share: the
+# layers below include neither it nor the commands, and only tools/ has a
+# command line.
+for folder in support frontend geom ir passes backends runtime cutting; do
+  forbid "$folder" '#include "(driver|tools)/' "$folder/ is below the driver: it includes neither driver/ nor tools/"
+done
+for folder in support frontend geom ir passes backends runtime cutting driver; do
+  forbid "$folder" '#include <CLI/' "only tools/ parses a command line (CLI11)"
+done
+forbid driver '#include "tools/' "driver/ is a library: the commands (tools/) use it, not the other way"
 # The core IR (ir/*.h, ir/*.cpp) has no geometry: that is ir/geom's.
 hits=$(grep -nE '#include "geom/' ir/*.h ir/*.cpp || true)
 if [ -n "$hits" ]; then echo "layering: the core IR does not include geom/ (ir/geom does):"; echo "$hits"; status=1; fi

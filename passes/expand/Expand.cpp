@@ -16,7 +16,6 @@
 
 #include <algorithm>
 #include <array>
-#include <charconv>
 
 namespace stepnc::passes {
 
@@ -151,8 +150,7 @@ namespace {
 
 class ExpandStrategiesPass final : public Pass {
 public:
-  ExpandStrategiesPass(double maxEngagement, double chordTolerance, std::string optionError)
-      : optionError_(std::move(optionError)) {
+  ExpandStrategiesPass(double maxEngagement, double chordTolerance) {
     x_.maxEngagement = maxEngagement;
     x_.chordTolerance = chordTolerance;
   }
@@ -160,10 +158,6 @@ public:
   std::string_view name() const override { return "expand-strategies"; }
 
   PassResult run(ir::Module &module, DiagnosticEngine &diags, PassStats &stats) override {
-    if (!optionError_.empty()) {
-      diags.error({}, optionError_);
-      return {false, false};
-    }
     x_.module = &module;
     x_.diags = &diags;
     x_.stats = &stats;
@@ -284,7 +278,6 @@ private:
   }
 
   Expander x_;
-  std::string optionError_;
 };
 
 } // namespace
@@ -292,28 +285,8 @@ private:
 } // namespace expand
 
 std::unique_ptr<Pass> createExpandStrategiesPass(const PassOptions &options) {
-  double maxEngagement = expand::kDefaultMaxEngagement, chord = expand::kDefaultChordTolerance;
-  std::string error;
-  if (auto it = options.find("max-engagement"); it != options.end()) {
-    double v = 0;
-    const char *first = it->second.data(), *last = first + it->second.size();
-    std::string_view unit;
-    auto [end, ec] = std::from_chars(first, last, v);
-    unit = std::string_view(end, size_t(last - end));
-    if (ec != std::errc() || !(v > 0 && v <= 180) || !(unit.empty() || unit == "deg"))
-      error = "expand-strategies: max-engagement='" + it->second +
-              "' is not an angle: expected degrees in (0, 180], such as max-engagement=60";
-    else
-      maxEngagement = v;
-  }
-  if (auto it = options.find("chord-tolerance"); it != options.end()) {
-    if (auto v = parseLengthOption(it->second))
-      chord = *v;
-    else
-      error = "expand-strategies: chord-tolerance='" + it->second +
-              "' is not a length: expected a positive number of mm, such as chord-tolerance=0.005";
-  }
-  return std::make_unique<expand::ExpandStrategiesPass>(maxEngagement, chord, std::move(error));
+  return std::make_unique<expand::ExpandStrategiesPass>(options.number("max-engagement").value(),
+                                                        options.number("chord-tolerance").value());
 }
 
 } // namespace stepnc::passes

@@ -2,9 +2,9 @@
 // one-line summary per file (and an entity histogram with --stats).
 #include "frontend/binding/Binder.h"
 #include "frontend/part21/Part21File.h"
-#include "tools/stepnc/SchemaSelection.h"
 #include "support/VerifyDiagnostics.h"
-#include "tools/stepnc/Driver.h"
+#include "tools/stepnc/CommandLine.h"
+#include "tools/stepnc/Commands.h"
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -19,7 +19,7 @@ struct CheckOptions {
   std::vector<std::string> files;
   bool stats = false;
   bool verify = false;
-  SchemaOptions schema;
+  driver::SchemaOptions schema;
   DiagnosticOptions diag;
 };
 
@@ -41,7 +41,7 @@ void printStats(const p21::Part21File &file) {
 
 /// Reads and checks one file: Part 21 syntax and references, then the schema.
 /// Returns the schema checked against (null if none).
-const express::Schema *checkFile(const p21::Part21File &file, const SchemaSelection &schemas,
+const express::Schema *checkFile(const p21::Part21File &file, const driver::SchemaSelection &schemas,
                                  DiagnosticEngine &diags) {
   if (diags.limitReached())
     return nullptr;
@@ -61,10 +61,9 @@ const express::Schema *checkFile(const p21::Part21File &file, const SchemaSelect
 int verifyFiles(const CheckOptions &opts) {
   int status = kExitOk;
   DiagnosticSession session(opts.diag);
-  SchemaSelection schemas(opts.schema);
-  bool io = false;
-  if (!schemas.load(session.engine(), io))
-    return io ? kExitUsage : kExitDiagnostics;
+  driver::SchemaSelection schemas(opts.schema);
+  if (const int rc = loadSchemas(schemas, session.engine()); rc != kExitOk)
+    return rc;
   for (const std::string &path : opts.files) {
     auto source = openInput(path);
     if (!source) {
@@ -86,10 +85,9 @@ int runCheckFiles(const CheckOptions &opts) {
     return verifyFiles(opts);
   DiagnosticSession session(opts.diag);
   DiagnosticEngine &diags = session.engine();
-  SchemaSelection schemas(opts.schema);
-  bool io = false;
-  if (!schemas.load(diags, io))
-    return io ? kExitUsage : kExitDiagnostics;
+  driver::SchemaSelection schemas(opts.schema);
+  if (const int rc = loadSchemas(schemas, diags); rc != kExitOk)
+    return rc;
   int status = kExitOk;
   for (const std::string &path : opts.files) {
     auto source = openInput(path);

@@ -1,28 +1,25 @@
 // `stepnc compile IN`: reads a STEP-NC file, checks it against its schema,
 // lowers it to the feature IR and verifies it; then, by --emit and --target,
 // writes the feature IR, or runs the pass pipeline and writes the toolpath IR
-// or a controller program. `stepnc opt IN` runs passes over IR text (or a
-// STEP-NC file). Nothing is written when there are errors; files are written
-// atomically.
+// or a controller program. `stepnc opt` (Opt.cpp) runs the same steps with
+// its own pipeline. Nothing is written when there are errors; files are
+// written atomically.
+#include "tools/stepnc/Compile.h"
+
 #include "backends/Backend.h"
 #include "backends/common/ToolTable.h"
 #include "backends/step-nc/OptimisedFile.h"
-#include "frontend/binding/Binder.h"
-#include "frontend/lowering/Lowering.h"
+#include "driver/LoadModule.h"
+#include "driver/Pipeline.h"
 #include "frontend/part21/Part21File.h"
 #include "frontend/part21/Writer.h"
-#include "ir/Parser.h"
 #include "ir/Printer.h"
 #include "ir/Verifier.h"
-#include "passes/PassManager.h"
-#include "support/VerifyDiagnostics.h"
 #include "runtime/Machine.h"
-#include "tools/stepnc/Compile.h"
-#include "tools/stepnc/Driver.h"
-#include "tools/stepnc/SchemaSelection.h"
-
 #include "support/Format.h"
 #include "support/OutputFile.h"
+#include "support/VerifyDiagnostics.h"
+#include "tools/stepnc/Commands.h"
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -33,38 +30,19 @@ namespace stepnc::tool {
 
 namespace {
 
-struct CompileOptions {
-  std::string input;
-  std::string output = "-";
-  std::string emit;  ///< feature-ir, toolpath-ir, motion-ir or program; empty: program with --target, else feature-ir
-  bool printLocations = false;
-  // compile only: the controller target
-  std::string target;
-  std::string toolTable;
-  bool noCycles = false;
-  std::optional<double> tolerance;
-  std::vector<std::string> targetOptions;
-  bool listTargets = false;
-  std::string machine;  ///< for motion-ir and the native target; bounds adapt-feed
-  bool noAdaptFeed = false;
-  bool noCompensateDeflection = false;
-  std::string cuttingData;
-  bool allowFeedIncrease = false;
-  // opt only
-  std::string passes;
-  std::vector<std::string> printAfter;
-  bool printAfterAll = false;
-  bool verifyEach = false;
-  bool listPasses = false;
-  bool stats = false;
-  /// Match the diagnostics against the expectations in the input's comments
-  /// instead of printing them (docs/diagnostics.md).
-  bool verifyDiagnostics = false;
-  SchemaOptions schema;
-  DiagnosticOptions diag;
-};
+std::string targetList() {
+  std::string names;
+  for (const backends::TargetInfo &t : backends::registeredTargets())
+    names += (names.empty() ? "" : ", ") + std::string(t.name);
+  return "targets: " + names;
+}
 
-std::string targetList();
+int listTargets() {
+  for (const backends::TargetInfo &t : backends::registeredTargets())
+    std::cout << t.name << "\n    " << t.description << '\n';
+  std::cout.flush();
+  return kExitOk;
+}
 
 /// The program name: the output file's stem, else the input's.
 std::string programName(const CompileOptions &opts) {
@@ -117,7 +95,7 @@ std::vector<std::string> optimisedDescription(const CompileOptions &opts, const 
 
 /// Writes the machine-optimised STEP-NC file atomically: canonical Part 21, or
 /// Part 28 XML when the output ends in .stpx or .xml.
-int writeOptimised(const CompileOptions &opts, const SchemaSelection &schemas, const p21::Part21File &input,
+int writeOptimised(const CompileOptions &opts, const driver::SchemaSelection &schemas, const p21::Part21File &input,
                    const ir::Module &module, const std::string &pipeline, const std::vector<std::string> &reports,
                    DiagnosticEngine &diags) {
   backends::OptimisedFileOptions options;
@@ -134,7 +112,11 @@ int writeOptimised(const CompileOptions &opts, const SchemaSelection &schemas, c
     printToolError(error);
     return kExitUsage;
   }
-  if (isPart28Path(opts.output) ? !schemas.writeAsPart28(*file, out, diags) : !p21::writePart21(*file, out, diags)) {
+  std::string usageError;
+  if (isPart28Path(opts.output) ? !schemas.writeAsPart28(*file, out, diags, usageError)
+                                : !p21::writePart21(*file, out, diags)) {
+    if (!usageError.empty())
+      printToolError(usageError);
     std::cerr << "stepnc: cannot write optimised STEP-NC for " << opts.input << "; nothing written\n";
     return diags.hasErrors() ? kExitDiagnostics : kExitUsage;
   }
@@ -153,19 +135,20 @@ int writeOptimised(const CompileOptions &opts, const SchemaSelection &schemas, c
 int compileSource(const CompileOptions &opts, const std::string &emit, std::unique_ptr<SourceFile> &source,
                   backends::Backend *backend, DiagnosticEngine &diags) {
   const bool needsMotion = emit == "motion-ir" || opts.target == "native";
-  SchemaSelection schemas(opts.schema);
-  bool usage = false;
-  if (!schemas.load(diags, usage))
-    return usage ? kExitUsage : kExitDiagnostics;
+  driver::SchemaSelection schemas(opts.schema);
+  if (const int rc = loadSchemas(schemas, diags); rc != kExitOk)
+    return rc;
   std::unique_ptr<p21::Part21File> file;
-  std::unique_ptr<ir::Module> module;
-  if (schemas.readAsPart21(source, diags))
-    module = loadModule(*source, schemas, diags, usage, emit == "stepnc" ? &file : nullptr);
+  std::string usageError;
+  std::unique_ptr<ir::Module> module =
+      driver::loadModule(source, schemas, diags, usageError, emit == "stepnc" ? &file : nullptr);
   if (module && !ir::verifyModule(*module, diags))
     module.reset();
   if (!module) {
-    if (usage)
+    if (!usageError.empty()) {
+      printToolError(usageError);
       return kExitUsage;
+    }
     std::cerr << "stepnc: " << opts.input << " has errors; nothing written\n";
     return kExitDiagnostics;
   }
@@ -176,24 +159,28 @@ int compileSource(const CompileOptions &opts, const std::string &emit, std::uniq
   // The toolpath IR is the feature IR after the passes that make and check
   // moves; a program is written from the toolpath IR.
   // The motion IR and the native target add the motion planned on the machine.
-  ToolpathPipelineOptions toolpath;
+  driver::ToolpathPipelineOptions toolpath;
   toolpath.machine = opts.machine;
   toolpath.adaptFeed = !opts.noAdaptFeed;
   toolpath.compensateDeflection = !opts.noCompensateDeflection;
   toolpath.cuttingData = opts.cuttingData;
   toolpath.allowFeedIncrease = opts.allowFeedIncrease;
-  std::string pipelineText = emit != "feature-ir" && opts.passes.empty() ? toolpathPipeline(toolpath) : opts.passes;
+  std::string pipelineText =
+      emit != "feature-ir" && opts.passes.empty() ? driver::toolpathPipeline(toolpath) : opts.passes;
   if (opts.passes.empty() && needsMotion)
-    pipelineText += "," + planMotionPipeline(opts.machine, opts.tolerance);
+    pipelineText += "," + driver::planMotionPipeline(opts.machine, opts.tolerance);
   std::vector<std::string> reports;
   if (!pipelineText.empty()) {
-    PipelineRun run;
+    driver::PipelineRun run;
     run.reports = &reports;
     run.verifyEach = opts.verifyEach;
     run.printAfterAll = opts.printAfterAll;
     run.printAfter = opts.printAfter;
     run.stats = opts.stats;
-    if (const int rc = runPipeline(*module, pipelineText, run, diags); rc != kExitOk) {
+    run.log = &std::cerr;
+    if (const int rc = driver::runPipeline(*module, pipelineText, run, diags, usageError); rc != kExitOk) {
+      if (rc == kExitUsage)
+        printToolError(usageError);
       if (rc == kExitDiagnostics)
         std::cerr << "stepnc: the pass pipeline failed on " << opts.input << "; nothing written\n";
       return rc;
@@ -235,6 +222,8 @@ int compileSource(const CompileOptions &opts, const std::string &emit, std::uniq
   printOptions.locations = opts.printLocations;
   return writeText(opts.output, ir::printModule(*module, printOptions));
 }
+
+} // namespace
 
 int runCompile(const CompileOptions &opts) {
   const std::string emit = !opts.emit.empty() ? opts.emit : opts.target.empty() ? "feature-ir" : "program";
@@ -287,160 +276,15 @@ int runCompile(const CompileOptions &opts) {
   return verifyDiagnostics(*source, collector.diags, std::cerr) ? kExitOk : kExitDiagnostics;
 }
 
-std::string targetList() {
-  std::string names;
-  for (const backends::TargetInfo &t : backends::registeredTargets())
-    names += (names.empty() ? "" : ", ") + std::string(t.name);
-  return "targets: " + names;
-}
-
-int listTargets() {
-  for (const backends::TargetInfo &t : backends::registeredTargets())
-    std::cout << t.name << "\n    " << t.description << '\n';
-  std::cout.flush();
-  return kExitOk;
-}
-
-int listPasses() {
-  for (const passes::PassInfo &p : passes::registeredPasses()) {
-    std::cout << p.name << "\n    " << p.description << '\n';
-    if (!p.options.empty())
-      std::cout << "    options: " << p.options << '\n';
-  }
-  std::cout.flush();
-  return kExitOk;
-}
-
-// Options compile and opt share: output, locations, schema, diagnostics.
-void addCommonOptions(CLI::App &cmd, const std::shared_ptr<CompileOptions> &opts,
-                      const std::function<void(int)> &setResult) {
-  cmd.add_option("-o,--output", opts->output, "Output file ('-', the default, for standard output)");
-  cmd.add_flag("--print-locs", opts->printLocations, "Print each IR node's source location (file:line:col #id)");
-  cmd.add_flag("--stats", opts->stats, "Print each pass's counters to stderr");
-  cmd.add_flag("--verify-diagnostics", opts->verifyDiagnostics,
+void addCommonOptions(CLI::App &cmd, CompileOptions &opts) {
+  cmd.add_option("-o,--output", opts.output, "Output file ('-', the default, for standard output)");
+  cmd.add_flag("--print-locs", opts.printLocations, "Print each IR node's source location (file:line:col #id)");
+  cmd.add_flag("--stats", opts.stats, "Print each pass's counters to stderr");
+  cmd.add_flag("--verify-diagnostics", opts.verifyDiagnostics,
                "Check the diagnostics against the expected-error/warning comments in the input\n"
                "(exit 0 when they match) instead of printing them");
-  addSchemaOptions(cmd, opts->schema);
-  addDiagnosticOptions(cmd, opts->diag);
-  cmd.callback([opts, setResult] { setResult(runCompile(*opts)); });
-}
-
-} // namespace
-
-std::unique_ptr<ir::Module> loadModule(const SourceFile &source, const SchemaSelection &schemas,
-                                       DiagnosticEngine &diags, bool &usage, std::unique_ptr<p21::Part21File> *keep) {
-  std::string_view text = source.text();
-  while (!text.empty() && (text[0] == ' ' || text[0] == '\n' || text[0] == '\r' || text[0] == '\t'))
-    text.remove_prefix(1);
-  if (text.starts_with(";") || text.starts_with("project")) {
-    auto module = ir::parseModule(source, diags);
-    if (!module || diags.hasErrors())
-      return nullptr;
-    return module;
-  }
-  auto file = p21::readPart21(source, diags);
-  if (diags.hasErrors())
-    return nullptr;
-  const express::Model *model = nullptr;
-  const express::Schema *schema = schemas.select(*file, diags, model);
-  if (!schema) {
-    printToolError("cannot compile " + std::string(source.name()) +
-                   " without a schema: give its EXPRESS file with --schema FILE.exp");
-    usage = true;
-    return nullptr;
-  }
-  binding::BindOptions bindOptions;
-  bindOptions.lenient = true;
-  auto bound = binding::bind(*file, *model, *schema, diags, bindOptions);
-  if (diags.hasErrors())
-    return nullptr;
-  auto module = lowering::lowerToFeatureIR(*bound, diags);
-  if (!module || diags.hasErrors())
-    return nullptr;
-  if (keep)
-    *keep = std::move(file);
-  return module;
-}
-
-std::string toolpathPipeline(const ToolpathPipelineOptions &options) {
-  std::string text = "resolve-feeds,expand-strategies,";
-  if (options.adaptFeed) {
-    std::string adapt;
-    auto add = [&](const std::string &o) { adapt += (adapt.empty() ? "<" : ",") + o; };
-    if (!options.machine.empty())
-      add("machine=" + options.machine);
-    if (!options.cuttingData.empty())
-      add("data=" + options.cuttingData);
-    if (options.allowFeedIncrease)
-      add("allow-increase=true");
-    text += "adapt-feed" + adapt + (adapt.empty() ? "" : ">") + ",";
-  }
-  if (options.compensateDeflection)
-    text += options.cuttingData.empty() ? "compensate-deflection,"
-                                        : "compensate-deflection<data=" + options.cuttingData + ">,";
-  return text + "verify-toolpaths";
-}
-
-std::string planMotionPipeline(const std::string &machine, std::optional<double> tolerance) {
-  std::string text = "plan-motion<machine=" + machine;
-  if (tolerance)
-    text += ",tolerance=" + formatShortest(*tolerance);
-  return text + ">";
-}
-
-int runPipeline(ir::Module &module, const std::string &text, const PipelineRun &run, DiagnosticEngine &diags) {
-  std::string error;
-  auto pipeline = passes::parsePipeline(text, error);
-  if (!pipeline) {
-    printToolError(error);
-    return kExitUsage;
-  }
-  passes::PassManagerOptions pmOptions;
-  pmOptions.verifyEach = run.verifyEach;
-  pmOptions.printAfterAll = run.printAfterAll;
-  pmOptions.printAfter.insert(run.printAfter.begin(), run.printAfter.end());
-  pmOptions.print = [](std::string_view t) { std::cerr << t; };
-  passes::PassManager manager(std::move(pmOptions));
-  manager.add(*pipeline);
-  const bool ok = manager.run(module, diags);
-  if (run.stats) {
-    for (const auto &[pass, counters] : manager.stats())
-      for (const auto &[what, n] : counters)
-        std::cerr << "stats: " << pass << ": " << n << ' ' << what << '\n';
-    for (const auto &[pass, lines] : manager.reports())
-      for (const std::string &line : lines)
-        std::cerr << "report: " << pass << ": " << line << '\n';
-  }
-  if (run.reports)
-    for (const auto &[pass, lines] : manager.reports())
-      for (const std::string &line : lines)
-        run.reports->push_back(std::string(pass) + ": " + line);
-  return ok ? kExitOk : kExitDiagnostics;
-}
-
-void registerOpt(CLI::App &app, std::function<void(int)> setResult) {
-  auto opts = std::make_shared<CompileOptions>();
-  CLI::App *cmd = app.add_subcommand(
-      "opt", "Read process IR text (or a STEP-NC file, lowered first), verify it, run a pass\n"
-             "pipeline over it (--passes) and print it.");
-  cmd->add_option("input", opts->input, "IR text or STEP-NC file");
-  cmd->add_option("--passes", opts->passes,
-                  "Pass pipeline to run, e.g. 'resolve-feeds' or 'a,b<key=value>' (-passes= works too)");
-  cmd->add_option("--print-after", opts->printAfter, "Print the IR to stderr after this pass (repeatable)");
-  cmd->add_flag("--print-after-all", opts->printAfterAll, "Print the IR to stderr after every pass");
-  cmd->add_flag("--verify-each", opts->verifyEach, "Verify the IR after every pass, naming a pass that breaks it");
-  cmd->add_flag("--list-passes", opts->listPasses, "List the passes stepnc knows, with their options, and exit");
-  addCommonOptions(*cmd, opts, setResult);
-  // --list-passes needs no input; everything else does.
-  cmd->callback([opts, setResult] {
-    if (opts->listPasses)
-      return setResult(listPasses());
-    if (opts->input.empty()) {
-      printToolError("opt: an input file is required");
-      return setResult(kExitUsage);
-    }
-    setResult(runCompile(*opts));
-  });
+  addSchemaOptions(cmd, opts.schema);
+  addDiagnosticOptions(cmd, opts.diag);
 }
 
 void registerCompile(CLI::App &app, std::function<void(int)> setResult) {
@@ -481,7 +325,7 @@ void registerCompile(CLI::App &app, std::function<void(int)> setResult) {
   cmd->add_option("--target-opt", opts->targetOptions,
                   "Override a target capability, key=value (repeatable): " + backends::overrideHelp());
   cmd->add_flag("--list-targets", opts->listTargets, "List the controller targets and exit");
-  addCommonOptions(*cmd, opts, setResult);
+  addCommonOptions(*cmd, *opts);
   cmd->callback([opts, setResult] {
     if (opts->listTargets)
       return setResult(listTargets());

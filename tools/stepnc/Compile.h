@@ -1,56 +1,55 @@
-// What `compile`, `opt` and `sim` share: reading an input into the IR and
-// running a pass pipeline over it.
+// What the `compile` and `opt` commands share: opt is compile with a pass
+// pipeline of the user's and the IR written out, so both read the same
+// options and run the same steps (Compile.cpp).
 #pragma once
 
-#include "frontend/part21/Part21File.h"
-#include "ir/Node.h"
-#include "support/Diagnostics.h"
-#include "support/SourceFile.h"
-#include "tools/stepnc/SchemaSelection.h"
+#include "tools/stepnc/CommandLine.h"
 
 #include <memory>
 #include <optional>
 #include <string>
-#include <string_view>
+#include <vector>
 
 namespace stepnc::tool {
 
-/// What shapes the toolpath pipeline: the machine (for adapt-feed's bounds
-/// and cycle times; may be empty) and the feed-adaptation choices.
-struct ToolpathPipelineOptions {
-  std::string machine;
-  bool adaptFeed = true;
-  bool compensateDeflection = true;
-  std::string cuttingData;  ///< a user cutting-data file, or empty
+struct CompileOptions {
+  std::string input;
+  std::string output = "-";
+  std::string emit;  ///< feature-ir, toolpath-ir, motion-ir or program; empty: program with --target, else feature-ir
+  bool printLocations = false;
+  // compile only: the controller target
+  std::string target;
+  std::string toolTable;
+  bool noCycles = false;
+  std::optional<double> tolerance;
+  std::vector<std::string> targetOptions;
+  bool listTargets = false;
+  std::string machine;  ///< for motion-ir and the native target; bounds adapt-feed
+  bool noAdaptFeed = false;
+  bool noCompensateDeflection = false;
+  std::string cuttingData;
   bool allowFeedIncrease = false;
-};
-
-/// What `compile --emit=toolpath-ir` runs: resolve-feeds, expand-strategies,
-/// adapt-feed and compensate-deflection (unless turned off), verify-toolpaths.
-std::string toolpathPipeline(const ToolpathPipelineOptions &options);
-
-/// The plan-motion pass for a machine (file or shipped name) and tolerance.
-std::string planMotionPipeline(const std::string &machine, std::optional<double> tolerance);
-
-/// Reads `source` as IR text (a file that starts with the IR's comment line
-/// or `project`) or as STEP-NC, which is checked and lowered. Returns null
-/// after reporting errors; `usage` is set when the command line is at fault.
-/// `file`, when given, receives the Part 21 file read (null for IR text).
-std::unique_ptr<ir::Module> loadModule(const SourceFile &source, const SchemaSelection &schemas,
-                                       DiagnosticEngine &diags, bool &usage,
-                                       std::unique_ptr<p21::Part21File> *file = nullptr);
-
-struct PipelineRun {
-  bool verifyEach = false;
-  bool printAfterAll = false;
+  // opt only
+  std::string passes;
   std::vector<std::string> printAfter;
-  bool stats = false;  ///< print each pass's counters to stderr
-  /// When given, receives each pass's report lines as "pass: line".
-  std::vector<std::string> *reports = nullptr;
+  bool printAfterAll = false;
+  bool verifyEach = false;
+  bool listPasses = false;
+  bool stats = false;
+  /// Match the diagnostics against the expectations in the input's comments
+  /// instead of printing them (docs/diagnostics.md).
+  bool verifyDiagnostics = false;
+  driver::SchemaOptions schema;
+  DiagnosticOptions diag;
 };
 
-/// Runs the pipeline `text` over `module`. Returns the exit code: kExitOk,
-/// kExitUsage for a bad pipeline, kExitDiagnostics when a pass fails.
-int runPipeline(ir::Module &module, const std::string &text, const PipelineRun &run, DiagnosticEngine &diags);
+/// Reads the input, lowers it, runs the pipeline (--passes, else the one
+/// --emit and --target need) and writes what --emit asks for. Returns the
+/// exit code.
+int runCompile(const CompileOptions &opts);
+
+/// Options compile and opt share: output, locations, statistics, expected
+/// diagnostics, schema, diagnostics.
+void addCommonOptions(CLI::App &cmd, CompileOptions &opts);
 
 } // namespace stepnc::tool

@@ -5,8 +5,8 @@
 #include "frontend/part21/Part21File.h"
 #include "frontend/part21/Writer.h"
 #include "support/OutputFile.h"
-#include "tools/stepnc/Driver.h"
-#include "tools/stepnc/SchemaSelection.h"
+#include "tools/stepnc/CommandLine.h"
+#include "tools/stepnc/Commands.h"
 
 #include <CLI/CLI.hpp>
 #include <iostream>
@@ -18,7 +18,7 @@ namespace {
 struct ConvertOptions {
   std::string input;
   std::string output;
-  SchemaOptions schema;
+  driver::SchemaOptions schema;
   DiagnosticOptions diag;
 };
 
@@ -29,10 +29,9 @@ int runConvert(const ConvertOptions &opts) {
     return kExitUsage;
   DiagnosticSession session(opts.diag);
   DiagnosticEngine &diags = session.engine();
-  SchemaSelection schemas(opts.schema);
-  bool usage = false;
-  if (!schemas.load(diags, usage))
-    return usage ? kExitUsage : kExitDiagnostics;
+  driver::SchemaSelection schemas(opts.schema);
+  if (const int rc = loadSchemas(schemas, diags); rc != kExitOk)
+    return rc;
   auto nothingWritten = [&] {
     std::cerr << "stepnc: " << opts.input << " has errors; nothing written\n";
     return kExitDiagnostics;
@@ -52,8 +51,11 @@ int runConvert(const ConvertOptions &opts) {
     p21::checkInstances(*file, diags);  // syntax and references, as the Part 21 writer checks them
     if (diags.hasErrors())
       return nothingWritten();
-    if (!schemas.writeAsPart28(*file, out, diags))
+    if (std::string usageError; !schemas.writeAsPart28(*file, out, diags, usageError)) {
+      if (!usageError.empty())
+        printToolError(usageError);
       return diags.hasErrors() ? nothingWritten() : kExitUsage;
+    }
   } else if (!p21::writePart21(*file, out, diags, {.checkReferences = true})) {
     // One pass: decode, check references and write; on any error `out`
     // discards the temporary file.

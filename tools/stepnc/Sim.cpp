@@ -9,6 +9,8 @@
 // only that the program's extent fits the travel. Machines whose chain the
 // player cannot move a 3-axis program on (lathes, generic chains) are
 // refused with the reason.
+#include "driver/LoadModule.h"
+#include "driver/Pipeline.h"
 #include "ir/motion/MotionIR.h"
 #include "ir/geom/MoveWalk.h"
 #include "runtime/Machine.h"
@@ -16,8 +18,8 @@
 #include "runtime/Player.h"
 #include "support/Format.h"
 #include "support/OutputFile.h"
-#include "tools/stepnc/Compile.h"
-#include "tools/stepnc/Driver.h"
+#include "tools/stepnc/CommandLine.h"
+#include "tools/stepnc/Commands.h"
 
 #include <CLI/CLI.hpp>
 #include <cmath>
@@ -38,7 +40,7 @@ struct SimCommandOptions {
   std::string workOffset;  ///< "X,Y,Z" mm: the program origin in machine coordinates
   std::string samples;  ///< CSV of every sample
   std::string output = "-";
-  SchemaOptions schema;
+  driver::SchemaOptions schema;
   DiagnosticOptions diag;
 };
 
@@ -98,14 +100,17 @@ int runSim(const SimCommandOptions &opts) {
   if (source->text().starts_with("STEPNC-MOTION")) {
     trajectory = runtime::readNative(*source, diags);
   } else {
-    SchemaSelection schemas(opts.schema);
-    bool usage = false;
-    if (!schemas.load(diags, usage))
-      return usage ? kExitUsage : kExitDiagnostics;
-    if (schemas.readAsPart21(source, diags))
-      module = loadModule(*source, schemas, diags, usage);
-    if (!module)
-      return usage ? kExitUsage : kExitDiagnostics;
+    driver::SchemaSelection schemas(opts.schema);
+    if (const int rc = loadSchemas(schemas, diags); rc != kExitOk)
+      return rc;
+    std::string usageError;
+    module = driver::loadModule(source, schemas, diags, usageError);
+    if (!module) {
+      if (usageError.empty())
+        return kExitDiagnostics;
+      printToolError(usageError);
+      return kExitUsage;
+    }
     // Whatever the input lacks is made: moves, then the motion.
     bool hasMoves = false, hasMotion = false;
     for (const ir::Node *e : ir::programOrder(*module)) {
@@ -114,17 +119,23 @@ int runSim(const SimCommandOptions &opts) {
     }
     std::string pipeline;
     if (!hasMoves) {
-      ToolpathPipelineOptions toolpath;
+      driver::ToolpathPipelineOptions toolpath;
       toolpath.machine = machineName;
-      pipeline = toolpathPipeline(toolpath) + ",";
+      pipeline = driver::toolpathPipeline(toolpath) + ",";
     }
     if (!hasMotion || opts.tolerance)
-      pipeline += planMotionPipeline(machineName, opts.tolerance);
+      pipeline += driver::planMotionPipeline(machineName, opts.tolerance);
     else if (!pipeline.empty())
       pipeline.pop_back();
-    if (!pipeline.empty())
-      if (const int rc = runPipeline(*module, pipeline, {}, diags); rc != kExitOk)
+    if (!pipeline.empty()) {
+      driver::PipelineRun run;
+      run.log = &std::cerr;
+      if (const int rc = driver::runPipeline(*module, pipeline, run, diags, usageError); rc != kExitOk) {
+        if (rc == kExitUsage)
+          printToolError(usageError);
         return rc;
+      }
+    }
     trajectory = ir::readMotion(*module, diags);
     program = ir::programPath(*module);
   }

@@ -1,19 +1,11 @@
 // The stepnc command: a thin layer of subcommands over the stepnc libraries.
-#include "tools/stepnc/Driver.h"
+#include "tools/stepnc/CommandLine.h"
+#include "tools/stepnc/Commands.h"
 
 #include <CLI/CLI.hpp>
 #include <iostream>
 #include <string>
 #include <vector>
-
-namespace stepnc::tool {
-void registerCheck(CLI::App &app, std::function<void(int)> setResult);
-void registerConvert(CLI::App &app, std::function<void(int)> setResult);
-void registerSchema(CLI::App &app, std::function<void(int)> setResult);
-void registerCompile(CLI::App &app, std::function<void(int)> setResult);
-void registerOpt(CLI::App &app, std::function<void(int)> setResult);
-void registerSim(CLI::App &app, std::function<void(int)> setResult);
-} // namespace stepnc::tool
 
 int main(int argc, char **argv) {
   using namespace stepnc::tool;

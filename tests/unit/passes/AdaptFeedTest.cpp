@@ -8,7 +8,6 @@
 #include "tests/unit/TestSupport.h"
 #include "tests/unit/ir/SampleModule.h"
 #include "tests/unit/passes/PassTestSupport.h"
-#include "tools/stepnc/Compile.h"
 
 #include <catch2/catch.hpp>
 
@@ -128,12 +127,4 @@ TEST_CASE("adapt-feed: pocket corners get lower feeds than the walls", "[adapt-f
   // At ae 3 of R 5 the chip factor on the walls is sin(acos(1 - 3/5)) =
   // 0.917; in the corners the tool engages over half a turn, a factor of 1.
   CHECK(cornerLow < 0.95 * wallLow);
-}
-
-TEST_CASE("adapt-feed: options are checked", "[adapt-feed]") {
-  ir::test::Parsed p = parsed();
-  std::vector<std::string> errors;
-  CHECK_FALSE(test::runPipeline(*p.module, "adapt-feed<allow-increase=maybe>", &errors));
-  REQUIRE(errors.size() == 1);
-  CHECK(errors[0] == "adapt-feed: allow-increase='maybe' must be true or false");
 }

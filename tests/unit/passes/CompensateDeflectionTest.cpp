@@ -199,13 +199,3 @@ TEST_CASE("compensate-deflection: a finished pocket verifies on its predicted pa
   REQUIRE_FALSE(errors.empty());
   CHECK(errors[0].find("gouge") != std::string::npos);
 }
-
-TEST_CASE("compensate-deflection: options are checked", "[compensate-deflection]") {
-  ir::test::Parsed p = parsed();
-  std::vector<std::string> errors;
-  CHECK_FALSE(test::runPipeline(*p.module, "compensate-deflection<max-offset=far>", &errors));
-  REQUIRE(errors.size() == 1);
-  CHECK(errors[0] ==
-        "compensate-deflection: max-offset='far' is not a length: expected a positive number of mm, such as "
-        "max-offset=0.05");
-}

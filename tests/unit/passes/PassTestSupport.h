@@ -3,11 +3,10 @@
 // pipeline on a module, and writing a straight cut by hand.
 #pragma once
 
+#include "driver/LoadModule.h"
 #include "passes/PassManager.h"
 #include "support/Format.h"
 #include "tests/unit/ir/SampleModule.h"
-#include "tools/stepnc/Compile.h"
-#include "tools/stepnc/SchemaSelection.h"
 
 #include <catch2/catch.hpp>
 
@@ -56,11 +55,11 @@ inline Loaded loadStepnc(const std::string &path) {
   REQUIRE(l.source);
   DiagnosticCollector c;
   DiagnosticEngine diags(c);
-  const tool::SchemaOptions options;
-  tool::SchemaSelection schemas(options);
-  bool usage = false;
-  REQUIRE(schemas.load(diags, usage));
-  l.module = tool::loadModule(*l.source, schemas, diags, usage);
+  const driver::SchemaOptions options;
+  driver::SchemaSelection schemas(options);
+  REQUIRE(schemas.load(diags, error));
+  l.module = driver::loadModule(l.source, schemas, diags, error);
+  INFO(error);
   REQUIRE(l.module);
   return l;
 }

@@ -29,13 +29,100 @@ TEST_CASE("pipeline errors say where and what", "[passes]") {
   CHECK(error.find("unknown pass 'unknown'") != std::string::npos);
 }
 
-TEST_CASE("every registered pass can be built", "[passes]") {
+TEST_CASE("every registered pass can be built, its declared defaults taken", "[passes]") {
   for (const PassInfo &info : registeredPasses()) {
     INFO(info.name);
-    auto pass = createPass(PipelineEntry{std::string(info.name), {}});
+    // The required options given, the others left to their defaults (which
+    // must be values of their type: a declaration's mistake fails here).
+    std::string text(info.name), required;
+    for (const OptionInfo &o : info.options)
+      if (o.fallback.kind == OptionDefault::Kind::Required)
+        required += (required.empty() ? "<" : ",") + std::string(o.name) + "=" +
+                    (o.type == OptionType::Machine ? "hsc-3axis" : "x");
+    std::string error;
+    auto p = parsePipeline(text + required + (required.empty() ? "" : ">"), error);
+    INFO(error);
+    REQUIRE(p);
+    auto pass = createPass(p->front());
     REQUIRE(pass);
     CHECK(pass->name() == info.name);
   }
+}
+
+TEST_CASE("pass options take their declared defaults", "[passes]") {
+  std::string error;
+  auto p = parsePipeline("expand-strategies,compensate-deflection,verify-toolpaths,adapt-feed", error);
+  REQUIRE(p);
+  CHECK((*p)[0].options.number("max-engagement") == 90.0);
+  CHECK((*p)[0].options.number("chord-tolerance") == 0.005);
+  CHECK((*p)[1].options.number("max-offset") == 0.05);
+  CHECK_FALSE((*p)[1].options.has("data"));        // no default: the shipped data
+  CHECK_FALSE((*p)[2].options.has("tolerance"));   // no default: the workpiece's
+  CHECK((*p)[3].options.has("allow-increase"));
+  CHECK_FALSE((*p)[3].options.flag("allow-increase"));
+  // A value given replaces the default, converted to the option's type.
+  p = parsePipeline("expand-strategies<max-engagement=60deg,chord-tolerance=0.01mm>,adapt-feed<allow-increase=true>",
+                    error);
+  REQUIRE(p);
+  CHECK((*p)[0].options.number("max-engagement") == 60.0);
+  CHECK((*p)[0].options.number("chord-tolerance") == 0.01);
+  CHECK((*p)[1].options.flag("allow-increase"));
+  CHECK_FALSE((*p)[1].options.has("machine"));
+}
+
+TEST_CASE("an option value not of its type is refused where it stands", "[passes]") {
+  std::string error;
+  CHECK_FALSE(parsePipeline("adapt-feed<allow-increase=maybe>", error));
+  CHECK(error == "in pass pipeline 'adapt-feed<allow-increase=maybe>' at character 27: pass 'adapt-feed' option "
+                 "'allow-increase' expects true or false, got 'maybe'");
+  CHECK_FALSE(parsePipeline("resolve-feeds,compensate-deflection<max-offset=far>", error));
+  CHECK(error == "in pass pipeline 'resolve-feeds,compensate-deflection<max-offset=far>' at character 48: pass "
+                 "'compensate-deflection' option 'max-offset' expects a positive length in mm, such as 0.05 or "
+                 "0.05mm, got 'far'");
+  for (const char *bad : {"abc", "-1", "0", "1e400", "0.1mm2", "0.01in", "nan", "inf", ""}) {
+    INFO(bad);
+    CHECK_FALSE(parsePipeline(std::string("verify-toolpaths<tolerance=") + bad + ">", error));
+    CHECK(error.find("option 'tolerance' expects a positive length in mm") != std::string::npos);
+  }
+  for (const char *bad : {"wide", "0", "-30", "181", "60rad", "deg"}) {
+    INFO(bad);
+    CHECK_FALSE(parsePipeline(std::string("expand-strategies<max-engagement=") + bad + ">", error));
+    CHECK(error.find("option 'max-engagement' expects an angle in degrees above 0 and at most 180") !=
+          std::string::npos);
+  }
+  CHECK(parsePipeline("expand-strategies<max-engagement=180>", error));
+  CHECK_FALSE(parsePipeline("compensate-deflection<data=>", error));
+  CHECK(error.find("option 'data' expects a file path, got ''") != std::string::npos);
+  CHECK_FALSE(parsePipeline("plan-motion<machine=>", error));
+  CHECK(error.find("option 'machine' expects a machine description (a TOML file) or a shipped machine (") !=
+        std::string::npos);
+}
+
+TEST_CASE("an unknown option and a missing required option are refused", "[passes]") {
+  std::string error;
+  CHECK_FALSE(parsePipeline("adapt-feed<allow-increas=true>", error));
+  CHECK(error == "in pass pipeline 'adapt-feed<allow-increas=true>' at character 25: pass 'adapt-feed' has no "
+                 "option 'allow-increas'");
+  CHECK_FALSE(parsePipeline("plan-motion<tolerance=0.01>", error));
+  CHECK(error.starts_with("in pass pipeline 'plan-motion<tolerance=0.01>' at character 28: pass 'plan-motion' "
+                          "needs option 'machine', a machine description (a TOML file) or a shipped machine ("));
+  CHECK(parsePipeline("plan-motion<machine=hsc-3axis>", error));
+}
+
+TEST_CASE("the pass list describes each option from its declaration", "[passes]") {
+  const PassInfo *adapt = nullptr;
+  for (const PassInfo &info : registeredPasses())
+    if (info.name == "adapt-feed")
+      adapt = &info;
+  REQUIRE(adapt);
+  const std::string text = describePass(*adapt);
+  CHECK(text.starts_with("adapt-feed\n    Set each milling move's feed"));
+  CHECK(text.find("\n    options:\n      machine=<machine>  ") != std::string::npos);
+  CHECK(text.find("\n      allow-increase=true|false  let feeds rise above the programmed ones (default false)\n") !=
+        std::string::npos);
+  CHECK(text.find("data=<file>  cutting-data TOML file on top of the shipped one (without it: the shipped cutting "
+                  "data only)") != std::string::npos);
+  CHECK(describeOptionTypes().find("<mm>: a positive length in mm") != std::string::npos);
 }
 
 namespace {

@@ -1,7 +1,10 @@
-// Pieces shared by the stepnc subcommands: diagnostic output set-up, exit
-// codes, and reading input files.
+// Pieces the stepnc commands share on the command line: exit codes,
+// diagnostic and schema options, the diagnostic output, reading input files
+// and writing output files.
 #pragma once
 
+#include "driver/ExitCode.h"
+#include "driver/SchemaSelection.h"
 #include "support/Diagnostics.h"
 #include "support/SourceFile.h"
 
@@ -15,12 +18,9 @@ class App;
 
 namespace stepnc::tool {
 
-/// Process exit codes, the same for every subcommand.
-enum ExitCode : int {
-  kExitOk = 0,          ///< success; warnings allowed
-  kExitDiagnostics = 1, ///< the input has errors
-  kExitUsage = 2,       ///< bad command line, or a file could not be read or written
-};
+using driver::kExitDiagnostics;
+using driver::kExitOk;
+using driver::kExitUsage;
 
 /// Options every subcommand that reads input shares.
 struct DiagnosticOptions {
@@ -30,6 +30,9 @@ struct DiagnosticOptions {
 };
 
 void addDiagnosticOptions(CLI::App &cmd, DiagnosticOptions &opts);
+
+/// --schema FILE.exp (repeatable) and --no-schema.
+void addSchemaOptions(CLI::App &cmd, driver::SchemaOptions &opts);
 
 /// Owns the consumer and engine configured from DiagnosticOptions.
 class DiagnosticSession {
@@ -42,6 +45,10 @@ private:
   std::unique_ptr<DiagnosticConsumer> consumer_;
   std::unique_ptr<DiagnosticEngine> engine_;
 };
+
+/// Loads the --schema files: kExitOk, kExitDiagnostics when they have
+/// errors, kExitUsage (printed) when one cannot be read.
+int loadSchemas(driver::SchemaSelection &schemas, DiagnosticEngine &diags);
 
 /// True if an output path asks for Part 28 XML: it ends in .stpx or .xml
 /// (any case).
@@ -56,6 +63,5 @@ int writeText(const std::string &path, const std::string &text);
 
 /// Prints "stepnc: error: message" to stderr.
 void printToolError(const std::string &message);
-
 
 } // namespace stepnc::tool

@@ -11,26 +11,21 @@
 #include <string>
 #include <vector>
 
-namespace CLI {
-class App;
-}
+namespace stepnc::driver {
 
-namespace stepnc::tool {
-
+/// Which schemas to check against (the commands' --schema and --no-schema).
 struct SchemaOptions {
-  std::vector<std::string> files;  ///< --schema FILE.exp (repeatable)
-  bool none = false;               ///< --no-schema
+  std::vector<std::string> files;  ///< EXPRESS files resolved together; empty: the built-in schemas
+  bool none = false;               ///< check Part 21 syntax and references only
 };
-
-void addSchemaOptions(CLI::App &cmd, SchemaOptions &opts);
 
 class SchemaSelection {
 public:
   explicit SchemaSelection(const SchemaOptions &opts) : opts_(opts) {}
 
-  /// Reads and resolves the --schema files, if any. Returns false (after
-  /// reporting) when one cannot be read or has errors.
-  bool load(DiagnosticEngine &diags, bool &ioError);
+  /// Reads and resolves the --schema files, if any. Returns false when one
+  /// has errors (reported to `diags`) or cannot be read (`ioError` says why).
+  bool load(DiagnosticEngine &diags, std::string &ioError);
 
   /// The schema to check `file` against, or null with a warning saying why
   /// (unknown schema, --no-schema is silent). `model` receives its model.
@@ -52,13 +47,14 @@ public:
   /// Writes `file` as Part 28 through its schema. The schema check itself is
   /// `stepnc check`'s business: binding here only names each instance's
   /// entity, and only what the mapping cannot express is an error. Returns
-  /// false after reporting (a schema that is not known is a usage error,
-  /// printed, with no diagnostic counted).
-  bool writeAsPart28(const p21::Part21File &file, OutputFile &out, DiagnosticEngine &diags) const;
+  /// false after reporting to `diags`, or with `usageError` set when the
+  /// file's schema is not known (no diagnostic counted).
+  bool writeAsPart28(const p21::Part21File &file, OutputFile &out, DiagnosticEngine &diags,
+                     std::string &usageError) const;
 
 private:
   const SchemaOptions &opts_;
   express::Model loaded_;
 };
 
-} // namespace stepnc::tool
+} // namespace stepnc::driver

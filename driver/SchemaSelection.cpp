@@ -1,35 +1,21 @@
-#include "tools/stepnc/SchemaSelection.h"
+#include "driver/SchemaSelection.h"
 
 #include "frontend/express/Builtin.h"
 #include "frontend/express/SchemaReader.h"
 #include "frontend/binding/Binder.h"
 #include "frontend/part28/Reader.h"
 #include "frontend/part28/Writer.h"
-#include "tools/stepnc/Driver.h"
 
-#include <CLI/CLI.hpp>
+namespace stepnc::driver {
 
-namespace stepnc::tool {
-
-void addSchemaOptions(CLI::App &cmd, SchemaOptions &opts) {
-  cmd.add_option("--schema", opts.files,
-                 "Check against the schema(s) in this EXPRESS file instead of the built-in ISO 14649 "
-                 "ARM (repeatable: files are resolved together)");
-  cmd.add_flag("--no-schema", opts.none, "Check Part 21 syntax and references only");
-}
-
-bool SchemaSelection::load(DiagnosticEngine &diags, bool &ioError) {
+bool SchemaSelection::load(DiagnosticEngine &diags, std::string &ioError) {
   if (opts_.files.empty())
     return true;
   const unsigned before = diags.errorCount();
   for (const std::string &path : opts_.files) {
-    std::string error;
-    auto file = SourceFile::open(path, error);
-    if (!file) {
-      printToolError(error);
-      ioError = true;
+    auto file = SourceFile::open(path, ioError);
+    if (!file)
       return false;
-    }
     express::readExpress(std::move(file), loaded_, diags);
   }
   if (diags.errorCount() == before)
@@ -96,16 +82,17 @@ bool SchemaSelection::readAsPart21(std::unique_ptr<SourceFile> &source, Diagnost
   return true;
 }
 
-bool SchemaSelection::writeAsPart28(const p21::Part21File &file, OutputFile &out, DiagnosticEngine &diags) const {
+bool SchemaSelection::writeAsPart28(const p21::Part21File &file, OutputFile &out, DiagnosticEngine &diags,
+                                    std::string &usageError) const {
   const express::Model *model = nullptr;
   const express::Schema *schema = find(file.schemaNames(), model);
   if (!schema) {
     std::string listed;
     for (const std::string &n : file.schemaNames())
       listed += (listed.empty() ? "" : ", ") + n;
-    printToolError("writing Part 28 needs the file's schema, and " +
-                   (listed.empty() ? std::string("FILE_SCHEMA names none") : "schema " + listed + " is not built in") +
-                   ": give its EXPRESS file with --schema FILE.exp");
+    usageError = "writing Part 28 needs the file's schema, and " +
+                 (listed.empty() ? std::string("FILE_SCHEMA names none") : "schema " + listed + " is not built in") +
+                 ": give its EXPRESS file with --schema FILE.exp";
     return false;
   }
   DiagnosticCollector ignored;
@@ -116,4 +103,4 @@ bool SchemaSelection::writeAsPart28(const p21::Part21File &file, OutputFile &out
   return p28::writePart28(*bound, [&out](std::string_view chunk) { out.write(chunk); }, diags);
 }
 
-} // namespace stepnc::tool
+} // namespace stepnc::driver

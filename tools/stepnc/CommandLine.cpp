@@ -1,4 +1,4 @@
-#include "tools/stepnc/Driver.h"
+#include "tools/stepnc/CommandLine.h"
 
 #include "support/OutputFile.h"
 
@@ -19,6 +19,13 @@ void addDiagnosticOptions(CLI::App &cmd, DiagnosticOptions &opts) {
   cmd.add_flag("--warnings-as-errors", opts.warningsAsErrors, "Treat warnings as errors");
 }
 
+void addSchemaOptions(CLI::App &cmd, driver::SchemaOptions &opts) {
+  cmd.add_option("--schema", opts.files,
+                 "Check against the schema(s) in this EXPRESS file instead of the built-in ISO 14649 "
+                 "ARM (repeatable: files are resolved together)");
+  cmd.add_flag("--no-schema", opts.none, "Check Part 21 syntax and references only");
+}
+
 DiagnosticSession::DiagnosticSession(const DiagnosticOptions &opts) {
   if (opts.format == "json")
     consumer_ = std::make_unique<JsonDiagnosticPrinter>(std::cerr);
@@ -30,6 +37,16 @@ DiagnosticSession::DiagnosticSession(const DiagnosticOptions &opts) {
 }
 
 DiagnosticSession::~DiagnosticSession() { engine_->finish(); }
+
+int loadSchemas(driver::SchemaSelection &schemas, DiagnosticEngine &diags) {
+  std::string error;
+  if (schemas.load(diags, error))
+    return kExitOk;
+  if (error.empty())
+    return kExitDiagnostics;
+  printToolError(error);
+  return kExitUsage;
+}
 
 void printToolError(const std::string &message) {
   std::cout.flush();

@@ -5,7 +5,8 @@
 #include "frontend/express/SchemaReader.h"
 #include "frontend/part28/Xsd.h"
 #include "support/OutputFile.h"
-#include "tools/stepnc/Driver.h"
+#include "tools/stepnc/CommandLine.h"
+#include "tools/stepnc/Commands.h"
 
 #include <CLI/CLI.hpp>
 #include <filesystem>

@@ -1,0 +1,29 @@
+// Reading an input into the process IR, as every command that compiles does
+// (compile, opt, sim): IR text is parsed; STEP-NC, Part 21 or Part 28 XML, is
+// read, checked leniently against its schema and lowered to the feature IR.
+#pragma once
+
+#include "driver/SchemaSelection.h"
+#include "frontend/part21/Part21File.h"
+#include "ir/Node.h"
+#include "support/Diagnostics.h"
+#include "support/SourceFile.h"
+
+#include <memory>
+#include <string>
+
+namespace stepnc::driver {
+
+/// Reads `source` as IR text (a file that starts with the IR's comment line
+/// or `project`) or as STEP-NC. Part 28 XML is translated first and `source`
+/// becomes the translation (whose diagnostics point into the XML); Part 21 is
+/// bound to its schema leniently (README: compile reads leniently) and
+/// lowered. Returns null after reporting the input's errors to `diags`, or
+/// with `usageError` set when the caller is at fault (no schema for the
+/// file). `file`, when given, receives the Part 21 file read (null for IR
+/// text).
+std::unique_ptr<ir::Module> loadModule(std::unique_ptr<SourceFile> &source, const SchemaSelection &schemas,
+                                       DiagnosticEngine &diags, std::string &usageError,
+                                       std::unique_ptr<p21::Part21File> *file = nullptr);
+
+} // namespace stepnc::driver
