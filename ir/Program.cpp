@@ -88,6 +88,28 @@ bool requireThreeAxisMilling(const Module &module, std::string_view consumer, Di
   return false;
 }
 
+namespace {
+
+void visitSteps(Node &n, const std::string &setup,
+                const std::function<void(Node &, const std::string &)> &visit) {
+  for (Node &c : n.children) {
+    if (c.kind == Kind::Workingstep || c.kind == Kind::RapidMovement)
+      visit(c, setup);
+    else if (c.kind == Kind::Workplan)
+      visitSteps(c, c.text("setup").value_or(setup), visit);
+    else if (c.is(Trait::ControlFlow) || c.category() == Category::Branch)
+      visitSteps(c, setup, visit);
+  }
+}
+
+} // namespace
+
+void forEachMachiningStep(Module &module, const std::function<void(Node &step, const std::string &setup)> &visit) {
+  for (Node &n : module.root.children)
+    if (n.kind == Kind::Workplan)
+      visitSteps(n, n.text("setup").value_or(""), visit);
+}
+
 std::vector<const Node *> programOrder(const Module &module) {
   std::vector<const Node *> out;
   for (const Node &n : module.root.children)

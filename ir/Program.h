@@ -7,6 +7,7 @@
 #include "ir/Node.h"
 #include "support/Diagnostics.h"
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -22,6 +23,14 @@ namespace stepnc::ir {
 /// program runs, so a reader that writes one straight program must refuse it
 /// (requireThreeAxisMilling).
 std::vector<const Node *> programOrder(const Module &module);
+
+/// Calls `visit(step, setup)` for every workingstep and rapid movement (the
+/// executables that get moves) under the module's workplans, in the order
+/// written: into nested workplans, and into the bodies and branches of
+/// control flow (then, else, branch, a while's body), each of which is a
+/// program of its own. `setup` is the setup in force: the symbol the nearest
+/// enclosing workplan names. A straight program is visited in program order.
+void forEachMachiningStep(Module &module, const std::function<void(Node &step, const std::string &setup)> &visit);
 
 /// A workingstep's operation (its child of category operation), or null.
 const Node *operationOf(const Node &step);
@@ -57,8 +66,8 @@ struct Beyond {
 /// milling programs (the G-code targets, plan-motion, the cutting passes,
 /// verify-toolpaths, the STEP-NC writer) cannot take: control flow, an
 /// operation of another process than milling and hole making, a tool axis,
-/// an arc out of the XY plane, a feed per revolution, a dwell, a change of
-/// process state, a lathe's X mode. The IR expresses all of them
+/// an arc out of the XY plane, a feed per revolution, a change of process
+/// state, a lathe's X mode. (Dwells and canned cycles they all take.) The IR expresses all of them
 /// (docs/ir.md); each reader takes them as it learns to.
 std::optional<Beyond> beyondThreeAxisMilling(const Module &module);
 

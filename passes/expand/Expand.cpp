@@ -162,22 +162,16 @@ public:
     x_.diags = &diags;
     x_.stats = &stats;
     x_.result = {};
-    for (Node &n : module.root.children)
-      if (n.kind == ir::Kind::Workplan)
-        workplan(n, n.text("setup").value_or(""));
+    // Workingsteps in the branches of control flow too: each branch is a
+    // program of its own, which a target with control flow writes as such.
+    ir::forEachMachiningStep(module, [&](Node &e, const std::string &setup) {
+      if (!e.child(ir::Kind::Moves))
+        executable(e, setup);
+    });
     return x_.result;
   }
 
 private:
-  void workplan(Node &plan, const std::string &setup) {
-    for (Node &e : plan.children) {
-      if (e.kind == ir::Kind::Workplan)
-        workplan(e, e.text("setup").value_or(setup));
-      else if ((e.kind == ir::Kind::Workingstep || e.kind == ir::Kind::RapidMovement) && !e.child(ir::Kind::Moves))
-        executable(e, setup);
-    }
-  }
-
   void executable(Node &ws, const std::string &setup) {
     if (ws.kind == ir::Kind::RapidMovement) {
       expandRapidMovement(x_, ws, setup);
