@@ -279,43 +279,94 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
   const bool checkTravel = r.travelNotChecked.empty() && !machine.axes.empty();
   r.workOffsetMm = options.workOffsetMm;
   const Vec3 offset = options.workOffsetMm.value_or(Vec3::Zero());
-  std::vector<bool> outside(machine.axes.size(), false), spanReported(machine.axes.size(), false);
+  // Per axis, taken once: the travel with its slack (positions beyond it
+  // leave the travel) and the longest extent that fits it.
+  struct AxisTravel {
+    double low = 0, high = 0;  ///< a position below low or above high is outside the travel
+    double longest = 0;        ///< an extent above it does not fit
+    bool outside = false;      ///< in an excursion outside the travel (with a work offset)
+    bool spanReported = false; ///< its extent was reported (without one)
+  };
+  std::vector<AxisTravel> travel(machine.axes.size());
+  for (size_t k = 0; k < machine.axes.size(); ++k) {
+    const Axis &axis = machine.axes[k];
+    const double slack = 1e-9 * (1 + std::max(std::abs(axis.travelMin), std::abs(axis.travelMax)));
+    travel[k].low = axis.travelMin - slack;
+    travel[k].high = axis.travelMax + slack;
+    travel[k].longest = axis.travelMax - axis.travelMin + slack;
+  }
+  // The lowest and highest position of each axis so far (SimReport::axisMin,
+  // axisMax once the samples are done), and how many axes are outside.
+  std::vector<double> lowest(machine.axes.size()), highest(machine.axes.size());
+  size_t outsideCount = 0;
   Joints joints = Joints::Zero(static_cast<Eigen::Index>(machine.axes.size()));
   bool haveJoints = false;
+  // One axis at position q: its range so far, and whether it leaves its
+  // travel (with a work offset; once per excursion) or the program's extent
+  // on it no longer fits the travel (without one).
+  auto checkAxis = [&](size_t k, double q, double t, uint32_t sg) {
+    AxisTravel &a = travel[k];
+    if (!haveJoints)
+      lowest[k] = highest[k] = q;
+    lowest[k] = std::min(lowest[k], q);
+    highest[k] = std::max(highest[k], q);
+    if (options.workOffsetMm) {
+      const bool out = q < a.low || q > a.high;
+      if (out && !a.outside) {
+        const Axis &axis = machine.axes[k];
+        violate(ViolationKind::Travel, static_cast<int>(k), t, sg, q,
+                q < axis.travelMin ? axis.travelMin : axis.travelMax);
+      }
+      outsideCount += size_t(out) - size_t(a.outside);
+      a.outside = out;
+    } else if (!a.spanReported && highest[k] - lowest[k] > a.longest) {
+      const Axis &axis = machine.axes[k];
+      violate(ViolationKind::Extent, static_cast<int>(k), t, sg, highest[k] - lowest[k],
+              axis.travelMax - axis.travelMin);
+      a.spanReported = true;
+    }
+  };
+  // xyz (no kinematics made): the axes x, y, z are the tip's coordinates.
+  // Most samples change nothing but the range: with a work offset, a
+  // position within the travel while no axis is outside it; without one, a
+  // position within the range so far. Those are taken here, with what
+  // checkAxis would give; the others go through checkAxis.
+  auto quietXyz = [&](const Vec3 &q) {
+    if (options.workOffsetMm) {
+      if (outsideCount > 0)
+        return false;
+      for (int k = 0; k < 3; ++k)
+        if (q[k] < travel[k].low || q[k] > travel[k].high)
+          return false;
+      for (int k = 0; k < 3; ++k) {
+        lowest[k] = std::min(lowest[k], q[k]);
+        highest[k] = std::max(highest[k], q[k]);
+      }
+      return true;
+    }
+    for (int k = 0; k < 3; ++k)
+      if (q[k] < lowest[k] || q[k] > highest[k])
+        return false;
+    return true;
+  };
   auto checkTravelAt = [&](const Vec3 &p, double t, uint32_t sg) {
     if (!checkTravel)
       return;
-    const ToolPose pose{p + offset, Vec3::UnitZ()};
-    if (kinematics) {
-      const InverseResult ir = kinematics->inverse(pose, haveJoints ? &joints : nullptr);
-      if (!ir.joints)
-        return;  // not on a chain whose rotary axes can stay at 0 (whyNotThreeAxis says so)
-      joints = *ir.joints;
-    } else {
-      joints = pose.tipMm;  // xyz: the axes are the tip's coordinates
+    const Vec3 tip = p + offset;
+    if (!kinematics) {  // xyz
+      if (haveJoints && quietXyz(tip))
+        return;
+      for (int k = 0; k < 3; ++k)
+        checkAxis(size_t(k), tip[k], t, sg);
+      haveJoints = true;
+      return;
     }
-    for (size_t k = 0; k < machine.axes.size(); ++k) {
-      const Axis &axis = machine.axes[k];
-      const double q = joints[static_cast<Eigen::Index>(k)];
-      if (!haveJoints) {
-        r.axisMin.push_back(q);
-        r.axisMax.push_back(q);
-      }
-      r.axisMin[k] = std::min(r.axisMin[k], q);
-      r.axisMax[k] = std::max(r.axisMax[k], q);
-      const double slack = 1e-9 * (1 + std::max(std::abs(axis.travelMin), std::abs(axis.travelMax)));
-      if (options.workOffsetMm) {
-        // Once per excursion: where the axis leaves its travel.
-        const bool out = q < axis.travelMin - slack || q > axis.travelMax + slack;
-        if (out && !outside[k])
-          violate(ViolationKind::Travel, static_cast<int>(k), t, sg, q, q < axis.travelMin ? axis.travelMin : axis.travelMax);
-        outside[k] = out;
-      } else if (!spanReported[k] && r.axisMax[k] - r.axisMin[k] > axis.travelMax - axis.travelMin + slack) {
-        violate(ViolationKind::Extent, static_cast<int>(k), t, sg, r.axisMax[k] - r.axisMin[k],
-                axis.travelMax - axis.travelMin);
-        spanReported[k] = true;
-      }
-    }
+    const InverseResult ir = kinematics->inverse(ToolPose{tip, Vec3::UnitZ()}, haveJoints ? &joints : nullptr);
+    if (!ir.joints)
+      return;  // not on a chain whose rotary axes can stay at 0 (whyNotThreeAxis says so)
+    joints = *ir.joints;
+    for (size_t k = 0; k < machine.axes.size(); ++k)
+      checkAxis(k, joints[static_cast<Eigen::Index>(k)], t, sg);
     haveJoints = true;
   };
 
@@ -482,6 +533,10 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
   }
   if (n > 0)
     leave(seg);
+  if (haveJoints) {
+    r.axisMin = std::move(lowest);
+    r.axisMax = std::move(highest);
+  }
 
   // The end state: the last sample is the end.
   r.endPosition = s.p;

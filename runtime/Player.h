@@ -11,7 +11,8 @@
 //
 // Travel and spindle: each sample's position is mapped through the machine's
 // kinematics (runtime/Kinematics.h; rotary axes at 0, tool along +z) to its
-// axes' positions. With the program origin's place on the machine given
+// axes' positions; on an xyz machine it is the axes' position, compared with
+// bounds taken once. With the program origin's place on the machine given
 // (SimOptions::workOffsetMm) each is checked against its travel; without
 // it, only that the program's extent on each axis fits the travel somewhere.
 // The spindle speed of each programmed move, when the caller knows it (the

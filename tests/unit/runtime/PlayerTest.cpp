@@ -6,6 +6,7 @@
 #include "runtime/Planner.h"
 #include "runtime/Player.h"
 #include "support/Format.h"
+#include "tests/unit/runtime/ShippedMachine.h"
 
 #include <catch2/catch.hpp>
 
@@ -504,4 +505,58 @@ TEST_CASE("a planned rectangle plays without violations", "[player]") {
   CHECK(r.meanFeed < 30);
   CHECK(r.maxDeviation <= t.tolerance);
   CHECK_THAT(text, Catch::Contains("violations: none"));
+}
+
+TEST_CASE("travel on an xyz machine is what the kinematics' path gives", "[player][travel]") {
+  // The xyz machine's own check (the position is the axes') against the
+  // general one: a table-table machine with the same x, y, z and its rotary
+  // axes at 0 maps each position through its kinematics to the same x, y, z.
+  const Machine five = test::shippedMachine("table-table-5axis");
+  REQUIRE(five.axes.size() == 5);
+  Machine xyz = five;
+  xyz.kinematics = {};
+  xyz.kinematics.chain = Chain::Xyz;
+  xyz.axes.resize(3);
+  // A path that goes out of x's and z's travel and back (x travels 0..500,
+  // z -400..0, with the origin at the offsets below), twice, and spans
+  // more x than the travel.
+  PathInput in;
+  in.start = Vec3(0, 0, 0);
+  for (const Vec3 &to :
+       {Vec3(-20, 0, 0), Vec3(300, 10, -20), Vec3(-30, 20, 30), Vec3(520, 30, -50), Vec3(100, 40, 10)}) {
+    PathMove move;
+    move.to = to;
+    move.feed = 6000;
+    in.moves.push_back(move);
+  }
+  const Trajectory t = plan(in, xyz);
+  const std::optional<Vec3> offsets[] = {std::nullopt, Vec3(10, 100, -20), Vec3(200, 100, -200), Vec3(-5, 0, 0)};
+  for (const std::optional<Vec3> &offset : offsets) {
+    INFO("offset " << (offset ? formatTuple({offset->x(), offset->y(), offset->z()}, 1) : "none"));
+    SimOptions o;
+    o.workOffsetMm = offset;
+    o.maxViolations = 1000;
+    const SimReport a = simulate(t, xyz, o), b = simulate(t, five, o);
+    INFO(formatReport(a, t, xyz));
+    CHECK(a.travelNotChecked.empty());
+    CHECK(b.travelNotChecked.empty());
+    REQUIRE(a.axisMin.size() == 3);
+    for (size_t k = 0; k < 3; ++k) {
+      CHECK(a.axisMin[k] == Approx(b.axisMin[k]).margin(1e-9));
+      CHECK(a.axisMax[k] == Approx(b.axisMax[k]).margin(1e-9));
+    }
+    std::vector<Violation> travel;
+    for (const Violation &v : b.violations)
+      if (v.kind == ViolationKind::Travel || v.kind == ViolationKind::Extent)
+        travel.push_back(v);
+    REQUIRE(a.violations.size() == travel.size());
+    CHECK(a.violationCount == travel.size());
+    for (size_t i = 0; i < travel.size(); ++i) {
+      CHECK(a.violations[i].kind == travel[i].kind);
+      CHECK(a.violations[i].axis == travel[i].axis);
+      CHECK(a.violations[i].t == travel[i].t);
+      CHECK(a.violations[i].value == Approx(travel[i].value).margin(1e-9));
+      CHECK(a.violations[i].limit == travel[i].limit);
+    }
+  }
 }
