@@ -381,35 +381,19 @@ def check_program(text, arc_tol):
             mach.feed = None
             mach.pos = [None, None, None]
             continue
-        if body == "CYCL DEF 32.0 TOLERANCE":
-            nxt = blocks[i + 1][1] if i + 1 < len(blocks) else ""
-            if not re.fullmatch(r"CYCL DEF 32\.1(?: T\S+)?", nxt):
-                problems.add(where, "CYCL DEF 32.0 not followed by CYCL DEF 32.1")
-            continue
-        m = re.fullmatch(r"CYCL DEF 32\.1(?: T(\S+))?", body)
-        if m:
-            if i == 0 or blocks[i - 1][1] != "CYCL DEF 32.0 TOLERANCE":
-                problems.add(where, "CYCL DEF 32.1 not right after CYCL DEF 32.0 TOLERANCE")
-            if m.group(1) is not None:
-                t = unsigned(m.group(1), where, problems, "tolerance")
-                if t is not None and t <= 0:
-                    problems.add(where, "tolerance T%s is not positive" % m.group(1))
-            continue
-        if body == "CYCL DEF 9.0 DWELL TIME":
-            nxt = blocks[i + 1][1] if i + 1 < len(blocks) else ""
-            if not re.fullmatch(r"CYCL DEF 9\.1 DWELL \S+", nxt):
-                problems.add(where, "CYCL DEF 9.0 not followed by CYCL DEF 9.1 DWELL")
-            continue
-        m = re.fullmatch(r"CYCL DEF 9\.1 DWELL (\S+)", body)
-        if m:
+        kind, m = two_block_cycle(i, body, blocks, where, problems)
+        if kind == 32 and m and m.group(1) is not None:
+            t = unsigned(m.group(1), where, problems, "tolerance")
+            if t is not None and t <= 0:
+                problems.add(where, "tolerance T%s is not positive" % m.group(1))
+        elif kind == 9 and m:
             # Cycle 9 waits where the tool is, from its definition on.
-            if i == 0 or blocks[i - 1][1] != "CYCL DEF 9.0 DWELL TIME":
-                problems.add(where, "CYCL DEF 9.1 not right after CYCL DEF 9.0 DWELL TIME")
             t = unsigned(m.group(1), where, problems, "dwell time")
             if t is not None and t <= 0:
                 problems.add(where, "dwell time %s is not positive" % m.group(1))
             elif t is not None:
                 mach.motions.append({"kind": "dwell", "to": tuple(mach.pos), "time": t, "where": where})
+        if kind is not None:
             continue
         if body.startswith("CYCL DEF 200"):
             check_cycle_200(body, cont, where, mach, problems)
@@ -459,6 +443,32 @@ def check_program(text, arc_tol):
         if not (before and before[0] == "L" and ("M30" in before or "M2" in before)):
             problems.add("block %d" % blocks[-2][0], "the block before END PGM is not the program end (M30 or M2)")
     return problems, mach
+
+
+# Cycles defined in two blocks: the number, the first block, the second
+# block's pattern and how problems name it.
+TWO_BLOCK_CYCLES = [
+    (32, "CYCL DEF 32.0 TOLERANCE", r"CYCL DEF 32\.1(?: T(\S+))?", "CYCL DEF 32.1", "CYCL DEF 32.1"),
+    (9, "CYCL DEF 9.0 DWELL TIME", r"CYCL DEF 9\.1 DWELL (\S+)", "CYCL DEF 9.1 DWELL", "CYCL DEF 9.1"),
+]
+
+
+def two_block_cycle(i, body, blocks, where, problems):
+    """(number, match of the second block or None) when block i is either
+    block of a two-block cycle, each checked to stand by the other; (None,
+    None) otherwise."""
+    for number, first, second, second_name, second_short in TWO_BLOCK_CYCLES:
+        if body == first:
+            nxt = blocks[i + 1][1] if i + 1 < len(blocks) else ""
+            if not re.fullmatch(second, nxt):
+                problems.add(where, "%s not followed by %s" % (" ".join(first.split()[:3]), second_name))
+            return number, None
+        m = re.fullmatch(second, body)
+        if m:
+            if i == 0 or blocks[i - 1][1] != first:
+                problems.add(where, "%s not right after %s" % (second_short, first))
+            return number, m
+    return None, None
 
 
 def check_cycle_200(body, cont, where, mach, problems):
