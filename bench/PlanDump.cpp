@@ -22,13 +22,19 @@ void dump(FILE *f, const Trajectory &t) {
     const Segment &s = t.segments[i];
     std::fprintf(f, "S %d %a %a %a %a %a %a %a", int(s.kind), s.start.x(), s.start.y(), s.start.z(), s.end.x(),
                  s.end.y(), s.end.z(), s.length);
-    if (s.kind == SegmentKind::Arc)
+    switch (s.kind) {
+    case SegmentKind::Line:
+    case SegmentKind::Dwell:  // its point is its start and end
+      break;
+    case SegmentKind::Arc:
       std::fprintf(f, " %a %a %a %a %a %d", s.center.x(), s.center.y(), s.radius, s.startAngle, s.sweep, int(s.ccw));
-    if (s.kind == SegmentKind::Blend) {
+      break;
+    case SegmentKind::Blend:
       for (const Vec3 &c : s.ctrl)
         std::fprintf(f, " %a %a %a", c.x(), c.y(), c.z());
       for (const double a : s.arcTable)
         std::fprintf(f, " %a", a);
+      break;
     }
     const SegmentInfo &in = t.info[i];
     std::fprintf(f, "\nI %a %a %a %d %a %u %u %d\n", in.limits.v, in.limits.a, in.limits.j, int(in.limitedBy), in.feed,

@@ -334,7 +334,7 @@ private:
       return out;
     const runtime::Trajectory t = runtime::plan(program.path, *machine);
     for (size_t k = 0; k < t.segments.size(); ++k)
-      out[program.owners[t.info[k].move]] += t.info[k].duration(t.profiles[k]);
+      out[program.owners[t.info[k].move]] += t.profiles[k].duration();  // dwells too
     return out;
   }
 

@@ -38,19 +38,18 @@ public:
     runtime::PlanOptions options;
     if (tolerance_)
       options.tolerance = *tolerance_;
-    if (program.trailingDwell > 0)
-      diags.warning({}, "plan-motion: the program ends with a dwell of " + formatFixed(program.trailingDwell, 3) +
-                            " s after its last move; the planned motion ends at rest without it");
     const runtime::Trajectory trajectory = runtime::plan(program.path, *machine, options);
     ir::attachMotion(module, program, trajectory);
-    long long blends = 0, stops = 0;
+    long long blends = 0, dwells = 0, stops = 0;
     for (size_t k = 0; k < trajectory.segments.size(); ++k) {
       blends += trajectory.segments[k].kind == runtime::SegmentKind::Blend;
+      dwells += trajectory.segments[k].kind == runtime::SegmentKind::Dwell;
       stops += trajectory.info[k].stop != runtime::StopReason::None;
     }
     stats["moves planned"] = (long long)program.path.moves.size();
     stats["segments"] = (long long)trajectory.segments.size();
     stats["blends"] = blends;
+    stats["dwells"] = dwells;
     stats["stops"] = stops;
     stats["cycle time (ms)"] = (long long)std::llround(trajectory.duration() * 1000);
     return {true, true};

@@ -23,8 +23,20 @@ namespace stepnc::runtime {
 
 namespace {
 
-constexpr int kVersion = 1;
+/// Version 2 is version 1 with dwells (the `dwell` segment and the stop
+/// reason `dwell`). A trajectory without them is written as version 1, which
+/// players of version 1 read; version 2 only when it has one.
+constexpr int kVersion = 2;
+constexpr int kVersionWithoutDwells = 1;
 constexpr std::string_view kMagic = "STEPNC-MOTION";
+
+/// The version a trajectory needs.
+int versionFor(const Trajectory &t) {
+  for (size_t i = 0; i < t.segments.size(); ++i)
+    if (t.segments[i].kind == SegmentKind::Dwell || t.info[i].stop == StopReason::Dwell)
+      return kVersion;
+  return kVersionWithoutDwells;
+}
 
 /// Relative agreement asked of written lengths, radii, angles and profile
 /// ends with what the reader recomputes: far above rounding (1e-15), far below
@@ -79,7 +91,7 @@ std::string writeNative(const Trajectory &trajectory, const std::string &source)
   assert(t.profiles.size() == t.segments.size() && t.info.size() == t.segments.size());
   std::string out;
   out.reserve(256 + t.segments.size() * 320);
-  out += std::string(kMagic) + ' ' + std::to_string(kVersion) + '\n';
+  out += std::string(kMagic) + ' ' + std::to_string(versionFor(t)) + '\n';
   out += "; planned by stepnc from " + quoted(source) + " for machine " + quoted(t.machine) + '\n';
   out += "; " + std::to_string(t.segments.size()) + (t.segments.size() == 1 ? " segment, " : " segments, ") +
          formatFixed(t.duration(), 3) + " s\n";
@@ -118,14 +130,16 @@ std::string writeNative(const Trajectory &trajectory, const std::string &source)
       for (int k = 1; k <= 4; ++k)
         appendPoint(out, seg.ctrl[k]);
       break;
+    case SegmentKind::Dwell:
+      out += "dwell to";  // where it stands: the start
+      appendPoint(out, seg.end);
+      break;
     }
     out += " length " + number(seg.length);
     out += " programmed_feed " + number(info.feed);
     out += " move " + std::to_string(info.move);
     out += " next " + std::to_string(info.nextMove);
     out += " stop " + std::string(stopReasonName(info.stop));
-    if (info.stop == StopReason::Dwell)
-      out += " wait " + number(info.wait);
     out += " limits";
     appendNumbers(out, {info.limits.v, info.limits.a, info.limits.j});
     out += " limited_by " + std::string(speedLimitName(info.limitedBy));
@@ -209,6 +223,7 @@ private:
   bool ok_ = true;
   bool anyError_ = false;
 
+  uint32_t version_ = kVersion;  ///< the file's format version
   uint32_t announced_ = 0;  ///< the header's segment count
   Vec3 at_ = Vec3::Zero();  ///< where the next segment starts
   /// The speed and acceleration the previous segment ends with; NaN after a
@@ -434,18 +449,20 @@ bool Reader::header(Trajectory &t) {
   if (!nextLine(false) || words_[0].offset != 0 || words_[0].text != kMagic) {
     fail(words_.empty() ? 0 : words_[0].offset,
          "not a stepnc native motion file: the first line must be '" + std::string(kMagic) + " " +
-             std::to_string(kVersion) + "'");
+             std::to_string(kVersionWithoutDwells) + "' or '" + std::string(kMagic) + " " + std::to_string(kVersion) +
+             "'");
     return false;
   }
   ++pos_;
   const uint32_t version = integer("the format version");
   if (!ok_)
     return false;
-  if (version != kVersion) {
-    failHere("unsupported native format version " + std::to_string(version) + "; this stepnc reads version " +
-             std::to_string(kVersion));
+  if (version < kVersionWithoutDwells || version > kVersion) {
+    failHere("unsupported native format version " + std::to_string(version) + "; this stepnc reads versions " +
+             std::to_string(kVersionWithoutDwells) + " to " + std::to_string(kVersion));
     return false;
   }
+  version_ = version;
   endOfLine("the format version");
 
   auto line = [&](std::string_view kw) {
@@ -497,10 +514,16 @@ void Reader::segment(Trajectory &t, bool first) {
     kind = SegmentKind::Arc;
   else if (kindWord.text == "blend")
     kind = SegmentKind::Blend;
+  else if (kindWord.text == "dwell")
+    kind = SegmentKind::Dwell;
   else if (kindWord.text != "line")
-    fail(kindWord.offset, "unknown segment kind '" + shown(kindWord.text) + "' (known: line, arc, blend)");
+    fail(kindWord.offset, "unknown segment kind '" + shown(kindWord.text) + "' (known: line, arc, blend, dwell)");
+  if (kind == SegmentKind::Dwell && version_ < kVersion)
+    fail(kindWord.offset, "a dwell segment needs format version " + std::to_string(kVersion) +
+                              "; this file is version " + std::to_string(version_));
   const Vec3 from = at_;
   keyword("to");
+  const uint64_t toAt = last_;
   const Vec3 to = point("the end point");
   if (ok_)
     at_ = to;  // the next segment starts here even when this line has a mistake further on
@@ -538,8 +561,11 @@ void Reader::segment(Trajectory &t, bool first) {
     ctrl[5] = to;
   }
   keyword("length");
-  const double length = positive("the length");
+  // A dwell waits where the tool is: no length. Every other segment moves.
+  const double length = kind == SegmentKind::Dwell ? nonNegative("the length") : positive("the length");
   const uint64_t lengthAt = last_;
+  if (ok_ && kind == SegmentKind::Dwell && length != 0)
+    failHere("a dwell has no length (the tool waits where it is): length 0, not " + number(length));
 
   SegmentInfo info;
   keyword("programmed_feed");
@@ -550,10 +576,12 @@ void Reader::segment(Trajectory &t, bool first) {
   info.nextMove = integer("the next move index");
   keyword("stop");
   info.stop = choice(kStopReasons, stopReasonName, "stop reason");
-  if (info.stop == StopReason::Dwell) {
-    keyword("wait");
-    info.wait = positive("the dwell's wait (s)");
-  }
+  if (ok_ && info.stop == StopReason::Dwell && version_ < kVersion)
+    failHere("the stop reason 'dwell' needs format version " + std::to_string(kVersion) + "; this file is version " +
+             std::to_string(version_));
+  if (ok_ && kind == SegmentKind::Dwell && info.stop != StopReason::Dwell)
+    failHere("a dwell segment stops for its dwell: 'stop dwell', not 'stop " + std::string(stopReasonName(info.stop)) +
+             "'");
   keyword("limits");
   info.limits.v = nonNegative("the speed limit");
   info.limits.a = nonNegative("the acceleration limit");
@@ -615,18 +643,35 @@ void Reader::segment(Trajectory &t, bool first) {
     seg.center = Vec3(cx, cy, 0);
     seg.radius = radius;
     seg.startAngle = startAngle;
-  } else if (ok_) {
+  } else if (ok_ && kind == SegmentKind::Blend) {
     what = "blend";
     seg = Segment::blend(ctrl);
+  } else if (ok_) {
+    what = "dwell";
+    const double off = (to - from).norm();
+    if (off > kAbsTolerance)
+      fail(toAt, "a dwell waits where the tool is: its end point is " + formatFixed(off, 9) +
+                     " mm from where the previous segment ends");
+    seg = Segment::dwell(from);
   }
   if (ok_ && std::abs(seg.length - length) > kRelTolerance * std::max(seg.length, length))
     fail(lengthAt, "length " + number(length) + " does not match the " + what + "'s geometry (" +
                        formatFixed(seg.length, 9) + " mm)");
   seg.length = length;
 
-  // The profile: continuous speed and acceleration, the whole length.
+  // The profile: continuous speed and acceleration, the whole length; a
+  // dwell's at rest throughout, for some time.
   if (ok_)
     checkProfile(prof, length, first, v0At, a0At, phasesAt);
+  if (ok_ && kind == SegmentKind::Dwell) {
+    for (const Phase &ph : prof.phases)
+      if (ph.jerk != 0) {
+        fail(phasesAt, "a dwell's phases have jerk 0 (the tool stays at rest), not " + number(ph.jerk));
+        break;
+      }
+    if (ok_ && !(prof.duration() > 0))
+      fail(phasesAt, "a dwell waits for the duration of its phases, which must be more than 0 s");
+  }
   if (ok_ && info.stop != StopReason::None && prof.v0 > kAbsTolerance)
     fail(v0At, "a segment that stops first (stop " + std::string(stopReasonName(info.stop)) +
                    ") must start at rest, not at v0 " + number(prof.v0));

@@ -59,7 +59,6 @@ struct Piece {
   SegmentKind kind = SegmentKind::Line;
   bool ccw = true;
   bool stopBefore = false;
-  double waitBefore = 0;  ///< s at rest before it (a dwell)
   bool hasMidCurvature = false;
   /// How it meets the piece before it (join): through a blend, or at rest
   /// for `stopReason`; neither when tangent and curvature already agree.
@@ -93,6 +92,14 @@ struct Piece {
     s.sweep = sweep;
     s.ccw = ccw;
   }
+};
+
+/// A dwell between pieces: the tool stops before piece `beforePiece` (or at
+/// the end, after the last) and waits at programmed move `move`'s point.
+struct PieceDwell {
+  size_t beforePiece = 0;
+  uint32_t move = 0;
+  double timeS = 0;
 };
 
 /// The points at which blendDeviation samples a blend: u = i / 24 for
@@ -340,7 +347,7 @@ double blendDeviation(const std::array<Vec3, 6> &ctrl, const Segment &a, double 
 /// (b.stopReason).
 void join(Piece &a, const Segment &sa, Piece &b, const Segment &sb, double tolerance) {
   if (b.stopBefore) {
-    b.stopReason = b.waitBefore > 0 ? StopReason::Dwell : StopReason::Program;
+    b.stopReason = StopReason::Program;
     return;
   }
   const PathPoint ea = sa.at(sa.length), bs = sb.at(0);
@@ -622,16 +629,24 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   out.cycleTime = machine.cycleTime;
   out.start = input.start;
 
-  // 1. One piece per move with any length.
+  // 1. One piece per move with any length; dwells stop the tool between
+  // pieces.
   std::vector<Piece> pieces;
   pieces.reserve(input.moves.size());
+  std::vector<PieceDwell> dwells;
   Vec3 at = input.start;
   bool pendingStop = false;
-  double pendingWait = 0;  // dwells before moves of no length wait before the next piece
   for (size_t i = 0; i < input.moves.size(); ++i) {
     const PathMove &m = input.moves[i];
-    pendingStop = pendingStop || m.stopBefore || m.waitBefore > 0;
-    pendingWait += m.waitBefore;
+    pendingStop = pendingStop || m.stopBefore;
+    if (m.kind == PathMove::Kind::Dwell) {
+      at = m.to;  // where the move before ends (PathMove): the next piece starts here
+      if (m.dwellS > 0) {
+        dwells.push_back({pieces.size(), uint32_t(i), m.dwellS});
+        pendingStop = true;
+      }
+      continue;
+    }
     const Segment seg = m.kind == PathMove::Kind::Line ? Segment::line(at, m.to)
                                                        : Segment::arcTurns(at, m.to, m.center, m.ccw, m.turns);
     at = m.to;
@@ -640,9 +655,7 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
     Piece &p = pieces.emplace_back(seg, uint32_t(i));
     p.feed = m.feed > 0 ? m.feed / 60 : 0;
     p.stopBefore = pendingStop;
-    p.waitBefore = pendingWait;
     pendingStop = false;
-    pendingWait = 0;
   }
 
   // 2. Junctions: blends or stops.
@@ -657,7 +670,7 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   smoothChains(input, pieces, tolerance);
 
   // 3. Segments with their caps.
-  size_t count = 0;
+  size_t count = dwells.size();
   for (const Piece &p : pieces)
     count += size_t(p.blendBefore) + size_t(p.keepsMiddle());
   out.segments.reserve(count);
@@ -670,33 +683,41 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   lengths.reserve(count);
   // d is the last segment's demand().
   const SpeedBudget budget(machine);
-  auto push = [&](double feed, uint32_t move, uint32_t next, StopReason stop, double wait, const AxisDemand &d) {
+  auto push = [&](double feed, uint32_t move, uint32_t next, StopReason stop, const AxisDemand &d) {
     lengths.push_back(out.segments.back().length);
     SegmentInfo &info = out.info.emplace_back();
     info.feed = feed;
     info.move = move;
     info.nextMove = next;
     info.stop = stop;
-    info.wait = wait;
     budget.limitsFor(d, feed, info);
   };
   StopReason stop = StopReason::Start;
-  double wait = 0;  // before the next segment pushed (a dwell)
+  // The dwells before piece `piece`: a segment each, at rest (their limits
+  // zero: nothing moves), and the segment after them starts at rest.
+  size_t nextDwell = 0;
+  auto pushDwells = [&](size_t piece) {
+    for (; nextDwell < dwells.size() && dwells[nextDwell].beforePiece == piece; ++nextDwell) {
+      const PieceDwell &d = dwells[nextDwell];
+      out.segments.push_back(Segment::dwell(input.moves[d.move].to));
+      lengths.push_back(0);
+      SegmentInfo &info = out.info.emplace_back();
+      info.move = d.move;
+      info.nextMove = d.move;
+      info.stop = StopReason::Dwell;
+      stop = StopReason::Dwell;
+    }
+  };
   {
     Segment segments[2];  // piece i's in segments[i % 2]
     for (size_t i = 0; i < pieces.size(); ++i) {
       const Piece &p = pieces[i];
       const Segment &before = segments[(i + 1) % 2], &here = segments[i % 2];
       p.segment(input, segments[i % 2]);
-      if (i == 0 && p.waitBefore > 0) {
-        stop = StopReason::Dwell;  // a dwell before the first move: at rest from the start anyway
-        wait = p.waitBefore;
-      }
+      if (i > 0 && p.stopReason != StopReason::None)
+        stop = p.stopReason;
+      pushDwells(i);
       if (i > 0) {
-        if (p.stopReason != StopReason::None) {
-          stop = p.stopReason;
-          wait = p.waitBefore;
-        }
         if (p.blendBefore) {
           const Piece &prev = pieces[i - 1];
           double feed = 0;  // the slower of the two; a rapid takes the feed of the other
@@ -706,18 +727,17 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
             feed = std::max(prev.feed, p.feed);
           AxisDemand demand;
           out.segments.push_back(Segment::blend(blendBetween(prev, before, p, here), demand));
-          push(feed, prev.move, p.move, stop, wait, demand);
+          push(feed, prev.move, p.move, stop, demand);
           stop = StopReason::None;
-          wait = 0;
         }
       }
       if (p.keepsMiddle()) {
         out.segments.push_back(here.part(p.cutStart, here.length - p.cutEnd));
-        push(p.feed, p.move, p.move, stop, wait, out.segments.back().demand());
+        push(p.feed, p.move, p.move, stop, out.segments.back().demand());
         stop = StopReason::None;
-        wait = 0;
       }
     }
+    pushDwells(pieces.size());  // after the last move
   }
   std::vector<Piece>().swap(pieces);  // not needed any more: its memory serves the steps below
 
@@ -780,11 +800,18 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   for (size_t r = 0; r < m; ++r)
     bound(vj[r + 1], vj[r], runs[r]);
 
-  // 6. Profiles: one per run, cut at its members' ends.
+  // 6. Profiles: one per run, cut at its members' ends; a dwell's is its
+  // wait at rest. (A dwell is a run of its own: it and the segment after it
+  // start at rest.)
   out.profiles.reserve(n);
   preferHugePages(out.profiles);
+  size_t dwellAt = 0;  // dwells come in the order of `dwells`
   for (size_t r = 0; r < m; ++r) {
     const Run &run = runs[r];
+    if (lengths[run.first] == 0) {  // only dwells have no length (moves of none make no piece)
+      out.profiles.push_back(dwellProfile(dwells[dwellAt++].timeS));
+      continue;
+    }
     const Profile whole = planProfile(vj[r], vj[r + 1], run.length, run.limits);
     if (run.first == run.last) {
       out.profiles.push_back(whole);

@@ -19,6 +19,11 @@
 //     with jerk-limited speed changes (closed forms, Profile.h).
 //  5. Profiles. Each run gets its fastest seven-phase profile between those
 //     speeds, with zero acceleration at both ends.
+//
+// A dwell stops the tool: the move before it ends at rest, the move after
+// it starts from rest, and between them a dwell segment (SegmentKind::Dwell,
+// stop reason Dwell, as the segment after it) holds the tool at the point
+// for the dwell's time.
 #pragma once
 
 #include "runtime/Machine.h"
@@ -29,15 +34,17 @@
 
 namespace stepnc::runtime {
 
+/// A programmed move. A dwell waits at `to`, which is where the move before
+/// it ends (the start for the first move), for `dwellS` seconds.
 struct PathMove {
-  enum class Kind : uint8_t { Line, Arc } kind = Kind::Line;
+  enum class Kind : uint8_t { Line, Arc, Dwell } kind = Kind::Line;
   Vec3 to = Vec3::Zero();
   Vec3 center = Vec3::Zero();  ///< arcs: the axis parallel to z through it
   bool ccw = true;
   int64_t turns = 0;           ///< arcs: whole turns before the last arc to `to`
   double feed = 0;             ///< mm/min; 0 = rapid (the axes' speed)
   bool stopBefore = false;     ///< the tool is at rest before this move
-  double waitBefore = 0;       ///< s it waits there first (a dwell; with stopBefore)
+  double dwellS = 0;           ///< dwells: s the tool waits
 };
 
 struct PathInput {
@@ -51,8 +58,8 @@ struct PlanOptions {
   double tolerance = 0;
 };
 
-/// Plans the moves on the machine. Moves of zero length are skipped; the
-/// trajectory ends at rest at the last move's end.
+/// Plans the moves on the machine. Moves of zero length and dwells of no
+/// time are skipped; the trajectory ends at rest at the last move's end.
 Trajectory plan(const PathInput &input, const Machine &machine, const PlanOptions &options = {});
 
 } // namespace stepnc::runtime

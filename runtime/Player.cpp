@@ -78,6 +78,8 @@ Programmed prepare(const Vec3 &from, const PathMove &move) {
   Programmed m;
   m.from = from;
   m.to = move.to;
+  if (move.kind == PathMove::Kind::Dwell)
+    m.from = move.to;  // a point: where the tool waits
   if (move.kind != PathMove::Kind::Arc)
     return m;
   m.arc = true;
@@ -204,11 +206,12 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
   double duration = 0, programmedFeedTime = 0;
   for (size_t i = 0; i < n; ++i) {
     const double d = trajectory.profiles[i].duration();
-    durations[i] = trajectory.info[i].wait + d;
-    duration += durations[i];
-    r.dwellTime += trajectory.info[i].wait;
+    durations[i] = d;
+    duration += d;
     const double feed = trajectory.info[i].feed;
-    if (feed > 0) {
+    if (trajectory.segments[i].kind == SegmentKind::Dwell) {
+      r.dwellTime += d;
+    } else if (feed > 0) {
       r.feedTime += d;
       r.feedDistance += trajectory.segments[i].length;
       programmedFeedTime += feed * d;
@@ -396,8 +399,7 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
     const bool fromRest = i == 0 || info.stop != StopReason::None;
     const bool toRest = i + 1 == n || trajectory.info[i + 1].stop != StopReason::None;
     if (fromRest)
-      cur.riseEnd =
-          info.wait + profile.phases[0].duration + profile.phases[1].duration + profile.phases[2].duration;
+      cur.riseEnd = profile.phases[0].duration + profile.phases[1].duration + profile.phases[2].duration;
     cur.fallStart = kInf;
     if (toRest)
       cur.fallStart =
@@ -446,8 +448,7 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
       }
       // The end is the last profile's own end, not a difference of sums.
       const double local = final ? durations[seg] : t - segStart;
-      // A dwell: at rest at the segment's start for its wait first.
-      const PathState ps = trajectory.profiles[seg].at(std::max(0.0, local - trajectory.info[seg].wait));
+      const PathState ps = trajectory.profiles[seg].at(local);
       const PathPoint pp = trajectory.segments[seg].at(ps.s);
       s.segment = static_cast<uint32_t>(seg);
       s.p = pp.p;

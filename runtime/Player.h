@@ -4,6 +4,10 @@
 // the path compared with the programmed feed (where it falls below, and
 // which limit made it), and every limit violation.
 //
+// A dwell segment holds the tool at its point, every derivative zero, for
+// its profile's duration; its time counts in the cycle time, apart from the
+// feed moves' and the rapids'.
+//
 // Values are the analytic derivatives at the sample times. Each is also
 // checked against its neighbour sample, |a(t+T) - a(t)| <= j_max T, so a jump
 // between samples (a curvature step, a profile that does not join) cannot hide
@@ -113,7 +117,7 @@ struct SimReport {
   size_t samples = 0;
   double feedTime = 0;      ///< s on feed moves
   double rapidTime = 0;     ///< s on rapids
-  double dwellTime = 0;     ///< s waiting at rest for dwells
+  double dwellTime = 0;     ///< s waiting at rest in dwells
   double feedDistance = 0;  ///< mm on feed moves
   double rapidDistance = 0;
   double meanFeed = 0;      ///< mm/s, feed distance / feed time

@@ -272,4 +272,10 @@ Profile planProfile(double v0, double v1, double length, const PathLimits &limit
   return prof;
 }
 
+Profile dwellProfile(double timeS) {
+  Profile p;
+  p.phases[3] = {timeS, 0};
+  return p;
+}
+
 } // namespace stepnc::runtime

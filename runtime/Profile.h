@@ -74,5 +74,8 @@ double reachableSpeed(double v0, double length, double a, double j);
 /// passes ensure it); the profile rises to the highest peak speed that fits,
 /// cruises, and falls, and covers exactly `length`.
 Profile planProfile(double v0, double v1, double length, const PathLimits &limits);
+/// A dwell's profile: at rest for `timeS` seconds, one cruise phase (slot 3,
+/// as in the seven-phase profiles) at zero speed; the other phases empty.
+Profile dwellProfile(double timeS);
 
 } // namespace stepnc::runtime

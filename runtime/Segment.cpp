@@ -390,6 +390,14 @@ Segment Segment::blend(const std::array<Vec3, 6> &ctrl, AxisDemand &demand) {
   return s;
 }
 
+Segment Segment::dwell(const Vec3 &at) {
+  Segment s;
+  s.kind = SegmentKind::Dwell;
+  s.start = at;
+  s.end = at;
+  return s;
+}
+
 PathPoint Segment::curveAt(double s) const {
   s = std::clamp(s, 0.0, length);
   switch (kind) {
@@ -433,6 +441,11 @@ PathPoint Segment::curveAt(double s) const {
       out.p = end;
     return out;
   }
+  case SegmentKind::Dwell: {
+    PathPoint out;
+    out.p = start;  // at rest: no tangent, no curvature
+    return out;
+  }
   }
   return {};
 }
@@ -457,6 +470,8 @@ AxisDemand Segment::demand() const {
   case SegmentKind::Blend:
     d = blendDemand(QuinticCurve(ctrl));
     break;
+  case SegmentKind::Dwell:
+    break;  // nothing moves
   }
   return d;
 }

@@ -1,6 +1,7 @@
 // The geometry of motion segments: straight lines, circular arcs and helices
-// about an axis parallel to z, and quintic blends that join two pieces with
-// continuous tangent and curvature. A segment is parametrised by arc length s
+// about an axis parallel to z, quintic blends that join two pieces with
+// continuous tangent and curvature, and dwells, where the tool waits at one
+// point (no length; the wait is its profile's duration). A segment is parametrised by arc length s
 // in [0, length]; `at` gives the point and its first three derivatives with
 // respect to s (unit tangent, curvature vector, and its rate of change), from
 // which the player turns a path speed profile into axis velocities,
@@ -18,7 +19,9 @@ namespace stepnc::runtime {
 
 using Vec3 = Eigen::Vector3d;
 
-enum class SegmentKind : uint8_t { Line, Arc, Blend };
+/// Dwell: the tool at rest at `start` (= `end`, length 0) for as long as the
+/// segment's profile lasts (dwellProfile, Profile.h).
+enum class SegmentKind : uint8_t { Line, Arc, Blend, Dwell };
 
 /// A point of a path and its derivatives with respect to arc length.
 struct PathPoint {
@@ -92,13 +95,15 @@ struct Segment {
   /// The same, with its demand() written to `demand` (the same bits), both
   /// from one evaluation of the curve's power form.
   static Segment blend(const std::array<Vec3, 6> &ctrl, AxisDemand &demand);
+  /// A dwell at `at`: no length; every point is `at`, every derivative 0.
+  static Segment dwell(const Vec3 &at);
   /// The part of this segment from arc length s0 to s1 (a line, arc or blend
-  /// of the same curve; blends only whole).
+  /// of the same curve; blends and dwells only whole).
   Segment part(double s0, double s1) const;
 
   /// The point at arc length s (clamped to [0, length]); `at(length).p` is
   /// exactly `end`. Lines here, where the compiler can inline them (the
-  /// planner asks for many line points), arcs and blends in curveAt.
+  /// planner asks for many line points), the others in curveAt.
   PathPoint at(double s) const {
     if (kind != SegmentKind::Line)
       return curveAt(s);
@@ -109,7 +114,7 @@ struct Segment {
     out.p = s >= length ? end : Vec3(start + out.r1 * s);
     return out;
   }
-  /// at() for arcs and blends.
+  /// at() for arcs, blends and dwells.
   PathPoint curveAt(double s) const;
   /// Upper bounds of the derivatives per axis over the whole segment.
   AxisDemand demand() const;

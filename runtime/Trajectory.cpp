@@ -52,8 +52,8 @@ std::optional<StopReason> stopReasonNamed(std::string_view name) {
 
 double Trajectory::duration() const {
   double t = 0;
-  for (size_t k = 0; k < profiles.size(); ++k)
-    t += info[k].duration(profiles[k]);
+  for (const Profile &p : profiles)
+    t += p.duration();
   return t;
 }
 

@@ -1,6 +1,7 @@
 // A planned motion: segments with their speed profiles, played one after the
 // other from `start`. This is what the planner produces, the native format
-// writes and the player samples.
+// writes and the player samples. A dwell is a segment too (SegmentKind::Dwell,
+// its wait its profile's duration), so every sum of durations counts it.
 #pragma once
 
 #include "runtime/Profile.h"
@@ -37,7 +38,7 @@ enum class StopReason : uint8_t {
   Reversal,  ///< the path turns back on itself (no blend can stay in tolerance)
   Tiny,      ///< the pieces are too short to blend within tolerance
   Program,   ///< a tool change, a change of setup or spindle, a stop in the program
-  Dwell,     ///< a dwell: the tool waits at rest (SegmentInfo::wait) before the segment
+  Dwell,     ///< a dwell segment (the tool waits there), or the segment after one
 };
 inline constexpr StopReason kStopReasons[] = {StopReason::None, StopReason::Start,   StopReason::Reversal,
                                               StopReason::Tiny, StopReason::Program, StopReason::Dwell};
@@ -51,10 +52,6 @@ struct SegmentInfo {
   uint32_t move = 0;                    ///< index of the programmed move it follows
   uint32_t nextMove = 0;                ///< blends: the move it joins to (else = move)
   StopReason stop = StopReason::None;   ///< why the segment starts at rest
-  double wait = 0;                      ///< s at rest before the segment starts (stop dwell), else 0
-
-  /// The segment's time: the wait, then its profile's.
-  double duration(const Profile &profile) const { return wait + profile.duration(); }
 };
 
 struct Trajectory {

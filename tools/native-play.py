@@ -7,7 +7,7 @@ import math
 import sys
 
 KEYS = {"to", "center", "radius", "start_angle", "sweep", "dir", "ctrl", "length", "programmed_feed",
-        "move", "next", "stop", "wait", "limits", "limited_by", "v0", "a0", "phases"}
+        "move", "next", "stop", "limits", "limited_by", "v0", "a0", "phases"}
 GX = (0.0, -0.5384693101056831, 0.5384693101056831, -0.906179845938664, 0.906179845938664)
 GW = (0.5688888888888889, 0.4786286704993665, 0.4786286704993665, 0.2369268850561891, 0.2369268850561891)
 
@@ -37,6 +37,8 @@ def arclen(P, u0, u1):  # Gauss-Legendre with five points
 def point(seg, s):
     kind, a, f = seg
     b, length = [float(x) for x in f["to"]], float(f["length"][0])
+    if kind == "dwell":  # at rest where it is, for its phases' time
+        return a
     if kind == "line":
         return [p + (q - p) * s / length for p, q in zip(a, b)]
     if kind == "arc":
@@ -63,8 +65,8 @@ def point(seg, s):
 
 def main(path):
     lines = [l.split() for l in open(path, encoding="utf-8") if l.strip() and not l.lstrip().startswith(";")]
-    if not lines or lines[0] != ["STEPNC-MOTION", "1"]:
-        sys.exit(f"{path}: not a version 1 native motion file")
+    if not lines or lines[0] not in (["STEPNC-MOTION", "1"], ["STEPNC-MOTION", "2"]):
+        sys.exit(f"{path}: not a version 1 or 2 native motion file")
     head = {w[0]: w[1:] for w in lines[1:6]}
     cycle, at = float(head["cycle_time"][0]), [float(x) for x in head["start"]]
     fmt = lambda v: "0.000000" if f"{v:.6f}" == "-0.000000" else f"{v:.6f}"
@@ -79,10 +81,6 @@ def main(path):
         seg = (words[0], at, f)
         ph = [float(x) for x in f["phases"][1:]]
         phases = list(zip(ph[0::2], ph[1::2]))
-        t0 += float(f["wait"][0]) if "wait" in f else 0.0  # a dwell: at rest at the start first
-        while k * cycle < t0:
-            print(fmt(k * cycle), *map(fmt, at))
-            k += 1
         t1 = t0 + sum(d for d, _ in phases)
         while k * cycle < t1:
             p = point(seg, distance(float(f["v0"][0]), float(f["a0"][0]), phases, k * cycle - t0))

@@ -25,7 +25,18 @@ ProgramPath programPath(const ir::Module &module) {
   bool stop = false;
   std::string tool, setup;
   std::optional<double> spindle;
-  double wait = 0;  // s of dwells since the last move
+  struct Added {
+    PathMove move;
+    const ir::Node *owner = nullptr, *node = nullptr;
+  };
+  auto add = [&](const Added &a) {
+    out.path.moves.push_back(a.move);
+    out.owners.push_back(a.owner);
+    out.nodes.push_back(a.node);
+  };
+  // Dwells before the first point the program names wait there, where the
+  // tool starts: they go before the move that names it.
+  std::vector<Added> leadingDwells;
   for (const ir::Node *e : programOrder(module)) {
     if (e->kind == ir::Kind::ProgramStop || e->kind == ir::Kind::OptionalStop) {
       stop = true;
@@ -43,33 +54,38 @@ ProgramPath programPath(const ir::Module &module) {
     setup = s;
     spindle = sp;
     for (const Move &m : walkMoves(*moves, position)) {
+      PathMove pm;
+      pm.stopBefore = stop;
+      stop = false;
       if (m.kind == MoveKind::Dwell) {
-        // The next move starts at rest after the wait.
-        wait += m.dwell;
+        pm.kind = PathMove::Kind::Dwell;
+        pm.dwellS = m.dwell;
+        if (position) {
+          pm.to = *position;
+          add({pm, e, m.node});
+        } else {
+          leadingDwells.push_back({pm, e, m.node});  // where, the first move says
+        }
         continue;
       }
       if (!position) {
         out.path.start = m.to;  // the tool starts at rest at the first point named
         position = m.to;
+        for (Added &d : leadingDwells) {
+          d.move.to = m.to;
+          add(d);
+        }
       }
-      PathMove pm;
       pm.kind = m.kind == MoveKind::Arc ? PathMove::Kind::Arc : PathMove::Kind::Line;
       pm.to = m.to;
       pm.center = m.center;
       pm.ccw = m.ccw;
       pm.turns = m.turns;
       pm.feed = m.isFeed() ? m.feed : 0;
-      pm.stopBefore = stop || wait > 0;
-      pm.waitBefore = wait;
-      stop = false;
-      wait = 0;
-      out.path.moves.push_back(pm);
-      out.owners.push_back(e);
-      out.nodes.push_back(m.node);
+      add({pm, e, m.node});
       position = m.to;
     }
   }
-  out.trailingDwell = wait;
   return out;
 }
 
@@ -98,22 +114,27 @@ void attachMotion(ir::Module &module, const ProgramPath &program, const runtime:
       motion.set("tolerance", ir::Value::length(trajectory.tolerance));
       motion.set("from", ir::Value::reals(numbers(seg.start)));
     }
-    times[owner] += info.duration(prof);
+    times[owner] += prof.duration();
     ir::Node s(ir::Kind::MotionSegment);
-    s.set("shape", ir::Value::word(seg.kind == SegmentKind::Line  ? "line"
-                                   : seg.kind == SegmentKind::Arc ? "arc"
-                                                                  : "blend"));
     s.set("to", ir::Value::reals(numbers(seg.end)));
-    if (seg.kind == SegmentKind::Arc) {
+    switch (seg.kind) {
+    case SegmentKind::Line: s.set("shape", ir::Value::word("line")); break;
+    case SegmentKind::Arc:
+      s.set("shape", ir::Value::word("arc"));
       s.set("center", ir::Value::reals({seg.center.x(), seg.center.y()}));
       s.set("dir", ir::Value::word(seg.ccw ? "ccw" : "cw"));
       s.set("sweep", ir::Value::real(seg.sweep));
-    } else if (seg.kind == SegmentKind::Blend) {
+      break;
+    case SegmentKind::Blend: {
+      s.set("shape", ir::Value::word("blend"));
       std::vector<double> pts;
       for (int i = 1; i <= 4; ++i)
         for (int c = 0; c < 3; ++c)
           pts.push_back(seg.ctrl[i][c]);
       s.set("points", ir::Value::reals(std::move(pts)));
+      break;
+    }
+    case SegmentKind::Dwell: s.set("shape", ir::Value::word("dwell")); break;  // its time is its phases'
     }
     s.set("length", ir::Value::real(seg.length));
     if (info.feed > 0)
@@ -123,8 +144,6 @@ void attachMotion(ir::Module &module, const ProgramPath &program, const runtime:
       s.set("next", ir::Value::integer(info.nextMove));
     if (info.stop != runtime::StopReason::None)
       s.set("stop", ir::Value::word(std::string(runtime::stopReasonName(info.stop))));
-    if (info.wait > 0)
-      s.set("wait", ir::Value::real(info.wait));
     s.set("limited_by", ir::Value::word(std::string(runtime::speedLimitName(info.limitedBy))));
     s.set("limits", ir::Value::reals({info.limits.v, info.limits.a, info.limits.j}));
     s.set("v0", ir::Value::real(prof.v0));
@@ -198,6 +217,13 @@ std::optional<runtime::Trajectory> readMotion(const ir::Module &module, Diagnost
           continue;
         }
         seg = Segment::arc(at, end, Vec3((*c)[0], (*c)[1], 0), s.text("dir") == "ccw", *s.number("sweep"));
+      } else if (shape == "dwell") {
+        if ((end - at).norm() > 1e-9) {
+          fail(s, "a dwell waits where the tool is: 'to' " + formatTuple({end.x(), end.y(), end.z()}, 6) +
+                      " is not where the previous segment ends, " + formatTuple({at.x(), at.y(), at.z()}, 6));
+          continue;
+        }
+        seg = Segment::dwell(at);
       } else {
         const auto pts = numbersOf(s, "points", 12);
         if (!pts)
@@ -221,11 +247,6 @@ std::optional<runtime::Trajectory> readMotion(const ir::Module &module, Diagnost
       info.nextMove = uint32_t(s.count("next").value_or(info.move));
       // The kind table allows only the names these read.
       info.stop = runtime::stopReasonNamed(s.text("stop").value_or("none")).value_or(runtime::StopReason::None);
-      info.wait = s.number("wait").value_or(0);
-      if ((info.stop == runtime::StopReason::Dwell) != (info.wait > 0) || !(info.wait >= 0)) {
-        fail(s, "a segment waits (a positive 'wait', in s) exactly when it stops for a dwell ('stop=dwell')");
-        continue;
-      }
       info.limitedBy =
           runtime::speedLimitNamed(s.text("limited_by").value_or("feed")).value_or(runtime::SpeedLimit::Feed);
       info.limits = {(*limits)[0], (*limits)[1], (*limits)[2]};
@@ -234,6 +255,16 @@ std::optional<runtime::Trajectory> readMotion(const ir::Module &module, Diagnost
       prof.a0 = s.number("a0").value_or(0);
       for (size_t i = 0; i < prof.phases.size(); ++i)
         prof.phases[i] = {(*phases)[2 * i], (*phases)[2 * i + 1]};
+      if (seg.kind == SegmentKind::Dwell) {
+        // At rest throughout, for some time (its phases' durations).
+        bool rests = info.stop == runtime::StopReason::Dwell && prof.v0 == 0 && prof.a0 == 0;
+        for (const runtime::Phase &ph : prof.phases)
+          rests = rests && ph.jerk == 0 && ph.duration >= 0;
+        if (!rests || !(prof.duration() > 0)) {
+          fail(s, "a dwell segment waits at rest: stop=dwell, v0 and a0 0, phases of jerk 0 that last more than 0 s");
+          continue;
+        }
+      }
       out.segments.push_back(std::move(seg));
       out.info.push_back(info);
       out.profiles.push_back(prof);

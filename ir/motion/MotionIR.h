@@ -23,15 +23,13 @@ struct ProgramPath {
   runtime::PathInput path;
   std::vector<const ir::Node *> owners;  ///< per move: the executable whose moves hold it
   std::vector<const ir::Node *> nodes;   ///< per move: its node
-  /// s of dwells after the last move: nothing follows them to wait before,
-  /// so the trajectory does not hold them (plan-motion says so).
-  double trailingDwell = 0;
 };
 
 /// The moves of every workingstep and rapid movement in program order. The
 /// tool starts at rest at the first move's end point. The tool stops before
-/// a change of tool, setup or spindle and at program and optional stops, and
-/// waits at rest for a dwell (the next move's waitBefore).
+/// a change of tool, setup or spindle and at program and optional stops. A
+/// dwell is a PathMove of kind Dwell at the point where the tool is (one
+/// before the first move, at that move's end point, where the tool starts).
 ProgramPath programPath(const ir::Module &module);
 
 /// Writes `trajectory` (planned from programPath(module)) into the module:

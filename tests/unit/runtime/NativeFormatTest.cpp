@@ -112,6 +112,27 @@ Trajectory sliced() {
   return t;
 }
 
+/// A feed line rest to rest, half a second's dwell at its end, and a rapid
+/// up from there.
+Trajectory dwelling() {
+  Trajectory t;
+  t.machine = "M";
+  t.tolerance = 0.01;
+  t.cycleTime = 0.001;
+  t.start = Vec3(0.1, 0.2, 1.0 / 3);
+  const Segment feed = Segment::line(t.start, t.start + Vec3(10.1, 0, 0));
+  add(t, feed, 0, 0, SpeedLimit::Feed, StopReason::Start, 0);
+  SegmentInfo wait;
+  wait.move = wait.nextMove = 1;
+  wait.stop = StopReason::Dwell;
+  t.segments.push_back(Segment::dwell(feed.end));
+  t.profiles.push_back(dwellProfile(0.5));
+  t.info.push_back(wait);
+  add(t, Segment::line(feed.end, feed.end + Vec3(0, 0, 5)), 0, 0, SpeedLimit::AxisVelocity, StopReason::Dwell, 2);
+  t.info[2].feed = 0;  // a rapid
+  return t;
+}
+
 void requireSame(const Trajectory &a, const Trajectory &b) {
   CHECK(a.machine == b.machine);
   CHECK(a.tolerance == b.tolerance);
@@ -204,6 +225,70 @@ TEST_CASE("a trajectory reads back value for value and byte for byte", "[native]
   CHECK(r.trajectory->profiles[1].phases[1].jerk == -1.25e-20);
 }
 
+TEST_CASE("a dwell reads back value for value and byte for byte, as version 2", "[native][dwell]") {
+  const Trajectory t = dwelling();
+  const std::string text = writeNative(t, "holes");
+  INFO(text);
+  CHECK(text.rfind("STEPNC-MOTION 2\n", 0) == 0);
+  CHECK(text.find("\ndwell to 10.2 0.2 0.3333333333333333 length 0 programmed_feed 0 move 1 next 1 stop dwell limits "
+                  "0 0 0 limited_by feed v0 0 a0 0 phases 7 0 0 0 0 0 0 0.5 0 0 0 0 0 0 0\nline to ") !=
+        std::string::npos);
+  CHECK(text.find(" move 2 next 2 stop dwell limits ") != std::string::npos);
+  CHECK(text.find("; 3 segments, " + formatFixed(t.duration(), 3) + " s\n") != std::string::npos);
+  Read r = read(text);
+  REQUIRE(r.errors.empty());
+  REQUIRE(r.trajectory);
+  requireSame(t, *r.trajectory);
+  CHECK(r.trajectory->segments[1].kind == SegmentKind::Dwell);
+  CHECK(r.trajectory->duration() == t.duration());
+  CHECK(writeNative(*r.trajectory, "holes") == text);
+  // Without a dwell the same writer writes version 1, which version 1
+  // players read.
+  CHECK(writeNative(sample(), "p").rfind("STEPNC-MOTION 1\n", 0) == 0);
+}
+
+TEST_CASE("native dwells are checked", "[native][dwell]") {
+  const std::string text = writeNative(dwelling(), "p");
+  REQUIRE(read(text).errors.empty());
+  const std::string dwellLine = "dwell to 10.2 0.2 0.3333333333333333 length 0 ";
+  const std::string waits = "phases 7 0 0 0 0 0 0 0.5 0 0 0 0 0 0 0";
+  // The first error of reading `changed`, on the dwell's line.
+  auto firstError = [](const std::string &changed) {
+    Read r = read(changed);
+    CHECK_FALSE(r.trajectory);
+    REQUIRE_FALSE(r.errors.empty());
+    CHECK(r.errors[0].rfind("11:", 0) == 0);
+    return r.errors[0];
+  };
+  // No time, negative time, a jerk.
+  CHECK_THAT(firstError(replaced(text, waits, "phases 7 0 0 0 0 0 0 0 0 0 0 0 0 0 0")),
+             Catch::EndsWith("a dwell waits for the duration of its phases, which must be more than 0 s"));
+  CHECK_THAT(firstError(replaced(text, waits, "phases 7 0 0 0 0 0 0 -0.5 0 0 0 0 0 0 0")),
+             Catch::EndsWith("a phase's duration must not be negative (found -0.5)"));
+  CHECK(read(replaced(text, waits, "phases 2 0.25 0 0.25 0")).errors.empty());  // any phases of jerk 0
+  CHECK_THAT(firstError(replaced(text, waits, "phases 7 0 0 0 0 0 0 0.5 1 0 0 0 0 0 0")),
+             Catch::Contains("the profile covers 0.020833333 mm, not the segment's length 0 mm"));
+  // A length, somewhere else, another stop reason, at speed.
+  CHECK_THAT(firstError(replaced(text, dwellLine, "dwell to 10.2 0.2 0.3333333333333333 length 0.5 ")),
+             Catch::EndsWith("a dwell has no length (the tool waits where it is): length 0, not 0.5"));
+  CHECK_THAT(firstError(replaced(text, dwellLine, "dwell to 10.2 0.25 0.3333333333333333 length 0 ")),
+             Catch::EndsWith("a dwell waits where the tool is: its end point is 0.050000000 mm from where the "
+                             "previous segment ends"));
+  CHECK_THAT(firstError(replaced(text, "next 1 stop dwell", "next 1 stop program")),
+             Catch::EndsWith("a dwell segment stops for its dwell: 'stop dwell', not 'stop program'"));
+  Trajectory atSpeed = dwelling();
+  atSpeed.profiles[0] = planProfile(0, 2, atSpeed.segments[0].length, atSpeed.info[0].limits);
+  CHECK_THAT(firstError(writeNative(atSpeed, "p")),
+             Catch::EndsWith("v0 0 mm/s does not continue the previous segment, which ends at 2.000000000 mm/s"));
+  // Version 1 has no dwells.
+  Read v1 = read(replaced(text, "STEPNC-MOTION 2", "STEPNC-MOTION 1"));
+  CHECK_FALSE(v1.trajectory);
+  REQUIRE(v1.errors.size() == 2);
+  CHECK(v1.errors[0] == "11:1: a dwell segment needs format version 2; this file is version 1");
+  CHECK_THAT(v1.errors[1], Catch::StartsWith("12:") && Catch::EndsWith("the stop reason 'dwell' needs format "
+                                                                        "version 2; this file is version 1"));
+}
+
 TEST_CASE("slices of one profile read back with their start acceleration", "[native]") {
   const Trajectory t = sliced();
   REQUIRE(t.profiles[1].a0 > 1);
@@ -270,11 +355,13 @@ TEST_CASE("the native text of a small trajectory", "[native]") {
 TEST_CASE("native format mistakes are located", "[native]") {
   REQUIRE(read(kSmall).errors.empty());
   // Another version: refused at the version number.
-  CHECK(error(replaced(kSmall, "STEPNC-MOTION 1", "STEPNC-MOTION 2")) ==
-        "1:15: unsupported native format version 2; this stepnc reads version 1");
-  CHECK(error("G01 X1\n") == "1:1: not a stepnc native motion file: the first line must be 'STEPNC-MOTION 1'");
-  CHECK(error("\n" + kSmall) == "2:1: not a stepnc native motion file: the first line must be 'STEPNC-MOTION 1'");
-  CHECK(error("") == "1:1: not a stepnc native motion file: the first line must be 'STEPNC-MOTION 1'");
+  CHECK(error(replaced(kSmall, "STEPNC-MOTION 1", "STEPNC-MOTION 3")) ==
+        "1:15: unsupported native format version 3; this stepnc reads versions 1 to 2");
+  const std::string notMotion =
+      ": not a stepnc native motion file: the first line must be 'STEPNC-MOTION 1' or 'STEPNC-MOTION 2'";
+  CHECK(error("G01 X1\n") == "1:1" + notMotion);
+  CHECK(error("\n" + kSmall) == "2:1" + notMotion);
+  CHECK(error("") == "1:1" + notMotion);
   // Truncated: fewer segments than announced, with or without 'end'.
   const std::string two = replaced(kSmall, "segments 1", "segments 2");
   CHECK(error(replaced(two, "end\n", "")) == "11:1: the file ends after 1 of the 2 segments announced");
@@ -296,7 +383,7 @@ TEST_CASE("native format mistakes are located", "[native]") {
   // Unknown keywords: in the header, as a segment kind, as a word value.
   CHECK(error(replaced(kSmall, "cycle_time", "cycletime")) == "6:1: expected 'cycle_time', found 'cycletime'");
   CHECK(error(replaced(kSmall, "line to", "circle to")) ==
-        "10:1: unknown segment kind 'circle' (known: line, arc, blend)");
+        "10:1: unknown segment kind 'circle' (known: line, arc, blend, dwell)");
   CHECK(error(replaced(kSmall, "stop start", "stop halt")) ==
         "10:63: unknown stop reason 'halt' (known: none, start, reversal, tiny, program, dwell)");
   CHECK(error(replaced(kSmall, " 1 2\n", " 1 2 3\n")) == "10:157: unexpected '3' after the last phase");
@@ -383,7 +470,7 @@ TEST_CASE("native segments join in speed", "[native]") {
   text = replaced(text, "blend to", "blend too");
   Read two = read(text);
   REQUIRE(two.errors.size() == 2);
-  CHECK(two.errors[0] == "10:1: unknown segment kind 'lime' (known: line, arc, blend)");
+  CHECK(two.errors[0] == "10:1: unknown segment kind 'lime' (known: line, arc, blend, dwell)");
   CHECK(two.errors[1] == "13:7: expected 'to', found 'too'");
 }
 
@@ -420,20 +507,4 @@ TEST_CASE("native segments join in acceleration", "[native]") {
   CHECK(stopError.rfind("11:", 0) == 0);
   CHECK(stopError.find("a segment that stops first (stop reversal) must start at rest, not at v0 ") !=
         std::string::npos);
-}
-
-TEST_CASE("a dwell's wait reads back, counts in the time, and is checked", "[native]") {
-  const std::string text = replaced(kSmall, "stop start", "stop dwell wait 0.75");
-  Read r = read(text);
-  REQUIRE(r.errors.empty());
-  REQUIRE(r.trajectory);
-  CHECK(r.trajectory->info[0].stop == StopReason::Dwell);
-  CHECK(r.trajectory->info[0].wait == 0.75);
-  CHECK(r.trajectory->duration() == 4.5 + 0.75);
-  // Written again: the same segment line, and the wait in the header's time.
-  CHECK(writeNative(*r.trajectory, "part.stpnc") ==
-        replaced(replaced(text, "; 1 segment, 4.500 s", "; 1 segment, 5.250 s"), "\"part.stpnc\"", "\"part.stpnc\""));
-  // A dwell without its wait, or one that does not wait.
-  CHECK(error(replaced(kSmall, "stop start", "stop dwell")) == "10:69: expected 'wait', found 'limits'");
-  CHECK(error(replaced(kSmall, "stop start", "stop dwell wait 0")) == "10:74: the dwell's wait (s) must be positive (found 0)");
 }

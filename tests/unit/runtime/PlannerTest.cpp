@@ -42,6 +42,14 @@ PathMove arc(double x, double y, double z, double cx, double cy, bool ccw, doubl
   return m;
 }
 
+PathMove dwell(const Vec3 &at, double timeS) {
+  PathMove m;
+  m.kind = PathMove::Kind::Dwell;
+  m.to = at;
+  m.dwellS = timeS;
+  return m;
+}
+
 /// Plans and plays `path`; every check of the issue holds.
 SimReport check(const PathInput &path, const Machine &machine) {
   const Trajectory t = plan(path, machine);
@@ -226,6 +234,122 @@ TEST_CASE("the tool stops where the program says and at reversals", "[planner]")
   check(p, m);
 }
 
+TEST_CASE("a dwell holds the tool at rest at its point for exactly its time", "[planner][dwell]") {
+  // A 40 mm line along x at 3000 mm/min, with half a second's dwell at its
+  // middle: the tool runs 20 mm rest to rest, waits, and runs 20 mm rest to
+  // rest. Without the dwell it is one 40 mm run. So the dwell costs its time
+  // and the stop it forces, two 20 mm runs instead of one of 40 mm, each
+  // time-optimal (restToRest: computed here, not by the planner).
+  const Machine m = test::shippedMachine("hsc-3axis");
+  const double a = m.axes[0].acceleration, j = m.axes[0].jerk;
+  const Vec3 middle(20, 0, 0);
+  PathInput without;
+  without.moves = {line(20, 0, 0, 3000), line(40, 0, 0, 3000)};
+  PathInput dwelt;
+  dwelt.moves = {line(20, 0, 0, 3000), dwell(middle, 0.5), line(40, 0, 0, 3000)};
+  PathInput stopped = without;  // a programmed stop at the dwell's point instead
+  stopped.moves[1].stopBefore = true;
+  const Trajectory tw = plan(without, m), td = plan(dwelt, m), ts = plan(stopped, m);
+
+  REQUIRE(td.segments.size() == 3);
+  const Segment &d = td.segments[1];
+  CHECK(d.kind == SegmentKind::Dwell);
+  CHECK(d.start == middle);
+  CHECK(d.end == middle);
+  CHECK(d.length == 0);
+  CHECK(td.info[1].move == 1);
+  CHECK(td.info[1].nextMove == 1);
+  CHECK(td.info[1].stop == StopReason::Dwell);
+  CHECK(td.info[2].stop == StopReason::Dwell);
+  CHECK(td.info[2].move == 2);
+  CHECK(td.profiles[0].v1() == 0);
+  CHECK(td.profiles[0].a1() == 0);
+  CHECK(td.profiles[1].v0 == 0);
+  CHECK(td.profiles[1].a0 == 0);
+  CHECK(td.profiles[1].duration() == 0.5);
+  CHECK(td.profiles[1].at(0.25).s == 0);
+  CHECK(td.profiles[2].v0 == 0);
+  CHECK(td.profiles[2].a0 == 0);
+  // The moves are planned as with a programmed stop there.
+  REQUIRE(ts.segments.size() == 2);
+  for (size_t k = 0; k < 2; ++k) {
+    const Profile &p = td.profiles[k == 0 ? 0 : 2], &q = ts.profiles[k];
+    for (size_t i = 0; i < p.phases.size(); ++i) {
+      CHECK(p.phases[i].duration == q.phases[i].duration);
+      CHECK(p.phases[i].jerk == q.phases[i].jerk);
+    }
+  }
+  // Total time: without the dwell, plus the dwell, plus the stop.
+  const double one = restToRest(40, 50, a, j), two = 2 * restToRest(20, 50, a, j), stop = two - one;
+  INFO("without " << tw.duration() << " s, with the dwell " << td.duration() << " s, the stop " << stop << " s");
+  CHECK(stop > 0.01);
+  CHECK(tw.duration() == Approx(one).epsilon(1e-9));
+  CHECK(td.duration() == Approx(tw.duration() + 0.5 + stop).epsilon(1e-9));
+  CHECK(td.duration() == Approx(ts.duration() + 0.5).epsilon(1e-14));
+
+  // Played at 1 kHz: every limit kept, and from the first line's end to the
+  // second's start (0.5 s) the tool is exactly at the middle, at rest; it
+  // moves just before and just after.
+  const SimReport r = check(dwelt, m);
+  CHECK(r.dwellTime == 0.5);
+  CHECK(r.duration == Approx(td.duration()).epsilon(1e-14));
+  const double t0 = td.profiles[0].duration(), t1 = t0 + 0.5;
+  size_t atRest = 0;
+  bool movedBefore = false, movedAfter = false;
+  simulate(td, m, {}, [&](const Sample &s) {
+    if (s.t > t0 && s.t < t1) {
+      ++atRest;
+      CHECK(s.segment == 1);
+      CHECK(s.p == middle);
+      CHECK(s.speed == 0);
+      CHECK(s.v == Vec3::Zero());
+      CHECK(s.a == Vec3::Zero());
+      CHECK(s.j == Vec3::Zero());
+    }
+    movedBefore = movedBefore || (s.t > t0 - 0.002 && s.t < t0 && s.speed > 0);
+    movedAfter = movedAfter || (s.t > t1 && s.t < t1 + 0.002 && s.speed > 0);
+  });
+  CHECK(atRest >= 499);
+  CHECK(atRest <= 501);
+  CHECK(movedBefore);
+  CHECK(movedAfter);
+}
+
+TEST_CASE("dwells at the start, at the end, in a row and of no time", "[planner][dwell]") {
+  const Machine m = test::shippedMachine("conventional-3axis");
+  // Before the first move and after the last: the trajectory starts and
+  // ends with them; two in a row stay two, each with its move.
+  PathInput p;
+  p.start = Vec3(0, 0, 5);
+  p.moves = {dwell(p.start, 0.25), line(30, 0, 5, 1200), dwell(Vec3(30, 0, 5), 0.5), dwell(Vec3(30, 0, 5), 0.75)};
+  const Trajectory t = plan(p, m);
+  REQUIRE(t.segments.size() == 4);
+  const SegmentKind kinds[] = {SegmentKind::Dwell, SegmentKind::Line, SegmentKind::Dwell, SegmentKind::Dwell};
+  for (size_t k = 0; k < 4; ++k) {
+    INFO("segment " << k);
+    CHECK(t.segments[k].kind == kinds[k]);
+    CHECK(t.info[k].stop == StopReason::Dwell);
+    CHECK(t.info[k].move == k);
+  }
+  CHECK(t.segments[0].start == p.start);
+  CHECK(t.segments[3].end == Vec3(30, 0, 5));
+  CHECK(t.duration() == Approx(0.25 + t.profiles[1].duration() + 0.5 + 0.75).epsilon(1e-14));
+  const SimReport r = check(p, m);
+  CHECK(r.dwellTime == 1.5);
+  CHECK(r.feedTime == Approx(t.profiles[1].duration()).epsilon(1e-14));
+  CHECK(r.rapidTime == 0);
+  CHECK_THAT(formatReport(r, t, m), Catch::Contains(", dwells 1.500 s)\n"));
+
+  // A dwell of no time is none: the corner is blended as without it.
+  PathInput none;
+  none.moves = {line(20, 0, 0, 3000), dwell(Vec3(20, 0, 0), 0), line(20, 20, 0, 3000)};
+  PathInput without;
+  without.moves = {line(20, 0, 0, 3000), line(20, 20, 0, 3000)};
+  const Trajectory tn = plan(none, m), tw = plan(without, m);
+  REQUIRE(tn.segments.size() == tw.segments.size());
+  CHECK(tn.duration() == tw.duration());
+}
+
 TEST_CASE("a curve written as short lines takes within 5 % of its lower bound", "[planner]") {
   // A 20 mm circle as 300, 3,000 and 30,000 chords (0.42 to 0.0042 mm) at
   // 4000 mm/min. Blends share the curve's curvature at the chords' middles,
@@ -345,46 +469,4 @@ TEST_CASE("a blend's arc-length table is its curve's length", "[planner]") {
     }
     CHECK(b.length == s);
   }
-}
-
-TEST_CASE("a dwell waits at rest for its time, where the program says", "[planner]") {
-  const Machine m = test::shippedMachine("hsc-3axis");
-  PathInput p;
-  p.moves.push_back(line(0, 0, -10, 300));  // a plunge
-  PathMove out = line(0, 0, 20, 0);         // the rapid out, after 0.5 s at the bottom
-  out.stopBefore = true;
-  out.waitBefore = 0.5;
-  p.moves.push_back(out);
-  const Trajectory t = plan(p, m);
-  REQUIRE(t.segments.size() == 2);
-  CHECK(t.info[1].stop == StopReason::Dwell);
-  CHECK(t.info[1].wait == 0.5);
-  CHECK(t.profiles[1].v0 == 0);
-  CHECK(t.profiles[1].a0 == 0);
-  // The wait counts once in the duration, beside the two rest-to-rest profiles.
-  CHECK(t.duration() == Approx(t.profiles[0].duration() + 0.5 + t.profiles[1].duration()).epsilon(1e-12));
-
-  // Played: at the bottom, at rest, for the whole wait.
-  const SimReport r = check(p, m);
-  CHECK(r.dwellTime == 0.5);
-  CHECK(r.duration == Approx(t.duration()).epsilon(1e-12));
-  const double reached = t.profiles[0].duration();
-  SimOptions options;
-  options.programmed = &p;
-  size_t atRest = 0;
-  simulate(t, m, options, [&](const Sample &s) {
-    if (s.t > reached + 1e-9 && s.t < reached + 0.5 - 1e-9) {
-      CHECK((s.p - Vec3(0, 0, -10)).norm() < 1e-12);
-      CHECK(s.speed == 0);
-      ++atRest;
-    }
-  });
-  CHECK(atRest >= 498);
-
-  // Without the dwell the same path is 0.5 s shorter and does not stop for it.
-  PathInput q = p;
-  q.moves[1].waitBefore = 0;
-  q.moves[1].stopBefore = false;
-  const Trajectory u = plan(q, m);
-  CHECK(u.duration() == Approx(t.duration() - 0.5).epsilon(1e-9));
 }

@@ -215,6 +215,62 @@ TEST_CASE("the sample count: every period before the end, plus the end", "[playe
   CHECK(r.endPosition == Vec3(1, 2, 3));
 }
 
+TEST_CASE("a dwell is played at rest at its point for its time", "[player][dwell]") {
+  const Machine m = testMachine();
+  // A line along x rest to rest (1.25 s), 0.75 s at its end, and a line
+  // back along y (1.25 s).
+  Trajectory t = oneLine(Vec3(1, 0, 0));
+  const Vec3 corner = t.segments[0].end;
+  SegmentInfo wait;
+  wait.move = wait.nextMove = 1;
+  wait.stop = StopReason::Dwell;
+  add(t, Segment::dwell(corner), dwellProfile(0.75), wait);
+  const double length = restToRestLength(Ramp{}, 0.5);
+  add(t, Segment::line(corner, corner + Vec3(0, length, 0)), restToRest(Ramp{}, 0.5),
+      feedInfo(kV, 2, StopReason::Dwell));
+  PathInput programmed;
+  programmed.moves.push_back({PathMove::Kind::Line, corner});
+  PathMove d{PathMove::Kind::Dwell, corner};
+  d.dwellS = 0.75;
+  programmed.moves.push_back(d);
+  programmed.moves.push_back({PathMove::Kind::Line, corner + Vec3(0, length, 0)});
+  SimOptions o;
+  o.programmed = &programmed;
+
+  size_t waiting = 0, atCorner = 0;
+  const SimReport r = simulate(t, m, o, [&](const Sample &s) {
+    if (s.segment == 1) {
+      ++waiting;
+      CHECK(s.p == corner);
+      CHECK(s.speed == 0);
+      CHECK(s.v == Vec3::Zero());
+      CHECK(s.a == Vec3::Zero());
+      CHECK(s.j == Vec3::Zero());
+    }
+    atCorner += s.p == corner;
+  });
+  const std::string text = formatReport(r, t, m);
+  INFO(text);
+  CHECK(r.violationCount == 0);
+  CHECK(r.maxDeviation < 1e-12);
+  CHECK(r.duration == 1.25 + 0.75 + 1.25);
+  CHECK(r.dwellTime == 0.75);
+  CHECK(r.feedTime == 2.5);
+  CHECK(r.rapidTime == 0);
+  CHECK(r.feedDistance == 2 * 218.75);
+  CHECK(r.samples == 3251);
+  // The samples at t = 1.250 s (where the first line ends and the dwell
+  // starts) to 1.999 s are the dwell's; at 2.000 s the next line starts
+  // from the corner.
+  CHECK(waiting == 750);
+  CHECK(atCorner == 751);
+  CHECK(r.endPosition == t.segments[2].end);
+  // Both lines start and end at rest: their cruise is what counts.
+  CHECK(r.minFeedRatio == Approx(1).epsilon(1e-12));
+  CHECK_THAT(text, Catch::Contains("cycle time: 3.250 s (feed moves 2.500 s over 437.5 mm, rapids 0.000 s over 0.0 "
+                                   "mm, dwells 0.750 s)\n"));
+}
+
 TEST_CASE("jerk above an axis's limit is reported on that axis", "[player]") {
   const Machine m = testMachine();
   Ramp hard;
