@@ -136,6 +136,12 @@ InFlightDiagnostic DiagnosticEngine::report(Severity severity, SourceLoc loc, st
   return InFlightDiagnostic(this, std::move(d));
 }
 
+InFlightDiagnostic DiagnosticEngine::assumption(SourceLoc loc, std::string message) {
+  if (strict_)
+    return error(loc, std::move(message));
+  return warning(loc, message + "; --strict makes it an error");
+}
+
 void DiagnosticEngine::emit(Diagnostic &&d) {
   if (d.severity == Severity::Warning && warningsAsErrors_)
     d.severity = Severity::Error;

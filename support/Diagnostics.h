@@ -116,11 +116,19 @@ public:
   InFlightDiagnostic remark(SourceLoc loc, std::string message) {
     return report(Severity::Remark, loc, std::move(message));
   }
+  /// What stepnc assumes to get past an imperfect input: a warning that says
+  /// what was assumed (the message names the value), an error under strict
+  /// mode. The message gains "; --strict makes it an error" when it is a
+  /// warning.
+  InFlightDiagnostic assumption(SourceLoc loc, std::string message);
 
   /// Errors after this many are dropped and limitReached() turns true; 0 means no limit.
   void setMaxErrors(unsigned n) { maxErrors_ = n; }
   /// Warnings become errors.
   void setWarningsAsErrors(bool on) { warningsAsErrors_ = on; }
+  /// Assumptions become errors (--strict).
+  void setStrict(bool on) { strict_ = on; }
+  bool strict() const { return strict_; }
   bool limitReached() const { return limitReached_; }
 
   unsigned errorCount() const { return errors_; }
@@ -140,6 +148,7 @@ private:
   unsigned warnings_ = 0;
   bool limitReached_ = false;
   bool warningsAsErrors_ = false;
+  bool strict_ = false;
 };
 
 } // namespace stepnc

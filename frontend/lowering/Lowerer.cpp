@@ -20,17 +20,33 @@ void Lowerer::unsupported(const Instance &inst, std::string_view what) {
       .entity(inst.id(), entity);
 }
 
+namespace {
+
+/// "'depth' of round_hole #28": the attribute a diagnostic is about.
+std::string attributeOf(const Instance &inst, std::string_view attribute) {
+  std::string text = "'";
+  text += attribute;
+  text += "' of ";
+  text += inst.entityName();
+  text += ' ';
+  text += hashId(inst.id());
+  return text;
+}
+
+} // namespace
+
 void Lowerer::missing(const Instance &inst, std::string_view attribute, std::string_view why) {
-  std::string entity(inst.entityName());
-  std::string message = "'";
-  message += attribute;
-  message += "' of ";
-  message += entity;
-  message += ' ';
-  message += hashId(inst.id());
+  std::string message = attributeOf(inst, attribute);
   message += ' ';
   message += why.empty() ? std::string_view("is needed to lower it") : why;
-  diags_.error(inst.attrLoc(attribute), std::move(message)).entity(inst.id(), entity);
+  diags_.error(inst.attrLoc(attribute), std::move(message)).entity(inst.id(), std::string(inst.entityName()));
+}
+
+void Lowerer::assumed(const Instance &inst, std::string_view attribute, std::string_view what) {
+  std::string message = attributeOf(inst, attribute);
+  message += ": ";
+  message += what;
+  diags_.assumption(inst.attrLoc(attribute), std::move(message)).entity(inst.id(), std::string(inst.entityName()));
 }
 
 std::string Lowerer::symbolFor(char sigil, const std::optional<std::string> &label, std::string_view fallback) {

@@ -52,6 +52,10 @@ public:
   void unsupported(const Instance &inst, std::string_view what = {});
   /// Reports a missing or invalid attribute that lowering needs.
   void missing(const Instance &inst, std::string_view attribute, std::string_view why = {});
+  /// Reports what lowering assumed for attribute `attribute` of `inst` (absent
+  /// or unusable in the file): `'depth' of ROUND_HOLE #28: <what>`, a warning
+  /// (an error with --strict). `what` says the value assumed and why.
+  void assumed(const Instance &inst, std::string_view attribute, std::string_view what);
   /// A fresh symbol with `sigil`, from a STEP-NC id string or a fallback.
   std::string symbolFor(char sigil, const std::optional<std::string> &label, std::string_view fallback);
   /// Sets origin and label from an instance.
