@@ -89,7 +89,8 @@ void readMaterials(TomlReader &r, const toml::table &root, CuttingData &data) {
       mat.kre = *v;
     if (auto v = r.number(m, "chip_thickness", where, "mm", 0.001, 2, !known))
       mat.chipThickness = *v;
-    r.number(m, "cutting_speed", where, "m/min", 1, 1e5, false);
+    if (auto v = r.number(m, "cutting_speed", where, "m/min", 1, 1e5, false))
+      mat.cuttingSpeed = *v;
   }
 }
 

@@ -26,6 +26,7 @@ struct Material {
   double ktc = 0, krc = 0;    ///< N/mm^2
   double kte = 0, kre = 0;    ///< N/mm
   double chipThickness = 0.1; ///< mm, the target maximum chip thickness h*
+  double cuttingSpeed = 0;    ///< m/min, typical for coated carbide; 0: not known
   std::string source;
 
   CuttingCoefficients coefficients() const { return {ktc, krc, kte, kre}; }

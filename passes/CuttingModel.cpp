@@ -48,25 +48,6 @@ const ir::Node *setupWorkpiece(const ir::Module &module, const std::string &setu
   return only;
 }
 
-MaterialChoice chooseMaterial(const ir::Node *workpiece, const cutting::CuttingData &data) {
-  MaterialChoice c;
-  const std::string id = workpiece ? workpiece->text("material").value_or("") : "";
-  const std::string standard = workpiece ? workpiece->text("material_standard").value_or("") : "";
-  std::string alias;
-  if (const cutting::Material *m = data.match(id, standard, alias)) {
-    c.material = m;
-    c.note = "material '" + id + (standard.empty() ? "" : "' ('" + standard) + (standard.empty() ? "'" : "')") +
-             " read as " + m->key + " (" + m->name + ", matched '" + alias + "')";
-    return c;
-  }
-  const auto it = data.materials.find(data.defaultMaterial);
-  c.material = it != data.materials.end() ? &it->second : nullptr;
-  c.note = (workpiece ? "material '" + id + "' ('" + standard + "') is not in the cutting data"
-                      : std::string("no workpiece names a material")) +
-           ": defaulted to " + data.defaultMaterial;
-  return c;
-}
-
 /// Samples along a move's plane path: (distance from start, point, direction).
 struct PathPoint {
   double s;
@@ -110,6 +91,25 @@ std::optional<ir::Kind> operationKind(const ir::Node &executable) {
 }
 
 } // namespace
+
+MaterialChoice chooseMaterial(const ir::Node *workpiece, const cutting::CuttingData &data) {
+  MaterialChoice c;
+  const std::string id = workpiece ? workpiece->text("material").value_or("") : "";
+  const std::string standard = workpiece ? workpiece->text("material_standard").value_or("") : "";
+  std::string alias;
+  if (const cutting::Material *m = data.match(id, standard, alias)) {
+    c.material = m;
+    c.note = "material '" + id + (standard.empty() ? "" : "' ('" + standard) + (standard.empty() ? "'" : "')") +
+             " read as " + m->key + " (" + m->name + ", matched '" + alias + "')";
+    return c;
+  }
+  const auto it = data.materials.find(data.defaultMaterial);
+  c.material = it != data.materials.end() ? &it->second : nullptr;
+  c.note = (workpiece ? "material '" + id + "' ('" + standard + "') is not in the cutting data"
+                      : std::string("no workpiece names a material")) +
+           ": defaulted to " + data.defaultMaterial;
+  return c;
+}
 
 double spindleTorqueLimit(const runtime::Machine &machine, double rpm) {
   double limit = machine.spindleTorque.value_or(kInf);

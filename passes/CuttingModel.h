@@ -140,6 +140,10 @@ struct MaterialChoice {
   std::string note; ///< "C45E 1.1191 read as steel_1045 (alias C45E)" or why it was defaulted
 };
 
+/// The material a workpiece names, matched in `data`; the default material
+/// (with a note saying so) when it names none that the data knows.
+MaterialChoice chooseMaterial(const ir::Node *workpiece, const cutting::CuttingData &data);
+
 CutterSetup cutterSetup(const ir::Node &tool, const cutting::CuttingData &data);
 
 /// Cuts the whole program into the stock and measures every horizontal

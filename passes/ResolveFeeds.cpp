@@ -5,9 +5,18 @@
 //   cutting speed [mm/min] = pi x tool diameter [mm] x |spindle| [rev/min]
 // Each value computed is marked in the technology node's comment; values the
 // file gives are never changed.
+//
+// A spindle speed the file does not give is assumed (reported; an error with
+// --strict) from the cutting speed, the file's or else the typical one of the
+// workpiece material for coated carbide (cutting/materials.toml), half of it
+// for hole-making tools:
+//   spindle [rev/min] = cutting speed [mm/min] / (pi x tool diameter [mm])
 #include "passes/Pass.h"
 
+#include "cutting/CuttingData.h"
 #include "ir/Kinds.h"
+#include "ir/Program.h"
+#include "passes/CuttingModel.h"
 #include "support/Format.h"
 
 #include <cmath>
@@ -28,12 +37,13 @@ public:
       if (n.kind == ir::Kind::Tool)
         tools[n.symbol] = &n;
     PassResult result;
-    visit(module.root, tools, diags, stats, result);
+    module_ = &module;
+    visit(module.root, nullptr, tools, diags, stats, result);
     return result;
   }
 
 private:
-  void visit(ir::Node &node, const std::map<std::string, const ir::Node *, std::less<>> &tools,
+  void visit(ir::Node &node, const ir::Node *step, const std::map<std::string, const ir::Node *, std::less<>> &tools,
              DiagnosticEngine &diags, PassStats &stats, PassResult &result) {
     for (ir::Node &child : node.children) {
       if (ir::isOperation(child.kind)) {
@@ -41,20 +51,54 @@ private:
         if (auto symbol = child.text("tool"))
           if (auto it = tools.find(*symbol); it != tools.end())
             tool = it->second;
-        resolve(child, tool, diags, stats, result);
+        resolve(child, step, tool, diags, stats, result);
       }
-      visit(child, tools, diags, stats, result);
+      visit(child, child.kind == ir::Kind::Workingstep ? &child : step, tools, diags, stats, result);
     }
   }
 
-  void resolve(ir::Node &op, const ir::Node *tool, DiagnosticEngine &diags, PassStats &stats, PassResult &result) {
+  /// The spindle speed (rev/min, signed) assumed for `op` when its
+  /// technology gives none, with why; nullopt (after reporting) when there is
+  /// nothing to assume it from.
+  std::optional<double> assumeSpindle(const ir::Node &op, const ir::Node *step, const ir::Node &tech,
+                                      const ir::Node *tool, DiagnosticEngine &diags, std::string &why) {
+    const double diameter = tool ? tool->number("diameter").value_or(0.0) : 0.0;
+    const std::string toolType = tool ? tool->text("type").value_or("") : "";
+    if (diameter <= 0 || toolType.find("tap") != std::string::npos)
+      return std::nullopt;  // no diameter to turn a speed into revolutions; a tap's speed is its pitch's
+    double vc = tech.number("cutting_speed").value_or(0);  // mm/min
+    std::string materialNote;
+    if (vc > 0) {
+      why = "from its cutting speed " + formatFixed(vc / 1000, 1) + " m/min";
+    } else {
+      const ir::Node *feature = step ? ir::findFeature(*module_, step->text("feature").value_or("")) : nullptr;
+      const ir::Node *workpiece = feature ? ir::workpieceOf(*module_, *feature) : nullptr;
+      const MaterialChoice material = chooseMaterial(workpiece, cutting::shippedCuttingData());
+      if (!material.material || material.material->cuttingSpeed <= 0)
+        return std::nullopt;
+      const bool holeMaking = ir::hasTraits(op.kind, ir::Trait::HoleMaking);
+      vc = material.material->cuttingSpeed * 1000 * (holeMaking ? 0.5 : 1.0);
+      why = "from a cutting speed of " + formatFixed(vc / 1000, 1) + " m/min (typical for coated carbide in " +
+            material.material->key + (holeMaking ? ", halved for hole making" : "") + ")";
+      materialNote = material.note;
+    }
+    const double n = vc / (std::numbers::pi * diameter);
+    why += " and the tool's diameter " + formatFixed(diameter, 4) + " mm";
+    if (!materialNote.empty())
+      why += "; " + materialNote;
+    // Clockwise (M3) for a right-hand tool, the usual cut.
+    return tool->text("hand") == "left" ? n : -n;
+  }
+
+  void resolve(ir::Node &op, const ir::Node *step, const ir::Node *tool, DiagnosticEngine &diags,
+               PassStats &stats, PassResult &result) {
     ir::Node *tech = nullptr;
     for (ir::Node &c : op.children)
       if (c.kind == ir::Kind::Technology)
         tech = &c;
     if (!tech)
       return;
-    const std::optional<double> spindle = tech->number("spindle");
+    std::optional<double> spindle = tech->number("spindle");
     // 0 stands for "not known" (a tool has positive flutes and diameter).
     const int64_t flutes = tool ? tool->count("flutes").value_or(0) : 0;
     const double diameter = tool ? tool->number("diameter").value_or(0.0) : 0.0;
@@ -63,6 +107,19 @@ private:
       derived += derived.empty() ? "" : "; ";
       derived += text;
     };
+    if (!spindle) {
+      std::string why;
+      if ((spindle = assumeSpindle(op, step, *tech, tool, diags, why))) {
+        tech->set("spindle", ir::Value::spindle(*spindle));
+        note("spindle assumed " + why);
+        diags.assumption(tech->origin.loc.valid() ? tech->origin.loc : op.origin.loc,
+                         op.kindName() + " '" + op.label + "' gives no spindle speed; assumed " +
+                             formatFixed(std::abs(*spindle), 1) + " rev/min " +
+                             (*spindle < 0 ? "clockwise " : "counter-clockwise ") + why)
+            .entity(tech->origin.entityId ? tech->origin.entityId : op.origin.entityId);
+        ++stats["spindle speeds assumed"];
+      }
+    }
     const double n = spindle ? std::abs(*spindle) : 0.0;
     if (!tech->has("feed")) {
       if (auto fz = tech->number("feed_per_tooth"); fz && flutes > 0 && n > 0) {
@@ -92,6 +149,8 @@ private:
       result.changed = true;
     }
   }
+
+  const ir::Module *module_ = nullptr;
 };
 
 } // namespace

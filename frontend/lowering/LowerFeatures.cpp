@@ -3,6 +3,11 @@
 // lowered once, under its workpiece, and referred to by symbol.
 #include "frontend/lowering/Lowerer.h"
 
+#include "support/Format.h"
+
+#include <cmath>
+#include <numbers>
+
 namespace stepnc::lowering {
 
 namespace {
@@ -13,7 +18,69 @@ void setDepth(Lowerer &l, Node &n, const Instance &f) {
     n.set("depth", Value::length(-*z));
 }
 
+std::string describe(const Instance &inst) { return hashId(inst.id()) + " " + std::string(inst.entityName()); }
+
 } // namespace
+
+void Lowerer::slotDepthFromProfile(Node &slot, const Instance &f) {
+  const std::optional<double> depth = slot.number("depth");
+  if (!depth || *depth > 0)
+    return;  // absent (reported) or given
+  // A partial circular profile is as deep as its arc: the sagitta
+  // r (1 - cos(sweep / 2)), its chord at the slot's top.
+  Instance shape = f.ref("swept_shape");
+  if (!shape.isA("partial_circular_profile"))
+    return;
+  const std::optional<double> r = toleranced(shape, "radius");
+  const std::optional<double> sweep = shape.real("sweep_angle");
+  if (!r || !sweep)
+    return;
+  const double sweepDeg = angle(*sweep).number;
+  const double sagitta = *r * (1 - std::cos(sweepDeg / 2 * std::numbers::pi / 180));
+  if (!(sweepDeg > 0 && sweepDeg <= 180 && sagitta > 1e-6))
+    return;
+  slot.set("depth", Value::length(sagitta));
+  assumed(f, "depth",
+          "its plane gives a depth of " + formatFixed(*depth, 4) + " mm; assumed " + formatFixed(sagitta, 4) +
+              " mm, the depth of its swept shape " + describe(shape) + " (radius " + formatFixed(*r, 4) +
+              " mm, sweep " + formatFixed(sweepDeg, 4) + " deg)");
+}
+
+Instance Lowerer::featureWorkpiece(const Instance &f) {
+  if (Instance wp = f.ref("its_workpiece"))
+    return wp;
+  if (projectWorkpieces_.size() != 1)
+    return {};
+  assumed(f, "its_workpiece", "absent; assumed " + describe(projectWorkpieces_[0]) + ", the project's only workpiece");
+  return projectWorkpieces_[0];
+}
+
+std::optional<RawExtent> Lowerer::rawExtent(const Instance &wp) {
+  Instance block = wp ? rawBounding(wp) : Instance();
+  if (!block || !block.isA("block"))
+    return std::nullopt;
+  auto x = block.real("x"), y = block.real("y"), z = block.real("z");
+  if (!x || !y || !z)
+    return std::nullopt;
+  Placement p;
+  if (Instance at = block.ref("position")) {
+    auto placed = placement(at);
+    if (!placed)
+      return std::nullopt;
+    p = *placed;
+  }
+  // ISO 14649-10: the block's placement is a corner; x, y, z run along its axes.
+  const Vec3 ey = p.axis.cross(p.ref);
+  RawExtent e;
+  e.block = block;
+  e.min = e.max = p.at;
+  for (int i = 1; i < 8; ++i) {
+    const Vec3 c = p.at + ((i & 1) ? *x : 0.0) * p.ref + ((i & 2) ? *y : 0.0) * ey + ((i & 4) ? *z : 0.0) * p.axis;
+    e.min = e.min.cwiseMin(c);
+    e.max = e.max.cwiseMax(c);
+  }
+  return e;
+}
 
 std::optional<std::string> Lowerer::feature(const Instance &f) {
   if (!f)
@@ -22,11 +89,18 @@ std::optional<std::string> Lowerer::feature(const Instance &f) {
     return it->second;
   Node n;
   std::vector<Instance> bosses;
-  auto commonPlacementAndDepth = [&] {
-    if (auto p = placement(f.ref("feature_placement")))
+  const Instance wpInstance = featureWorkpiece(f);
+  Placement frame;  // the feature's, identity when it has none
+  auto commonPlacement = [&] {
+    if (auto p = placement(f.ref("feature_placement"))) {
+      frame = *p;
       setPlacement(n, *p);
-    else
+    } else {
       missing(f, "feature_placement");
+    }
+  };
+  auto commonPlacementAndDepth = [&] {
+    commonPlacement();
     setDepth(*this, n, f);
   };
   auto length = [&](std::string_view irName, std::string_view attribute) {
@@ -80,7 +154,7 @@ std::optional<std::string> Lowerer::feature(const Instance &f) {
     const bool closed = f.isA("closed_pocket");
     n.kind = closed ? ir::Kind::ClosedPocket : ir::Kind::OpenPocket;
     commonPlacementAndDepth();
-    copyReal(n, "slope", f, "slope", Value::angle);
+    copyAngle(n, "slope", f, "slope");
     Instance bottom = f.ref("bottom_condition");
     if (bottom.isA("planar_pocket_bottom_condition")) {
       n.set("bottom", Value::word("planar"));
@@ -105,7 +179,37 @@ std::optional<std::string> Lowerer::feature(const Instance &f) {
     bosses = f.refs("its_boss");
   } else if (f.isA("round_hole")) {
     n.kind = ir::Kind::RoundHole;
-    commonPlacementAndDepth();
+    commonPlacement();
+    Instance bottomCondition = f.ref("bottom_condition");
+    if (!f.ref("depth") && bottomCondition.isA("through_bottom_condition")) {
+      // A through hole goes through the raw piece along its axis, from where
+      // the axis enters it to where it leaves. A placement inside the raw
+      // piece moves up to the entry: drilling from there never rapids into
+      // material the file does not say is gone.
+      std::optional<RawExtent> raw = rawExtent(wpInstance);
+      auto span = raw ? raw->span(frame.at, -frame.axis) : std::nullopt;
+      if (span && span->first <= 1e-6 && span->second > 1e-6) {
+        const double depth = span->second - std::min(0.0, span->first);
+        std::string what = "absent; assumed " + formatFixed(depth, 4) +
+                           " mm: a through hole, along its axis through the raw piece " + describe(raw->block);
+        if (span->first < -1e-6) {
+          const Vec3 was = frame.at;
+          frame.at += frame.axis * -span->first;
+          setPlacement(n, frame);
+          what += ", from where its axis enters it, " + formatTuple({frame.at.x(), frame.at.y(), frame.at.z()}, 4) +
+                  " mm (its placement " + formatTuple({was.x(), was.y(), was.z()}, 4) + " mm is inside the raw piece)";
+        }
+        n.set("depth", Value::length(depth));
+        assumed(f, "depth", what);
+      } else {
+        missing(f, "depth",
+                raw ? "is needed to lower it: the hole's placement is not inside the raw piece, so how deep it goes "
+                      "through cannot be assumed"
+                    : "is needed to lower it: a through hole's depth is assumed only from a BLOCK raw piece");
+      }
+    } else {
+      setDepth(*this, n, f);
+    }
     if (auto d = toleranced(f, "diameter"))
       n.set("diameter", Value::length(*d));
     else
@@ -116,12 +220,12 @@ std::optional<std::string> Lowerer::feature(const Instance &f) {
           n.set("final_diameter", Value::length(*d));
       } else if (taper.isA("angle_taper")) {
         if (auto a = taper.real("angle"))
-          n.set("taper_angle", Value::angle(*a));
+          n.set("taper_angle", angle(*a));
       } else {
         unsupported(taper, "hole taper");
       }
     }
-    Instance bottom = f.ref("bottom_condition");
+    const Instance &bottom = bottomCondition;
     if (bottom.isA("through_bottom_condition")) {
       n.set("bottom", Value::word("through"));
     } else if (bottom.isA("flat_with_radius_hole_bottom")) {
@@ -133,7 +237,7 @@ std::optional<std::string> Lowerer::feature(const Instance &f) {
     } else if (bottom.isA("conical_hole_bottom")) {
       n.set("bottom", Value::word("conical"));
       if (auto a = bottom.real("tip_angle"))
-        n.set("tip_angle", Value::angle(*a));
+        n.set("tip_angle", angle(*a));
       if (auto r = toleranced(bottom, "tip_radius"))
         n.set("tip_radius", Value::length(*r));
     } else if (bottom.isA("spherical_hole_bottom")) {
@@ -168,8 +272,16 @@ std::optional<std::string> Lowerer::feature(const Instance &f) {
       }
       n.set(i == 0 ? "end_1" : "end_2", Value::word(word));
     }
-    addPath("course_of_travel", true);
+    PathContext context;
+    context.frame = frame;
+    context.raw = rawExtent(wpInstance);
+    context.openEnds = n.text("end_1") == "open" && n.text("end_2") == "open";
+    if (auto p = path(f.ref("course_of_travel"), &context))
+      n.add(std::move(*p));
+    else
+      missing(f, "course_of_travel");
     addProfile("swept_shape", true);
+    slotDepthFromProfile(n, f);
   } else if (f.isA("step")) {
     n.kind = ir::Kind::Step;
     commonPlacementAndDepth();
@@ -184,7 +296,7 @@ std::optional<std::string> Lowerer::feature(const Instance &f) {
   } else if (f.isA("boss")) {
     n.kind = ir::Kind::Boss;
     commonPlacementAndDepth();
-    copyReal(n, "slope", f, "slope", Value::angle);
+    copyAngle(n, "slope", f, "slope");
     addProfile("its_boundary", true);
   } else {
     unsupported(f, "feature");
@@ -208,7 +320,7 @@ std::optional<std::string> Lowerer::feature(const Instance &f) {
     }
   }
   const std::string symbol = n.symbol;
-  std::optional<std::string> wp = workpiece(f.ref("its_workpiece"));
+  std::optional<std::string> wp = workpiece(wpInstance);
   Node *owner = wp ? findResource(*wp) : nullptr;
   if (!owner) {
     missing(f, "its_workpiece");

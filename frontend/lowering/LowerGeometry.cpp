@@ -2,10 +2,47 @@
 // lengths, profiles, travel paths and curves.
 #include "frontend/lowering/Lowerer.h"
 
+#include "support/Format.h"
+
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 namespace stepnc::lowering {
+
+namespace {
+
+/// The slab method over the first `axes` coordinates.
+std::optional<std::pair<double, double>> boxSpan(const Vec3 &lo, const Vec3 &hi, const Vec3 &p, const Vec3 &d,
+                                                 int axes) {
+  constexpr double kEps = 1e-9;
+  double enter = -std::numeric_limits<double>::infinity(), exit = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < axes; ++i) {
+    if (std::abs(d[i]) < 1e-12) {
+      if (p[i] < lo[i] - kEps || p[i] > hi[i] + kEps)
+        return std::nullopt;
+      continue;
+    }
+    double t0 = (lo[i] - p[i]) / d[i], t1 = (hi[i] - p[i]) / d[i];
+    if (t0 > t1)
+      std::swap(t0, t1);
+    enter = std::max(enter, t0);
+    exit = std::min(exit, t1);
+  }
+  if (enter > exit + kEps)
+    return std::nullopt;
+  return std::pair{enter, exit};
+}
+
+} // namespace
+
+std::optional<std::pair<double, double>> RawExtent::spanXY(const Vec3 &p, const Vec3 &d) const {
+  return boxSpan(min, max, p, d, 2);
+}
+
+std::optional<std::pair<double, double>> RawExtent::span(const Vec3 &p, const Vec3 &d) const {
+  return boxSpan(min, max, p, d, 3);
+}
 
 std::optional<Vec3> Lowerer::point(const Instance &p) {
   if (!p || !p.isA("cartesian_point")) {
@@ -124,9 +161,9 @@ std::optional<Node> Lowerer::profile(const Instance &p) {
     else if (required)
       missing(p, attribute);
   };
-  auto angle = [&](Node &n, std::string_view irName, std::string_view attribute, bool required) {
+  auto angleOf = [&](Node &n, std::string_view irName, std::string_view attribute, bool required) {
     if (auto v = p.real(attribute))
-      n.set(std::string(irName), Value::angle(*v));
+      n.set(std::string(irName), angle(*v));
     else if (required)
       missing(p, attribute);
   };
@@ -147,21 +184,21 @@ std::optional<Node> Lowerer::profile(const Instance &p) {
     n.kind = ir::Kind::SquareUProfile;
     length(n, "width", "width", true);
     length(n, "first_radius", "first_radius", false);
-    angle(n, "first_angle", "first_angle", false);
+    angleOf(n, "first_angle", "first_angle", false);
     length(n, "second_radius", "second_radius", false);
-    angle(n, "second_angle", "second_angle", false);
+    angleOf(n, "second_angle", "second_angle", false);
   } else if (p.isA("rounded_u_profile")) {
     n.kind = ir::Kind::RoundedUProfile;
     length(n, "width", "width", true);
   } else if (p.isA("vee_profile")) {
     n.kind = ir::Kind::VeeProfile;
     length(n, "profile_radius", "profile_radius", false);
-    angle(n, "profile_angle", "profile_angle", true);
-    angle(n, "tilt_angle", "tilt_angle", true);
+    angleOf(n, "profile_angle", "profile_angle", true);
+    angleOf(n, "tilt_angle", "tilt_angle", true);
   } else if (p.isA("partial_circular_profile")) {
     n.kind = ir::Kind::PartialCircularProfile;
     length(n, "radius", "radius", true);
-    angle(n, "sweep_angle", "sweep_angle", true);
+    angleOf(n, "sweep_angle", "sweep_angle", true);
   } else if (p.isA("general_closed_profile") || p.isA("general_profile")) {
     n.kind = ir::Kind::GeneralProfile;
     const bool closed = p.isA("general_closed_profile");
@@ -178,7 +215,7 @@ std::optional<Node> Lowerer::profile(const Instance &p) {
   return n;
 }
 
-std::optional<Node> Lowerer::path(const Instance &t) {
+std::optional<Node> Lowerer::path(const Instance &t, const PathContext *context) {
   if (!t)
     return std::nullopt;
   Node n(ir::Kind::Path);
@@ -191,12 +228,33 @@ std::optional<Node> Lowerer::path(const Instance &t) {
     Node line(ir::Kind::Line);
     stamp(line, t, "");
     line.set("at", Value::point(pl.at));
-    if (auto d = direction(t.ref("its_direction")))
-      line.set("dir", Value::direction(*d));
+    std::optional<Vec3> dir = direction(t.ref("its_direction"));
+    if (!dir && context && !t.ref("its_direction")) {
+      // Along the feature's x axis: the direction its frame is written for.
+      dir = Vec3::UnitX();
+      assumed(t, "its_direction", "absent; assumed (1, 0, 0), the x axis of the feature's frame");
+    }
+    if (dir)
+      line.set("dir", Value::direction(*dir));
     else
       missing(t, "its_direction");
-    if (auto len = toleranced(t, "distance"))
-      line.set("length", Value::length(*len));
+    std::optional<double> length = toleranced(t, "distance");
+    if (!length && dir && context && context->openEnds && context->raw && !t.ref("distance")) {
+      // Open at both ends: the path runs to where it leaves the raw piece.
+      const Placement &f = context->frame;
+      const Vec3 y = f.axis.cross(f.ref);
+      auto toWorkpiece = [&](const Vec3 &v) { return Vec3(v.x() * f.ref + v.y() * y + v.z() * f.axis); };
+      const Vec3 from = f.at + toWorkpiece(pl.at), along = toWorkpiece(*dir).normalized();
+      if (auto span = context->raw->spanXY(from, along); span && span->second > 1e-6) {
+        length = span->second;
+        assumed(t, "distance",
+                "absent; assumed " + formatFixed(*length, 4) + " mm, to where the path leaves the raw piece " +
+                    hashId(context->raw->block.id()) + " " + std::string(context->raw->block.entityName()) +
+                    " (both ends of the slot are open)");
+      }
+    }
+    if (length)
+      line.set("length", Value::length(*length));
     else
       missing(t, "distance");
     n.add(std::move(line));

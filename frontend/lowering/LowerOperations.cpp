@@ -77,8 +77,8 @@ std::optional<std::string> Lowerer::tool(const Instance &t) {
     if (Instance dim = body.ref("dimension")) {
       copyReal(n, "diameter", dim, "diameter", Value::length);
       copyReal(n, "corner_radius", dim, "edge_radius", Value::length);
-      copyReal(n, "tip_half_angle", dim, "tool_tip_half_angle", Value::angle);
-      copyReal(n, "circumference_angle", dim, "tool_circumference_angle", Value::angle);
+      copyAngle(n, "tip_half_angle", dim, "tool_tip_half_angle");
+      copyAngle(n, "circumference_angle", dim, "tool_circumference_angle");
       copyReal(n, "cutting_edge_length", dim, "cutting_edge_length", Value::length);
       copyReal(n, "edge_center_vertical", dim, "edge_center_vertical", Value::length);
       copyReal(n, "edge_center_horizontal", dim, "edge_center_horizontal", Value::length);
@@ -90,7 +90,7 @@ std::optional<std::string> Lowerer::tool(const Instance &t) {
     if (auto hand = body.enumeration("hand_of_cut"))
       n.set("hand", Value::word(*hand));
     copyFlag(n, "coolant_through", body, "coolant_through_tool");
-    copyReal(n, "taper_angle", body, "taper_angle", Value::angle);
+    copyAngle(n, "taper_angle", body, "taper_angle");
   } else {
     missing(t, "its_tool_body");
   }
@@ -330,7 +330,7 @@ std::optional<Node> Lowerer::operation(const Instance &op) {
     if (Instance o = ar.ref("tool_orientation"))
       if (auto d = direction(o))
         a.set("tool_orientation", Value::direction(*d));
-    copyReal(a, "angle", ar, "angle", Value::angle);
+    copyAngle(a, "angle", ar, "angle");
     for (std::string_view attribute : {"radius", "width", "travel_length"})
       copyReal(a, attribute, ar, attribute, Value::length);
     n.add(std::move(a));

@@ -4,6 +4,9 @@
 
 #include "support/Format.h"
 
+#include <cmath>
+#include <numbers>
+
 namespace stepnc::lowering {
 
 // --- helpers -----------------------------------------------------------------
@@ -43,8 +46,10 @@ void Lowerer::missing(const Instance &inst, std::string_view attribute, std::str
 }
 
 void Lowerer::assumed(const Instance &inst, std::string_view attribute, std::string_view what) {
-  std::string message = attributeOf(inst, attribute);
-  message += ": ";
+  // The diagnostic names the instance ("#28 ROUND_HOLE: 'depth' absent; ...").
+  std::string message = "'";
+  message += attribute;
+  message += "' ";
   message += what;
   diags_.assumption(inst.attrLoc(attribute), std::move(message)).entity(inst.id(), std::string(inst.entityName()));
 }
@@ -112,12 +117,7 @@ std::optional<std::string> Lowerer::workpiece(const Instance &wp) {
   }
   if (auto tol = wp.real("global_tolerance"))
     node.set("global_tolerance", Value::length(*tol));
-  // The raw piece: the bounding geometry, here or on the raw-piece workpiece.
-  Instance bounding = wp.ref("its_bounding_geometry");
-  if (!bounding)
-    if (Instance raw = wp.ref("its_rawpiece"))
-      bounding = raw.ref("its_bounding_geometry");
-  if (bounding) {
+  if (Instance bounding = rawBounding(wp)) {
     if (bounding.isA("block")) {
       Node raw(ir::Kind::Rawpiece);
       stamp(raw, bounding, "");
@@ -145,6 +145,18 @@ std::optional<std::string> Lowerer::workpiece(const Instance &wp) {
   lowered_[wp.index()] = symbol;
   module_->root.add(std::move(node));
   return symbol;
+}
+
+Instance Lowerer::rawBounding(const Instance &wp) {
+  // The bounding geometry of its_rawpiece (the stock the part is made from),
+  // else the part's own bounding geometry (the stock is taken to be the part's
+  // envelope, as most files mean when they give no raw piece).
+  Instance bounding;
+  if (Instance raw = wp.ref("its_rawpiece"))
+    bounding = raw.ref("its_bounding_geometry");
+  if (!bounding)
+    bounding = wp.ref("its_bounding_geometry");
+  return bounding;
 }
 
 std::optional<std::string> Lowerer::setup(const Instance &s) {
@@ -259,6 +271,76 @@ bool Lowerer::executable(const Instance &exe, Node &parent) {
   return false;
 }
 
+namespace {
+
+/// Every angle (plane_angle_measure) lowering reads, by entity and attribute:
+/// what chooseAngleUnit looks at.
+constexpr std::pair<std::string_view, std::string_view> kAngles[] = {
+    {"milling_tool_dimension", "tool_tip_half_angle"},
+    {"milling_tool_dimension", "tool_circumference_angle"},
+    {"tapered_drill", "taper_angle"},
+    {"tapered_reamer", "taper_angle"},
+    {"tapered_tap", "taper_angle"},
+    {"tapered_endmill", "taper_angle"},
+    {"conical_hole_bottom", "tip_angle"},
+    {"angle_taper", "angle"},
+    {"pocket", "slope"},
+    {"boss", "slope"},
+    {"square_u_profile", "first_angle"},
+    {"square_u_profile", "second_angle"},
+    {"vee_profile", "profile_angle"},
+    {"vee_profile", "tilt_angle"},
+    {"partial_circular_profile", "sweep_angle"},
+    {"plunge_ramp", "angle"},
+    {"plunge_helix", "angle"},
+    {"plunge_zigzag", "angle"},
+    {"ap_retract_angle", "angle"},
+};
+
+} // namespace
+
+void Lowerer::chooseAngleUnit() {
+  using Angle = UnitConventions::Angle;
+  if (options_.units.angles != Angle::Auto) {
+    angleToDeg_ = options_.units.angles == Angle::Radian ? 180 / std::numbers::pi : 1.0;
+    return;
+  }
+  // Radians when every angle is below 2 pi and none is a whole number of
+  // degrees: 0.349066 (20 deg) and 1.570796 (90 deg) read as radians; one
+  // angle of 31 or 118 keeps the whole file in degrees. A file with no angle,
+  // or only zeros, stays in degrees.
+  const auto &entries = bound_.file().entries();
+  std::optional<std::pair<Instance, std::string_view>> example;
+  double exampleValue = 0;
+  for (size_t i = 0; i < entries.size(); ++i) {
+    Instance inst(bound_, i);
+    for (const auto &[entity, attribute] : kAngles) {
+      if (!inst.isA(entity))
+        continue;
+      std::optional<double> v = inst.real(attribute);
+      if (!v || *v == 0)
+        continue;
+      const double a = std::abs(*v);
+      if (a > 2 * std::numbers::pi + 1e-9 || std::abs(a - std::round(a)) < 1e-9)
+        return;  // degrees
+      if (!example) {
+        example = std::pair{inst, attribute};
+        exampleValue = *v;
+      }
+    }
+  }
+  if (!example)
+    return;
+  angleToDeg_ = 180 / std::numbers::pi;
+  const auto &[inst, attribute] = *example;
+  diags_
+      .assumption(inst.attrLoc(attribute),
+                  "angles read as radians: every angle in the file is below 2 pi and none is a whole number of "
+                  "degrees (" + std::string(attribute) + " " + formatFixed(exampleValue, 6) + " = " +
+                      formatFixed(exampleValue * 180 / std::numbers::pi, 4) + " deg)")
+      .entity(inst.id(), std::string(inst.entityName()));
+}
+
 std::unique_ptr<ir::Module> Lowerer::run() {
   const auto &entries = bound_.file().entries();
   std::vector<Instance> projects;
@@ -276,10 +358,12 @@ std::unique_ptr<ir::Module> Lowerer::run() {
         .entity(projects[1].id(), "PROJECT")
         .note(projects[0].loc(), "the first PROJECT is here");
   const Instance &project = projects[0];
+  chooseAngleUnit();
   module_ = std::make_unique<ir::Module>();
   module_->sourceName = std::string(bound_.file().source().name());
   stamp(module_->root, project);
-  for (const Instance &wp : project.refs("its_workpieces"))
+  projectWorkpieces_ = project.refs("its_workpieces");
+  for (const Instance &wp : projectWorkpieces_)
     workpiece(wp);
   Instance main = project.ref("main_workplan");
   if (!main) {

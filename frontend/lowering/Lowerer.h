@@ -26,6 +26,28 @@ struct Placement {
   Vec3 ref = Vec3::UnitX();
 };
 
+/// A raw piece's extent in its workpiece's coordinates: the box around its
+/// BLOCK (exact when the block's axes are the workpiece's), for the values
+/// lowering assumes from it.
+struct RawExtent {
+  Instance block;
+  Vec3 min = Vec3::Zero(), max = Vec3::Zero();
+  /// The parameters t in [enter, exit] at which the line p + t d (d a unit
+  /// vector) is inside the box, in x and y only (a line on the top face
+  /// counts as inside); nullopt when it misses the box.
+  std::optional<std::pair<double, double>> spanXY(const Vec3 &p, const Vec3 &d) const;
+  /// The same in x, y and z.
+  std::optional<std::pair<double, double>> span(const Vec3 &p, const Vec3 &d) const;
+};
+
+/// What a travel path's absent values may be assumed from: the frame of the
+/// feature it belongs to and the raw piece it is cut in.
+struct PathContext {
+  Placement frame;
+  std::optional<RawExtent> raw;
+  bool openEnds = false;  ///< both ends open: the path may run across the raw piece
+};
+
 /// Copies real attribute `attribute` of `from` into `to` as `irName`, made with
 /// `make` (Value::length, Value::angle, Value::ratio, ...), when it is present.
 inline void copyReal(Node &to, std::string_view irName, const Instance &from, std::string_view attribute,
@@ -53,8 +75,9 @@ public:
   /// Reports a missing or invalid attribute that lowering needs.
   void missing(const Instance &inst, std::string_view attribute, std::string_view why = {});
   /// Reports what lowering assumed for attribute `attribute` of `inst` (absent
-  /// or unusable in the file): `'depth' of ROUND_HOLE #28: <what>`, a warning
-  /// (an error with --strict). `what` says the value assumed and why.
+  /// or unusable in the file): `#28 round_hole: 'depth' <what>`, a warning
+  /// (an error with --strict). `what` says what the file has, the value
+  /// assumed and why: "absent; assumed 20 mm: ...".
   void assumed(const Instance &inst, std::string_view attribute, std::string_view what);
   /// A fresh symbol with `sigil`, from a STEP-NC id string or a fallback.
   std::string symbolFor(char sigil, const std::optional<std::string> &label, std::string_view fallback);
@@ -62,6 +85,13 @@ public:
   void stamp(Node &node, const Instance &inst, std::string_view labelAttribute = "its_id");
 
   // Unit conversion.
+  /// A plane_angle_measure as an IR angle (deg), in the file's angle unit.
+  Value angle(double planeAngle) const { return Value::angle(planeAngle * angleToDeg_); }
+  /// Copies angle attribute `attribute` of `from` into `to` as `irName`, when present.
+  void copyAngle(Node &to, std::string_view irName, const Instance &from, std::string_view attribute) const {
+    if (auto v = from.real(attribute))
+      to.set(std::string(irName), angle(*v));
+  }
   double feedMmPerMin(double speedMeasure) const { return speedMeasure * options_.units.speedToMmPerMin; }
   double spindleRevPerMin(double rotSpeed) const { return rotSpeed * options_.units.rotSpeedToRevPerMin; }
 
@@ -80,12 +110,23 @@ public:
   /// A profile (closed or open) as a profile node; null node kind on failure.
   std::optional<Node> profile(const Instance &profile);
   /// A travel path (linear_path, circular_path, general path) as a path node.
-  std::optional<Node> path(const Instance &travel);
+  /// With a context, a linear path's absent direction and distance are
+  /// assumed from it (reported); without, they are errors.
+  std::optional<Node> path(const Instance &travel, const PathContext *context = nullptr);
   /// Any bounded curve (polyline, trimmed curve, composite curve, circle,
   /// line, helix, B-spline) as a curve node.
   std::optional<Node> curve(const Instance &curve);
 
   // --- features (LowerFeatures.cpp) ------------------------------------------
+  /// The workpiece a feature is cut in: its_workpiece, or when that is absent
+  /// the project's only workpiece (reported as assumed). Null when neither.
+  Instance featureWorkpiece(const Instance &feature);
+  /// A slot whose depth plane gives no depth takes the depth of its swept
+  /// shape where the shape has one (a partial circular profile), reported.
+  void slotDepthFromProfile(Node &slot, const Instance &feature);
+  /// The raw piece of a workpiece as an extent; nullopt when it has no block.
+  std::optional<RawExtent> rawExtent(const Instance &workpiece);
+
   /// The feature's symbol, lowering it under its workpiece the first time.
   std::optional<std::string> feature(const Instance &feature);
 
@@ -100,11 +141,15 @@ public:
 
 private:
   std::optional<std::string> workpiece(const Instance &wp);
+  /// The BLOCK (or other bounding geometry) that stands for a workpiece's raw piece.
+  static Instance rawBounding(const Instance &wp);
   std::optional<std::string> setup(const Instance &setup);
   bool executable(const Instance &exe, Node &parent);
   std::optional<Node> workingstep(const Instance &ws);
   std::optional<Node> workplan(const Instance &wp);
   Node *findResource(const std::string &symbol);
+  /// Decides how the file's angles are read (options_.units.angles).
+  void chooseAngleUnit();
 
   const binding::BoundFile &bound_;
   DiagnosticEngine &diags_;
@@ -114,6 +159,8 @@ private:
   std::map<size_t, std::string> lowered_;  ///< instance index -> symbol of its resource node
   std::set<size_t> reported_;              ///< instances already reported unsupported
   std::set<size_t> workplansOnStack_;      ///< cycle guard for nested workplans
+  std::vector<Instance> projectWorkpieces_;  ///< the project's its_workpieces
+  double angleToDeg_ = 1.0;                  ///< plane_angle_measure to deg
 };
 
 } // namespace stepnc::lowering

@@ -11,6 +11,7 @@
 #include "frontend/binding/Binder.h"
 #include "ir/Node.h"
 
+#include <cstdint>
 #include <memory>
 
 namespace stepnc::lowering {
@@ -21,6 +22,12 @@ struct UnitConventions {
   double speedToMmPerMin = 60000.0;
   /// rot_speed_measure (spindle) to rev/min: 60 reads rev/s.
   double rotSpeedToRevPerMin = 60.0;
+  /// plane_angle_measure: ISO 14649 files are written in degrees, but some
+  /// generators write radians. Auto reads radians when every angle the file
+  /// gives is below 2 pi and none is a whole number of degrees (reported).
+  /// (No command-line option sets it yet.)
+  enum class Angle : uint8_t { Auto, Degree, Radian };
+  Angle angles = Angle::Auto;
 };
 
 struct LowerOptions {

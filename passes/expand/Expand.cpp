@@ -143,7 +143,8 @@ void Expander::assumed(const Node &ws, const Node &at, const std::string &messag
   // Located at what the file gives (the approach, the strategy); a node
   // made by the pass or without an origin falls back to the step's.
   const Node &where = at.origin.loc.valid() ? at : ws;
-  diags->warning(where.origin.loc, ws.kindName() + " " + ws.symbol + ": " + message).entity(where.origin.entityId);
+  diags->assumption(where.origin.loc, ws.kindName() + " " + ws.symbol + ": " + message)
+      .entity(where.origin.entityId);
 }
 
 namespace {
@@ -248,7 +249,7 @@ private:
       }
       const ir::FeatureShape &s = *shape.shape;
       const double secplane = ws.number("secplane").value_or(0);
-      if (secplane < s.top) {
+      if (secplane < s.top && !raiseSecplaneOverAir(ws, *op, *feature, s, secplane, moves)) {
         x_.report(ws, "its security plane z=" + formatFixed(secplane, 4) + " mm is below the top of " + s.symbol +
                           " (z=" + formatFixed(s.top, 4) + " mm): there is no safe height to travel at");
         return;
@@ -258,6 +259,27 @@ private:
     }
     if (expanded)
       x_.attach(ws, std::move(moves));
+  }
+
+  /// A feature wholly above the raw piece (a generator's misplaced feature:
+  /// its machining cuts air) may have its security plane below its top and
+  /// still above the material: the step then travels at the feature's top
+  /// plus the retract plane, reported. False (nothing changed) otherwise.
+  bool raiseSecplaneOverAir(Node &ws, const Node &op, const Node &feature, const ir::FeatureShape &s,
+                            double secplane, Node &moves) {
+    const std::optional<ir::RawBlock> raw = ir::rawBlock(ir::workpieceOf(*x_.module, feature));
+    if (!raw || secplane < raw->top || s.bottom < raw->top)
+      return false;
+    const double raised = s.top + op.number("retract_plane").value_or(kDefaultClearance);
+    x_.assumed(ws, ws,
+               s.symbol + " lies wholly above the raw piece (its floor z=" + formatFixed(s.bottom, 4) +
+                   " mm, the raw piece's top z=" + formatFixed(raw->top, 4) +
+                   " mm): its machining cuts no material. Its security plane z=" + formatFixed(secplane, 4) +
+                   " mm is below its top z=" + formatFixed(s.top, 4) + " mm; assumed z=" + formatFixed(raised, 4) +
+                   " mm (the top plus the retract plane) for this workingstep");
+    ws.set("secplane", ir::Value::length(raised));
+    moves.set("secplane", ir::Value::length(raised));
+    return true;
   }
 
   /// Runs the family on the step; when it made moves without an error,

@@ -97,7 +97,7 @@ public:
   /// as the operation's approach) that workingstep `ws` is expanded on an
   /// assumption: "workingstep @w: approach plunge_zigzag is not supported:
   /// plunging along the tool axis". The moves are those the message names;
-  /// the warning only says so (--warnings-as-errors stops the compile there).
+  /// the warning only says so (--strict makes it an error).
   void assumed(const Node &ws, const Node &at, const std::string &message);
 };
 
