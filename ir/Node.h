@@ -121,9 +121,22 @@ struct Node {
 };
 
 /// A whole program: the root node (`project`) and the file it came from.
+/// How lowering read the source file's implicit units (ISO 14649 leaves the
+/// unit of speed_measure and rot_speed_measure to the file): the factors to
+/// the IR's mm/min and rev/min. What writes values back into the file (the
+/// machine-optimised STEP-NC) writes them in the file's own units.
+struct SourceUnits {
+  double feedToMmPerMin = 60000;      ///< a technology's feedrate (m/s)
+  double cutspeedToMmPerMin = 60000;  ///< its cutspeed (m/s)
+  double spindleToRevPerMin = 60;     ///< its spindle (rev/s)
+};
+
 struct Module {
   Node root{Kind::Project};
   std::string sourceName;
+  /// Set by lowering; not part of the IR text (IR read from text has the
+  /// standard's units).
+  SourceUnits sourceUnits;
 };
 
 /// Structural equality (kinds, symbols, labels, attributes, children; not origins).

@@ -12,7 +12,6 @@
 // round-trip reals).
 #include "backends/step-nc/OptimisedFile.h"
 
-#include "frontend/lowering/Lowering.h"
 #include "frontend/part21/Writer.h"
 #include "ir/Kinds.h"
 #include "ir/Program.h"
@@ -154,7 +153,8 @@ std::string_view toolpathType(std::string_view role, bool rapid) {
 /// Writes the moves of workingsteps as toolpath lists.
 class ToolpathWriter {
 public:
-  ToolpathWriter(Instances &out, DiagnosticEngine &diags) : out_(out), diags_(diags) {}
+  ToolpathWriter(Instances &out, const ir::SourceUnits &units, DiagnosticEngine &diags)
+      : out_(out), units_(units), diags_(diags) {}
 
   /// The TOOLPATH_LIST of `ws`'s `moves`, in the frame of its feature; none
   /// (after an error) when a move cannot be written, or (silently) when the
@@ -318,14 +318,14 @@ private:
   /// A milling technology with `feed` (mm/min) and the workingstep's spindle,
   /// shared by every toolpath that has both.
   InstanceId technology(double feed) {
-    const lowering::UnitConventions units;
+    // In the units the input was read in, so that the file stays consistent.
     const auto key = std::make_tuple(feed, spindle_, feedReference_);
     if (auto it = technologies_.find(key); it != technologies_.end())
       return it->second;
     const double speed =
-        preimage(feed, feed / units.speedToMmPerMin, [&](double v) { return v * units.speedToMmPerMin; });
-    const double spindle = preimage(spindle_, spindle_ / units.rotSpeedToRevPerMin,
-                                    [&](double v) { return v * units.rotSpeedToRevPerMin; });
+        preimage(feed, feed / units_.feedToMmPerMin, [&](double v) { return v * units_.feedToMmPerMin; });
+    const double spindle = preimage(spindle_, spindle_ / units_.spindleToRevPerMin,
+                                    [&](double v) { return v * units_.spindleToRevPerMin; });
     const InstanceId id = out_.add("MILLING_TECHNOLOGY", Instances::real(speed) + ",." + feedReference_ + ".,$," +
                                                              Instances::real(spindle) + ",$,.F.,.F.,.F.,$");
     technologies_.emplace(key, id);
@@ -333,6 +333,7 @@ private:
   }
 
   Instances &out_;
+  const ir::SourceUnits &units_;
   DiagnosticEngine &diags_;
   const Node *ws_ = nullptr;
   const ir::PlaneFrame *frame_ = nullptr;
@@ -417,7 +418,7 @@ std::string writeOptimisedPart21(const p21::Part21File &input, const ir::Module 
   if (!ok)
     return {};
   Instances out(largestId(input) + 1);
-  ToolpathWriter writer(out, diags);
+  ToolpathWriter writer(out, module.sourceUnits, diags);
   std::map<InstanceId, InstanceId> toolpathOf; // operation -> its new toolpath list
   std::map<InstanceId, const Node *> writtenBy;
   std::vector<const Node *> steps;

@@ -107,17 +107,16 @@ std::optional<std::string> Lowerer::tool(const Instance &t) {
 
 namespace {
 
-// Feeds and cutting speeds whose unit the ARM leaves implicit are read as m/s
-// (UnitConventions). A converted value far outside what machines do means the
-// file uses another convention: say so, with the value as read.
-void checkPlausible(Lowerer &l, const Instance &tech, std::string_view attribute, double mmPerMin,
-                    double low, double high) {
-  if (mmPerMin == 0.0 || (std::abs(mmPerMin) >= low && std::abs(mmPerMin) <= high))
+// Feeds, cutting speeds and spindle speeds whose unit the ARM leaves implicit
+// are read in the unit chosen for the file (Lowerer::chooseSpeedUnits). A
+// converted value still far outside what machines do: say so, as read.
+void checkPlausible(Lowerer &l, const Instance &tech, std::string_view attribute, double value, double low,
+                    double high, const char *unit) {
+  if (value == 0.0 || (std::abs(value) >= low && std::abs(value) <= high))
     return;
-  char text[160];
-  std::snprintf(text, sizeof text, "%s %g read as %.1f mm/min (the value taken as m/s), outside %g..%g mm/min: "
-                "the file may use another unit", std::string(attribute).c_str(), *tech.real(attribute),
-                mmPerMin, low, high);
+  char text[200];
+  std::snprintf(text, sizeof text, "%s %g read as %.1f %s, outside %g..%g %s: the file may use another unit",
+                std::string(attribute).c_str(), *tech.real(attribute), value, unit, low, high, unit);
   l.diags().warning(tech.attrLoc(attribute), text).entity(tech.id(), "MILLING_TECHNOLOGY");
 }
 
@@ -212,17 +211,20 @@ Node technology(Lowerer &l, const Instance &tech) {
   if (auto f = tech.real("feedrate")) {
     const double feed = l.feedMmPerMin(*f);
     n.set("feed", Value::feed(feed));
-    checkPlausible(l, tech, "feedrate", feed, 1.0, 100000.0);
+    checkPlausible(l, tech, "feedrate", feed, 1.0, 100000.0, "mm/min");
   }
   if (auto fz = tech.real("feedrate_per_tooth"))
     n.set("feed_per_tooth", Value::length(*fz));
   if (auto vc = tech.real("cutspeed")) {
-    const double speed = l.feedMmPerMin(*vc);
+    const double speed = l.cuttingSpeedMmPerMin(*vc);
     n.set("cutting_speed", Value::feed(speed));
-    checkPlausible(l, tech, "cutspeed", speed, 1000.0, 3000000.0);
+    checkPlausible(l, tech, "cutspeed", speed, 1000.0, 3000000.0, "mm/min");
   }
-  if (auto s = tech.real("spindle"))
-    n.set("spindle", Value::spindle(l.spindleRevPerMin(*s)));
+  if (auto s = tech.real("spindle")) {
+    const double rpm = l.spindleRevPerMin(*s);
+    n.set("spindle", Value::spindle(rpm));
+    checkPlausible(l, tech, "spindle", rpm, 1.0, 100000.0, "rev/min");
+  }
   n.set("feed_reference", Value::word(tech.enumeration("feedrate_reference").value_or("tcp")));
   copyFlag(n, "sync_spindle_feed", tech, "synchronize_spindle_with_feed");
   copyFlag(n, "inhibit_feed_override", tech, "inhibit_feedrate_override");

@@ -341,6 +341,124 @@ void Lowerer::chooseAngleUnit() {
       .entity(inst.id(), std::string(inst.entityName()));
 }
 
+namespace {
+
+/// A reading of a unit the ARM leaves implicit: its name and its factor to
+/// the IR's unit (mm/min, rev/min).
+struct UnitReading {
+  std::string_view name;
+  double factor;
+};
+
+/// The readings of speed_measure and rot_speed_measure, the standard's first.
+constexpr UnitReading kSpeedReadings[] = {{"m/s", 60000}, {"mm/min", 1}, {"m/min", 1000}, {"mm/s", 60}};
+constexpr UnitReading kSpindleReadings[] = {{"rev/s", 60}, {"rev/min", 1}};
+
+/// One value of the file to be read: where it is and the tool it turns.
+struct SpeedValue {
+  Instance tech;
+  std::string_view attribute;
+  double value;
+  double toolDiameter;  ///< mm, 0 when not known
+};
+
+/// The reading under which every value is plausible, else the one under
+/// which most are (the first on ties: the standard's).
+template <size_t N, class Plausible>
+size_t chooseReading(const UnitReading (&readings)[N], const std::vector<SpeedValue> &values, Plausible plausible) {
+  size_t best = 0, bestCount = 0;
+  for (size_t r = 0; r < N; ++r) {
+    size_t count = 0;
+    for (const SpeedValue &v : values)
+      count += plausible(v, v.value * readings[r].factor) ? 1 : 0;
+    if (count == values.size())
+      return r;
+    if (count > bestCount) {
+      best = r;
+      bestCount = count;
+    }
+  }
+  return best;
+}
+
+} // namespace
+
+void Lowerer::chooseSpeedUnits() {
+  // Every technology an operation uses, with its tool's diameter.
+  std::vector<SpeedValue> feeds, cutspeeds, spindles;
+  const auto &entries = bound_.file().entries();
+  for (size_t i = 0; i < entries.size(); ++i) {
+    Instance op(bound_, i);
+    if (!op.isA("machining_operation"))
+      continue;
+    Instance tech = op.ref("its_technology");
+    if (!tech)
+      continue;
+    double diameter = 0;
+    if (Instance dim = op.ref("its_tool").ref("its_tool_body").ref("dimension"))
+      diameter = dim.real("diameter").value_or(0);
+    for (auto [attribute, list] : {std::pair{"feedrate", &feeds}, {"cutspeed", &cutspeeds}, {"spindle", &spindles}})
+      if (auto v = tech.real(attribute); v && *v != 0)
+        list->push_back({tech, attribute, *v, diameter});
+  }
+  // Plausible: feeds of 1 mm/min to 60 m/min; cutting speeds of 1 to 1500
+  // m/min; spindle speeds of 10 to 60000 rev/min that give such a cutting
+  // speed on the tool, when its diameter is known.
+  auto plausibleCutspeed = [](double mmPerMin) { return mmPerMin >= 1000 && mmPerMin <= 1.5e6; };
+  const size_t feed = chooseReading(kSpeedReadings, feeds, [](const SpeedValue &, double f) {
+    return std::abs(f) >= 1 && std::abs(f) <= 60000;
+  });
+  const size_t cutspeed = chooseReading(kSpeedReadings, cutspeeds,
+                                        [&](const SpeedValue &, double vc) { return plausibleCutspeed(std::abs(vc)); });
+  auto plausibleSpindle = [&](const SpeedValue &v, double n) {
+    n = std::abs(n);
+    return n >= 10 && n <= 60000 && (v.toolDiameter <= 0 || plausibleCutspeed(std::numbers::pi * v.toolDiameter * n));
+  };
+  const size_t spindle = chooseReading(kSpindleReadings, spindles, plausibleSpindle);
+  const UnitConventions &u = options_.units;
+  feedToMmPerMin_ = u.speedToMmPerMin > 0 ? u.speedToMmPerMin : kSpeedReadings[feed].factor;
+  cutspeedToMmPerMin_ = u.speedToMmPerMin > 0 ? u.speedToMmPerMin : kSpeedReadings[cutspeed].factor;
+  spindleToRevPerMin_ = u.rotSpeedToRevPerMin > 0 ? u.rotSpeedToRevPerMin : kSpindleReadings[spindle].factor;
+  // Say which reading was taken when it is not the standard's.
+  auto report = [&](const std::vector<SpeedValue> &values, const UnitReading &chosen, const UnitReading &standard,
+                    std::string_view what, std::string_view unit) {
+    if (chosen.factor == standard.factor || values.empty())
+      return;
+    const SpeedValue &v = values.front();
+    diags_
+        .assumption(v.tech.attrLoc(v.attribute),
+                    std::string(what) + " read as " + std::string(chosen.name) + ", not " + std::string(standard.name) +
+                        ": as " + std::string(standard.name) + " they are not what a machine does (" +
+                        std::string(v.attribute) + " " + formatFixed(v.value, 4) + " of " + hashId(v.tech.id()) +
+                        ": " + formatFixed(std::abs(v.value) * chosen.factor, 1) + " " + std::string(unit) + "; as " +
+                        std::string(standard.name) + ", " + formatFixed(std::abs(v.value) * standard.factor, 1) + ")")
+        .entity(v.tech.id(), std::string(v.tech.entityName()));
+  };
+  if (u.speedToMmPerMin <= 0) {
+    report(feeds, kSpeedReadings[feed], kSpeedReadings[0], "feeds", "mm/min");
+    report(cutspeeds, kSpeedReadings[cutspeed], kSpeedReadings[0], "cutting speeds", "mm/min");
+  }
+  if (u.rotSpeedToRevPerMin <= 0)
+    report(spindles, kSpindleReadings[spindle], kSpindleReadings[0], "spindle speeds", "rev/min");
+  // A spindle speed that no reading makes plausible with the others: say
+  // what it gives on its tool (feeds and cutting speeds are checked as they
+  // are lowered).
+  for (const SpeedValue &v : spindles) {
+    const double n = std::abs(v.value) * spindleToRevPerMin_;
+    if (plausibleSpindle(v, n))
+      continue;
+    diags_
+        .warning(v.tech.attrLoc(v.attribute),
+                 "spindle " + formatFixed(v.value, 4) + " read as " + formatFixed(n, 1) + " rev/min" +
+                     (v.toolDiameter > 0 ? ", a cutting speed of " +
+                                               formatFixed(std::numbers::pi * v.toolDiameter * n / 1000, 1) +
+                                               " m/min on its " + formatFixed(v.toolDiameter, 4) + " mm tool"
+                                         : std::string()) +
+                     ": not what a machine does, in this or any unit the file's other speeds allow")
+        .entity(v.tech.id(), std::string(v.tech.entityName()));
+  }
+}
+
 std::unique_ptr<ir::Module> Lowerer::run() {
   const auto &entries = bound_.file().entries();
   std::vector<Instance> projects;
@@ -359,8 +477,10 @@ std::unique_ptr<ir::Module> Lowerer::run() {
         .note(projects[0].loc(), "the first PROJECT is here");
   const Instance &project = projects[0];
   chooseAngleUnit();
+  chooseSpeedUnits();
   module_ = std::make_unique<ir::Module>();
   module_->sourceName = std::string(bound_.file().source().name());
+  module_->sourceUnits = {feedToMmPerMin_, cutspeedToMmPerMin_, spindleToRevPerMin_};
   stamp(module_->root, project);
   projectWorkpieces_ = project.refs("its_workpieces");
   for (const Instance &wp : projectWorkpieces_)

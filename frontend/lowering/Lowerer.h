@@ -92,8 +92,9 @@ public:
     if (auto v = from.real(attribute))
       to.set(std::string(irName), angle(*v));
   }
-  double feedMmPerMin(double speedMeasure) const { return speedMeasure * options_.units.speedToMmPerMin; }
-  double spindleRevPerMin(double rotSpeed) const { return rotSpeed * options_.units.rotSpeedToRevPerMin; }
+  double feedMmPerMin(double speedMeasure) const { return speedMeasure * feedToMmPerMin_; }
+  double cuttingSpeedMmPerMin(double speedMeasure) const { return speedMeasure * cutspeedToMmPerMin_; }
+  double spindleRevPerMin(double rotSpeed) const { return rotSpeed * spindleToRevPerMin_; }
 
   // --- geometry (LowerGeometry.cpp) ----------------------------------------
   std::optional<Vec3> point(const Instance &cartesianPoint);
@@ -150,6 +151,8 @@ private:
   Node *findResource(const std::string &symbol);
   /// Decides how the file's angles are read (options_.units.angles).
   void chooseAngleUnit();
+  /// Decides how the file's feeds, cutting speeds and spindle speeds are read.
+  void chooseSpeedUnits();
 
   const binding::BoundFile &bound_;
   DiagnosticEngine &diags_;
@@ -161,6 +164,9 @@ private:
   std::set<size_t> workplansOnStack_;      ///< cycle guard for nested workplans
   std::vector<Instance> projectWorkpieces_;  ///< the project's its_workpieces
   double angleToDeg_ = 1.0;                  ///< plane_angle_measure to deg
+  double feedToMmPerMin_ = 60000.0;          ///< a technology's feedrate to mm/min
+  double cutspeedToMmPerMin_ = 60000.0;      ///< its cutspeed to mm/min
+  double spindleToRevPerMin_ = 60.0;         ///< its spindle to rev/min
 };
 
 } // namespace stepnc::lowering

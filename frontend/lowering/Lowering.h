@@ -18,10 +18,14 @@ namespace stepnc::lowering {
 
 /// How ISO 14649 quantities whose unit the ARM leaves implicit are read.
 struct UnitConventions {
-  /// speed_measure (feedrate, cutting speed) to mm/min: 60000 reads m/s.
-  double speedToMmPerMin = 60000.0;
-  /// rot_speed_measure (spindle) to rev/min: 60 reads rev/s.
-  double rotSpeedToRevPerMin = 60.0;
+  /// speed_measure (feedrate, cutting speed) to mm/min: 60000 reads m/s, the
+  /// reading of ISO 14649-11's Example 1. 0: chosen per file by plausibility
+  /// (feeds and cutting speeds separately: some generators write the feed in
+  /// m/s and the cutting speed in m/min), reported when not m/s.
+  double speedToMmPerMin = 0.0;
+  /// rot_speed_measure (spindle) to rev/min: 60 reads rev/s. 0: chosen per
+  /// file by plausibility (rev/s or rev/min), reported when not rev/s.
+  double rotSpeedToRevPerMin = 0.0;
   /// plane_angle_measure: ISO 14649 files are written in degrees, but some
   /// generators write radians. Auto reads radians when every angle the file
   /// gives is below 2 pi and none is a whole number of degrees (reported).
