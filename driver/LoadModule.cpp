@@ -1,10 +1,16 @@
 #include "driver/LoadModule.h"
 
-#include "frontend/binding/Binder.h"
 #include "frontend/lowering/Lowering.h"
 #include "ir/Parser.h"
 
 namespace stepnc::driver {
+
+binding::BindOptions bindOptions(const DiagnosticEngine &diags) {
+  binding::BindOptions options;
+  options.strict = diags.strict();
+  options.lenient = !diags.strict();
+  return options;
+}
 
 std::unique_ptr<ir::Module> loadModule(std::unique_ptr<SourceFile> &source, const SchemaSelection &schemas,
                                        DiagnosticEngine &diags, std::string &usageError,
@@ -30,9 +36,7 @@ std::unique_ptr<ir::Module> loadModule(std::unique_ptr<SourceFile> &source, cons
                  " without a schema: give its EXPRESS file with --schema FILE.exp";
     return nullptr;
   }
-  binding::BindOptions bindOptions;
-  bindOptions.lenient = true;
-  auto bound = binding::bind(*file, *model, *schema, diags, bindOptions);
+  auto bound = binding::bind(*file, *model, *schema, diags, bindOptions(diags));
   if (diags.hasErrors())
     return nullptr;
   auto module = lowering::lowerToFeatureIR(*bound, diags);

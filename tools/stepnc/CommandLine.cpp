@@ -19,6 +19,13 @@ void addDiagnosticOptions(CLI::App &cmd, DiagnosticOptions &opts) {
   cmd.add_flag("--warnings-as-errors", opts.warningsAsErrors, "Treat warnings as errors");
 }
 
+void addStrictOption(CLI::App &cmd, DiagnosticOptions &opts) {
+  cmd.add_flag("--strict", opts.strict,
+               "Make every assumption an error: '$' where the schema wants a value, an alias for an\n"
+               "entity name, an abstract entity instantiated, a value lowering had to assume (without\n"
+               "--strict each is a warning that ends '--strict makes it an error')");
+}
+
 void addSchemaOptions(CLI::App &cmd, driver::SchemaOptions &opts) {
   cmd.add_option("--schema", opts.files,
                  "Check against the schema(s) in this EXPRESS file instead of the built-in ISO 14649 "
@@ -34,6 +41,7 @@ DiagnosticSession::DiagnosticSession(const DiagnosticOptions &opts) {
   engine_ = std::make_unique<DiagnosticEngine>(*consumer_);
   engine_->setMaxErrors(opts.maxErrors);
   engine_->setWarningsAsErrors(opts.warningsAsErrors);
+  engine_->setStrict(opts.strict);
 }
 
 DiagnosticSession::~DiagnosticSession() { engine_->finish(); }

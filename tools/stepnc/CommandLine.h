@@ -27,9 +27,16 @@ struct DiagnosticOptions {
   std::string format = "text";  ///< "text" or "json"
   unsigned maxErrors = 50;
   bool warningsAsErrors = false;
+  /// --strict: what stepnc assumes to read an imperfect STEP-NC file is an
+  /// error, not a warning.
+  bool strict = false;
 };
 
 void addDiagnosticOptions(CLI::App &cmd, DiagnosticOptions &opts);
+
+/// --strict, for the commands that read STEP-NC (compile, check, convert,
+/// opt, sim).
+void addStrictOption(CLI::App &cmd, DiagnosticOptions &opts);
 
 /// --schema FILE.exp (repeatable) and --no-schema.
 void addSchemaOptions(CLI::App &cmd, driver::SchemaOptions &opts);

@@ -270,6 +270,7 @@ int runCompile(const CompileOptions &opts) {
   // expectations written in the input's comments (docs/diagnostics.md).
   DiagnosticCollector collector;
   DiagnosticEngine collecting(collector);
+  collecting.setStrict(opts.diag.strict);
   const int rc = compileSource(opts, emit, source, backend.get(), collecting);
   if (rc == kExitUsage)
     return rc;
@@ -285,6 +286,7 @@ void addCommonOptions(CLI::App &cmd, CompileOptions &opts) {
                "(exit 0 when they match) instead of printing them");
   addSchemaOptions(cmd, opts.schema);
   addDiagnosticOptions(cmd, opts.diag);
+  addStrictOption(cmd, opts.diag);
 }
 
 void registerCompile(CLI::App &app, std::function<void(int)> setResult) {

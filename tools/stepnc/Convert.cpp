@@ -81,6 +81,7 @@ void registerConvert(CLI::App &app, std::function<void(int)> setResult) {
   cmd->add_option("-o,--output", opts->output, "Output file ('-' for standard output)")->required();
   addSchemaOptions(*cmd, opts->schema);
   addDiagnosticOptions(*cmd, opts->diag);
+  addStrictOption(*cmd, opts->diag);
   cmd->callback([opts, setResult] { setResult(runConvert(*opts)); });
 }
 

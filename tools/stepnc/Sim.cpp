@@ -226,6 +226,7 @@ void registerSim(CLI::App &app, std::function<void(int)> setResult) {
   cmd->add_option("-o,--output", opts->output, "Report file ('-', the default, for standard output)");
   addSchemaOptions(*cmd, opts->schema);
   addDiagnosticOptions(*cmd, opts->diag);
+  addStrictOption(*cmd, opts->diag);
   cmd->callback([opts, setResult] { setResult(runSim(*opts)); });
 }
 
