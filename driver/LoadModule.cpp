@@ -30,10 +30,13 @@ std::unique_ptr<ir::Module> loadModule(std::unique_ptr<SourceFile> &source, cons
   if (diags.hasErrors())
     return nullptr;
   const express::Model *model = nullptr;
-  const express::Schema *schema = schemas.select(*file, diags, model);
+  const express::Schema *schema = schemas.selectToCompile(*file, diags, model);
   if (!schema) {
-    usageError = "cannot compile " + std::string(source->name()) +
-                 " without a schema: give its EXPRESS file with --schema FILE.exp";
+    // A schema stepnc does not compile is the file's error, reported at its
+    // FILE_SCHEMA; --no-schema is the caller's.
+    if (!diags.hasErrors())
+      usageError = "cannot compile " + std::string(source->name()) +
+                   " with --no-schema: lowering reads the file through its schema";
     return nullptr;
   }
   auto bound = binding::bind(*file, *model, *schema, diags, bindOptions(diags));

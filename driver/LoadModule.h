@@ -25,10 +25,11 @@ binding::BindOptions bindOptions(const DiagnosticEngine &diags);
 /// Reads `source` as IR text (a file that starts with the IR's comment line
 /// or `project`) or as STEP-NC. Part 28 XML is translated first and `source`
 /// becomes the translation (whose diagnostics point into the XML); Part 21 is
-/// bound to its schema as bindOptions(diags) says and lowered. Returns null after reporting the input's errors to `diags`, or
-/// with `usageError` set when the caller is at fault (no schema for the
-/// file). `file`, when given, receives the Part 21 file read (null for IR
-/// text).
+/// bound to its schema as bindOptions(diags) says and lowered. Returns null
+/// after reporting the input's errors to `diags` (a FILE_SCHEMA that names
+/// no schema stepnc compiles is one, located there), or with `usageError` set
+/// when the caller is at fault (--no-schema). `file`, when given, receives
+/// the Part 21 file read (null for IR text).
 std::unique_ptr<ir::Module> loadModule(std::unique_ptr<SourceFile> &source, const SchemaSelection &schemas,
                                        DiagnosticEngine &diags, std::string &usageError,
                                        std::unique_ptr<p21::Part21File> *file = nullptr);
