@@ -1,10 +1,16 @@
 #include "driver/LoadModule.h"
 
-#include "frontend/binding/Binder.h"
 #include "frontend/lowering/Lowering.h"
 #include "ir/Parser.h"
 
 namespace stepnc::driver {
+
+binding::BindOptions bindOptions(const DiagnosticEngine &diags) {
+  binding::BindOptions options;
+  options.strict = diags.strict();
+  options.lenient = !diags.strict();
+  return options;
+}
 
 std::unique_ptr<ir::Module> loadModule(std::unique_ptr<SourceFile> &source, const SchemaSelection &schemas,
                                        DiagnosticEngine &diags, std::string &usageError,
@@ -24,15 +30,16 @@ std::unique_ptr<ir::Module> loadModule(std::unique_ptr<SourceFile> &source, cons
   if (diags.hasErrors())
     return nullptr;
   const express::Model *model = nullptr;
-  const express::Schema *schema = schemas.select(*file, diags, model);
+  const express::Schema *schema = schemas.selectToCompile(*file, diags, model);
   if (!schema) {
-    usageError = "cannot compile " + std::string(source->name()) +
-                 " without a schema: give its EXPRESS file with --schema FILE.exp";
+    // A schema stepnc does not compile is the file's error, reported at its
+    // FILE_SCHEMA; --no-schema is the caller's.
+    if (!diags.hasErrors())
+      usageError = "cannot compile " + std::string(source->name()) +
+                   " with --no-schema: lowering reads the file through its schema";
     return nullptr;
   }
-  binding::BindOptions bindOptions;
-  bindOptions.lenient = true;
-  auto bound = binding::bind(*file, *model, *schema, diags, bindOptions);
+  auto bound = binding::bind(*file, *model, *schema, diags, bindOptions(diags));
   if (diags.hasErrors())
     return nullptr;
   auto module = lowering::lowerToFeatureIR(*bound, diags);

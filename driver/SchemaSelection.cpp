@@ -54,6 +54,35 @@ const express::Schema *SchemaSelection::select(const p21::Part21File &file, Diag
   return nullptr;
 }
 
+const express::Schema *SchemaSelection::selectToCompile(const p21::Part21File &file, DiagnosticEngine &diags,
+                                                        const express::Model *&model) const {
+  if (opts_.none || !opts_.files.empty())
+    return select(file, diags, model);
+  const std::vector<std::string> names = file.schemaNames();
+  if (const express::Schema *s = express::builtinSchemaFor(names)) {
+    model = &express::builtinModel();
+    return s;
+  }
+  // Not a STEP-NC file as far as stepnc knows: say what the file declares
+  // and what would be compiled, at the declaration.
+  const p21::HeaderEntity *header = file.headerEntity("FILE_SCHEMA");
+  std::string listed, known;
+  for (const std::string &n : names)
+    listed += (listed.empty() ? "" : ", ") + n;
+  for (std::string_view n : express::builtinSchemaNames())
+    known += (known.empty() ? "" : ", ") + std::string(n);
+  std::string declared = names.empty() ? "FILE_SCHEMA names no schema"
+                                       : "FILE_SCHEMA names " + listed +
+                                             (names.size() == 1 ? ", which is not" : ", none of which is") +
+                                             " a schema stepnc compiles";
+  if (names.size() == 1 && express::upper(names[0]) == "INTEGRATED_CNC_SCHEMA")
+    declared += " (it is the AP238 AIM, the mapped form; stepnc reads the ARM)";
+  diags.error(file.loc(header ? header->begin : 0),
+              declared + ": stepnc compiles ISO 14649 / AP238 STEP-NC files, whose FILE_SCHEMA names " + known +
+                  "; 'stepnc check --schema FILE.exp' checks a file against another EXPRESS schema");
+  return nullptr;
+}
+
 const express::Schema *SchemaSelection::find(const std::vector<std::string> &names,
                                              const express::Model *&model) const {
   if (opts_.none)

@@ -32,6 +32,14 @@ public:
   const express::Schema *select(const p21::Part21File &file, DiagnosticEngine &diags,
                                 const express::Model *&model) const;
 
+  /// The schema to compile `file` against: select's, except that a file
+  /// whose FILE_SCHEMA names no built-in schema (and no --schema was given)
+  /// is an error located at its FILE_SCHEMA entry that names what the file
+  /// declares and what stepnc compiles. Null with that error, or silently
+  /// with --no-schema (the caller's mistake: nothing to lower through).
+  const express::Schema *selectToCompile(const p21::Part21File &file, DiagnosticEngine &diags,
+                                         const express::Model *&model) const;
+
   /// The schema for a document naming `names`, without diagnostics: with
   /// --schema the one named (else the first given), else the built-in one the
   /// names answer to (the ARM when no name is given); null with --no-schema or

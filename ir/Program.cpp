@@ -118,6 +118,13 @@ std::vector<const Node *> programOrder(const Module &module) {
   return out;
 }
 
+bool hasMachiningSteps(const Module &module) {
+  for (const Node *e : programOrder(module))
+    if (e->kind == Kind::Workingstep || e->kind == Kind::RapidMovement || e->is(Trait::ControlFlow))
+      return true;
+  return false;
+}
+
 const Node *operationOf(const Node &step) { return step.childIn(Category::Operation); }
 
 Node *operationOf(Node &step) { return const_cast<Node *>(step.childIn(Category::Operation)); }

@@ -24,6 +24,13 @@ namespace stepnc::ir {
 /// (requireThreeAxisMilling).
 std::vector<const Node *> programOrder(const Module &module);
 
+/// Whether the program has a step that moves the tool: a workingstep or a
+/// rapid movement among its executables (control flow counts, for what its
+/// branches may hold). An empty workplan, or one of stops and messages only,
+/// has none: an empty program, which every target writes as one with nothing
+/// to move.
+bool hasMachiningSteps(const Module &module);
+
 /// Calls `visit(step, setup)` for every workingstep and rapid movement (the
 /// executables that get moves) under the module's workplans, in the order
 /// written: into nested workplans, and into the bodies and branches of

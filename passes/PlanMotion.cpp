@@ -30,6 +30,10 @@ public:
       diags.error({}, "plan-motion: " + why);
       return {false, false};
     }
+    // An empty program has nothing to plan, and is no mistake: the native
+    // target writes it with no segments.
+    if (!ir::hasMachiningSteps(module))
+      return {true, false};
     const ir::ProgramPath program = ir::programPath(module);
     if (program.path.moves.empty()) {
       diags.warning({}, "plan-motion: the program has no moves to plan (run expand-strategies first)");

@@ -10,6 +10,38 @@ namespace stepnc {
 
 OutputFile::~OutputFile() { discard(); }
 
+bool OutputFile::writable(const std::string &path, std::string &error) {
+  if (path == "-")
+    return true;
+  struct stat st {};
+  if (::stat(path.c_str(), &st) == 0) {
+    if (S_ISDIR(st.st_mode)) {
+      error = "cannot write '" + path + "': it is a directory";
+      return false;
+    }
+    // access() answers for the user (root may write anything); a file with
+    // no write permission at all is read-only for root too.
+    const bool noOneWrites = (st.st_mode & (S_IWUSR | S_IWGRP | S_IWOTH)) == 0;
+    if (::access(path.c_str(), W_OK) != 0 || (S_ISREG(st.st_mode) && noOneWrites)) {
+      error = "cannot write '" + path + "': the file is read-only; it is left as it is";
+      return false;
+    }
+    return true;
+  }
+  // A new file: its folder must exist and take it.
+  const size_t slash = path.find_last_of('/');
+  const std::string folder = slash == std::string::npos ? "." : slash == 0 ? "/" : path.substr(0, slash);
+  if (::stat(folder.c_str(), &st) != 0 || !S_ISDIR(st.st_mode)) {
+    error = "cannot create '" + path + "': the folder '" + folder + "' does not exist";
+    return false;
+  }
+  if (::access(folder.c_str(), W_OK | X_OK) != 0) {
+    error = "cannot create '" + path + "': " + std::strerror(errno);
+    return false;
+  }
+  return true;
+}
+
 bool OutputFile::open(const std::string &path, std::string &error) {
   path_ = path;
   if (path == "-") {
@@ -17,6 +49,8 @@ bool OutputFile::open(const std::string &path, std::string &error) {
     file_ = stdout;
     return true;
   }
+  if (!writable(path, error))
+    return false;
   struct stat st {};
   if (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
     if (S_ISDIR(st.st_mode)) {
@@ -86,10 +120,16 @@ bool OutputFile::commit(std::string &error) {
     discard();
     return false;
   }
-  // mkstemp creates 0600; give the result the usual permissions.
-  mode_t mask = ::umask(0);
-  ::umask(mask);
-  ::chmod(tempPath_.c_str(), 0666 & ~mask);
+  // mkstemp creates 0600: a file replaced keeps its permissions, a new one
+  // gets the usual ones.
+  struct stat st {};
+  if (::stat(path_.c_str(), &st) == 0 && S_ISREG(st.st_mode)) {
+    ::chmod(tempPath_.c_str(), st.st_mode & 07777);
+  } else {
+    mode_t mask = ::umask(0);
+    ::umask(mask);
+    ::chmod(tempPath_.c_str(), 0666 & ~mask);
+  }
   if (std::rename(tempPath_.c_str(), path_.c_str()) != 0) {
     error = "cannot write '" + path_ + "': " + std::strerror(errno);
     discard();

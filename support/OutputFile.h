@@ -2,7 +2,9 @@
 // file beside the target and renamed over it only when complete, so a failure
 // never leaves a partial file behind. "-" means standard output; a target that
 // exists and is not a regular file (a device such as /dev/null, a FIFO) is
-// written directly, since renaming over it would replace the device.
+// written directly, since renaming over it would replace the device. A
+// read-only target is refused rather than renamed over; a replaced file keeps
+// its permissions.
 #pragma once
 
 #include <cstdio>
@@ -19,8 +21,16 @@ public:
   OutputFile(const OutputFile &) = delete;
   OutputFile &operator=(const OutputFile &) = delete;
 
-  /// Opens a temporary file next to `path` (or stdout for "-").
+  /// Opens a temporary file next to `path` (or stdout for "-"); fails, with
+  /// `error` saying why, where writable() does.
   bool open(const std::string &path, std::string &error);
+
+  /// Whether `path` may be written, checked before any work: "-", a device or
+  /// FIFO the user may write, a new file in an existing folder the user may
+  /// write in, or an existing regular file the user may write. An existing
+  /// file without write permission is refused, for root too when no one may
+  /// write it: renaming over it would replace a file its owner protected.
+  static bool writable(const std::string &path, std::string &error);
   void write(std::string_view bytes);
   void put(char c) { std::fputc(c, file_); }
   /// Flushes, syncs and renames the temporary file onto the target.

@@ -433,9 +433,9 @@ bool Binder::checkValue(const Value &v, TypeId type, const Context &ctx, bool op
     }
     if (options_.lenient && ctx.path.empty()) {
       const p21::InstanceEntry &e = entry(ctx.entry);
-      diags_.warning(file_.loc(e.begin() + v.offset),
-                     "attribute " + std::to_string(ctx.position) + " '" + (ctx.slot ? ctx.slot->name : "") +
-                         "': '$' (no value) where a value is required (" + expected(type) + "); read as absent")
+      diags_.assumption(file_.loc(e.begin() + v.offset),
+                        "attribute " + std::to_string(ctx.position) + " '" + (ctx.slot ? ctx.slot->name : "") +
+                            "': '$' (no value) where a value is required (" + expected(type) + "); read as absent")
           .entity(e.id, entityName(ctx.entry));
       return true;
     }
@@ -636,7 +636,7 @@ void Binder::checkInstance(size_t index, const p21::ValueArena &values) {
         diags_.error(at, message).entity(en.id, entityName(index));
         return;
       }
-      diags_.warning(at, message + " (read as written)").entity(en.id, entityName(index));
+      diags_.assumption(at, message + " (read as written)").entity(en.id, entityName(index));
     }
     checkRecord(index, records[0], e, false);
     return;
@@ -711,11 +711,18 @@ void Binder::run() {
       checkInstance(i, values);
   });
 
-  for (const auto &[alias, use] : aliasUses_)
-    diags_.warning(file_.loc(use.first), "'" + alias + "' is not an entity of schema '" + schema_.name +
-                                             "'; read as its alias '" + use.target + "' (" +
-                                             std::to_string(use.count) +
-                                             (use.count == 1 ? " instance)" : " instances)"));
+  // An alias: one diagnostic per name, at its first use; an error with
+  // --strict, where only the schema's own names are read.
+  for (const auto &[alias, use] : aliasUses_) {
+    const std::string count =
+        " (" + std::to_string(use.count) + (use.count == 1 ? " instance" : " instances");
+    const std::string head = "'" + alias + "' is not an entity of schema '" + schema_.name + "'";
+    if (options_.strict)
+      diags_.error(file_.loc(use.first), head + "; it is an alias of '" + use.target + "', read as such without --strict" + count + ")");
+    else
+      diags_.warning(file_.loc(use.first),
+                     head + "; read as its alias '" + use.target + "'" + count + "; --strict makes each an error)");
+  }
   reportTally(unsetAggregate_, "'$' written for a mandatory aggregate; read as empty");
   reportTally(unsetString_, "'$' written for a mandatory string (a name, label or identifier); read as ''");
   if (intForReal_ > 0)

@@ -58,13 +58,14 @@ struct BindOptions {
   const AliasTable *aliases = &AliasTable::builtin();
   /// Report common drift as errors instead of warnings: `$` written for a
   /// mandatory aggregate that may be empty (read as empty) or for a mandatory
-  /// string such as a name or label (read as '').
+  /// string such as a name or label (read as ''), and an entity name from the
+  /// alias table (--strict).
   bool strict = false;
-  /// Compiling's reading: report as warnings what leaves the meaning clear
-  /// enough to machine: `$` in any other mandatory attribute ("read as
-  /// absent"; lowering reports an error where it needs the value) and an
-  /// abstract entity instantiated (its attributes are still checked).
-  /// `stepnc check` keeps these errors.
+  /// The commands' reading without --strict (driver::bindOptions): report as
+  /// warnings what leaves the meaning clear enough to machine: `$` in any
+  /// other mandatory attribute ("read as absent"; lowering reports an error
+  /// where it needs the value) and an abstract entity instantiated (its
+  /// attributes are still checked). Off, these are errors.
   bool lenient = false;
 };
 

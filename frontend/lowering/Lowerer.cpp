@@ -461,34 +461,64 @@ void Lowerer::chooseSpeedUnits() {
 
 std::unique_ptr<ir::Module> Lowerer::run() {
   const auto &entries = bound_.file().entries();
-  std::vector<Instance> projects;
+  std::vector<Instance> projects, workplans;
   for (size_t i = 0; i < entries.size(); ++i) {
     Instance inst(bound_, i);
     if (inst.isA("project"))
-      projects.push_back(std::move(inst));
+      projects.push_back(inst);
+    else if (inst.isA("workplan"))
+      workplans.push_back(inst);
   }
-  if (projects.empty()) {
-    diags_.error(bound_.file().loc(0), "no PROJECT instance: there is no workplan to lower");
-    return nullptr;
-  }
-  if (projects.size() > 1)
-    diags_.error(projects[1].loc(), "a second PROJECT instance; only one workplan can be lowered")
-        .entity(projects[1].id(), "PROJECT")
-        .note(projects[0].loc(), "the first PROJECT is here");
-  const Instance &project = projects[0];
   chooseAngleUnit();
   chooseSpeedUnits();
   module_ = std::make_unique<ir::Module>();
   module_->sourceName = std::string(bound_.file().source().name());
   module_->sourceUnits = {feedToMmPerMin_, cutspeedToMmPerMin_, spindleToRevPerMin_};
-  stamp(module_->root, project);
-  projectWorkpieces_ = project.refs("its_workpieces");
-  for (const Instance &wp : projectWorkpieces_)
-    workpiece(wp);
-  Instance main = project.ref("main_workplan");
-  if (!main) {
-    missing(project, "main_workplan");
-    return std::move(module_);
+  Instance main;
+  if (projects.empty()) {
+    // No PROJECT names the main workplan: a workplan that is no other
+    // workplan's element can only be the top of the program. With one such
+    // workplan that is what the file means; with none or several, it says
+    // nothing.
+    std::set<size_t> elements;
+    for (const Instance &wp : workplans)
+      for (const Instance &exe : wp.refs("its_elements"))
+        elements.insert(exe.index());
+    std::vector<Instance> tops;
+    for (const Instance &wp : workplans)
+      if (!elements.count(wp.index()))
+        tops.push_back(wp);
+    if (tops.size() != 1) {
+      auto diag = diags_.error(
+          bound_.file().loc(0),
+          workplans.empty() ? std::string("no PROJECT instance: there is no workplan to lower")
+          : tops.empty()    ? std::string("no PROJECT instance, and every workplan is an element of another: none "
+                                          "is the main workplan")
+                            : "no PROJECT instance, and " + std::to_string(tops.size()) +
+                               " workplans are not elements of another: which is the main workplan is not said");
+      for (const Instance &wp : tops)
+        diag.note(wp.loc(), "workplan " + hashId(wp.id()) + " is not an element of another workplan");
+      return nullptr;
+    }
+    main = tops[0];
+    diags_.assumption(main.loc(), "no PROJECT: workplan " + hashId(main.id()) + " taken as the main workplan")
+        .entity(main.id(), "WORKPLAN");
+    stamp(module_->root, main);
+  } else {
+    if (projects.size() > 1)
+      diags_.error(projects[1].loc(), "a second PROJECT instance; only one workplan can be lowered")
+          .entity(projects[1].id(), "PROJECT")
+          .note(projects[0].loc(), "the first PROJECT is here");
+    const Instance &project = projects[0];
+    stamp(module_->root, project);
+    projectWorkpieces_ = project.refs("its_workpieces");
+    for (const Instance &wp : projectWorkpieces_)
+      workpiece(wp);
+    main = project.ref("main_workplan");
+    if (!main) {
+      missing(project, "main_workplan");
+      return std::move(module_);
+    }
   }
   std::optional<Node> plan = workplan(main);
   // Resources first, in a fixed order: workpieces, tools, setups; then the plan.

@@ -271,6 +271,10 @@ std::optional<runtime::Trajectory> readMotion(const ir::Module &module, Diagnost
       at = end;
     }
   }
+  // A program with nothing that moves (an empty workplan) has an empty
+  // trajectory: no segments, planned on no machine.
+  if (!any && !hasMachiningSteps(module))
+    return out;
   if (!any)
     diags.error({}, "no motion to play: the IR has no 'motion' nodes (run plan-motion first)");
   if (!any || !ok)

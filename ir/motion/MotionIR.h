@@ -38,7 +38,9 @@ ProgramPath programPath(const ir::Module &module);
 void attachMotion(ir::Module &module, const ProgramPath &program, const runtime::Trajectory &trajectory);
 
 /// Reads the trajectory back from the `motion` nodes (errors located at the
-/// node that is wrong); nullopt when there are none or one is wrong.
+/// node that is wrong); nullopt when there are none or one is wrong. A
+/// program with no step that moves (ir::hasMachiningSteps) has an empty
+/// trajectory: no segments, no machine's name, starting at the origin.
 std::optional<runtime::Trajectory> readMotion(const ir::Module &module, DiagnosticEngine &diags);
 
 } // namespace stepnc::ir

@@ -142,7 +142,10 @@ class Machine:
             self.spindle = False
 
     def line(self, where, axes, rapid, feed):
-        self.need_tool(where)
+        # An L block without coordinates ("L M30" in a program with no
+        # motion) moves nothing: it needs no tool.
+        if axes:
+            self.need_tool(where)
         if not rapid and axes:
             self.feed_move(where, feed)
         target = list(self.pos)

@@ -1,5 +1,8 @@
 // `stepnc check FILE...`: reads each file, reports its diagnostics and prints a
-// one-line summary per file (and an entity histogram with --stats).
+// one-line summary per file (and an entity histogram with --stats). Files are
+// read against their schema as compile reads them (driver::bindOptions):
+// drift whose meaning is clear is a warning, an error with --strict.
+#include "driver/LoadModule.h"
 #include "frontend/binding/Binder.h"
 #include "frontend/part21/Part21File.h"
 #include "support/VerifyDiagnostics.h"
@@ -48,7 +51,7 @@ const express::Schema *checkFile(const p21::Part21File &file, const driver::Sche
   const express::Model *model = nullptr;
   const express::Schema *schema = schemas.select(file, diags, model);
   if (schema)
-    binding::bind(file, *model, *schema, diags);  // includes the Part 21 reference check
+    binding::bind(file, *model, *schema, diags, driver::bindOptions(diags));  // includes the Part 21 reference check
   else
     p21::checkInstances(file, diags);
   return schema;
@@ -72,6 +75,7 @@ int verifyFiles(const CheckOptions &opts) {
     }
     DiagnosticCollector collector;
     DiagnosticEngine diags(collector);
+    diags.setStrict(opts.diag.strict);
     auto file = p21::readPart21(*source, diags);
     checkFile(*file, schemas, diags);
     if (!verifyDiagnostics(*source, collector.diags, std::cerr) && status == kExitOk)
@@ -135,6 +139,7 @@ void registerCheck(CLI::App &app, std::function<void(int)> setResult) {
                 "files' comments instead of printing them (exit 0 when all match)");
   addSchemaOptions(*cmd, opts->schema);
   addDiagnosticOptions(*cmd, opts->diag);
+  addStrictOption(*cmd, opts->diag);
   cmd->callback([opts, setResult] { setResult(runCheckFiles(*opts)); });
 }
 

@@ -3,9 +3,18 @@
 #include "support/OutputFile.h"
 
 #include <CLI/CLI.hpp>
+#include <filesystem>
 #include <iostream>
 
 namespace stepnc::tool {
+
+namespace {
+
+/// The engine of the JSON diagnostic session open now, if any: the command's
+/// own messages go into its array, which must stay the whole of stderr.
+DiagnosticEngine *jsonSession = nullptr;
+
+} // namespace
 
 void addDiagnosticOptions(CLI::App &cmd, DiagnosticOptions &opts) {
   cmd.add_option("--diagnostics", opts.format,
@@ -17,6 +26,13 @@ void addDiagnosticOptions(CLI::App &cmd, DiagnosticOptions &opts) {
                  "Stop after this many errors (0: no limit)")
       ->default_str("50");
   cmd.add_flag("--warnings-as-errors", opts.warningsAsErrors, "Treat warnings as errors");
+}
+
+void addStrictOption(CLI::App &cmd, DiagnosticOptions &opts) {
+  cmd.add_flag("--strict", opts.strict,
+               "Make every assumption an error: '$' where the schema wants a value, an alias for an\n"
+               "entity name, an abstract entity instantiated, a value lowering had to assume (without\n"
+               "--strict each is a warning that ends '--strict makes it an error')");
 }
 
 void addSchemaOptions(CLI::App &cmd, driver::SchemaOptions &opts) {
@@ -34,9 +50,16 @@ DiagnosticSession::DiagnosticSession(const DiagnosticOptions &opts) {
   engine_ = std::make_unique<DiagnosticEngine>(*consumer_);
   engine_->setMaxErrors(opts.maxErrors);
   engine_->setWarningsAsErrors(opts.warningsAsErrors);
+  engine_->setStrict(opts.strict);
+  if (opts.format == "json")
+    jsonSession = engine_.get();
 }
 
-DiagnosticSession::~DiagnosticSession() { engine_->finish(); }
+DiagnosticSession::~DiagnosticSession() {
+  if (jsonSession == engine_.get())
+    jsonSession = nullptr;
+  engine_->finish();
+}
 
 int loadSchemas(driver::SchemaSelection &schemas, DiagnosticEngine &diags) {
   std::string error;
@@ -50,7 +73,35 @@ int loadSchemas(driver::SchemaSelection &schemas, DiagnosticEngine &diags) {
 
 void printToolError(const std::string &message) {
   std::cout.flush();
+  if (jsonSession) {
+    jsonSession->error(SourceLoc{}, message);
+    return;
+  }
   std::cerr << "stepnc: error: " << message << '\n';
+}
+
+void printStatus(const std::string &line) {
+  if (jsonSession)
+    return;
+  std::cout.flush();
+  std::cerr << "stepnc: " << line << '\n';
+}
+
+int checkOutput(std::string_view command, const std::string &input, const std::string &output) {
+  if (output == "-")
+    return kExitOk;
+  std::error_code ec;
+  if (std::filesystem::equivalent(input, output, ec)) {
+    printToolError(std::string(command) + ": -o '" + output + "' is the input file " + input +
+                   ", which would be replaced: give another output file");
+    return kExitUsage;
+  }
+  std::string error;
+  if (!OutputFile::writable(output, error)) {
+    printToolError(error);
+    return kExitUsage;
+  }
+  return kExitOk;
 }
 
 int writeText(const std::string &path, const std::string &text) {

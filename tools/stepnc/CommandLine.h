@@ -27,14 +27,24 @@ struct DiagnosticOptions {
   std::string format = "text";  ///< "text" or "json"
   unsigned maxErrors = 50;
   bool warningsAsErrors = false;
+  /// --strict: what stepnc assumes to read an imperfect STEP-NC file is an
+  /// error, not a warning.
+  bool strict = false;
 };
 
 void addDiagnosticOptions(CLI::App &cmd, DiagnosticOptions &opts);
 
+/// --strict, for the commands that read STEP-NC (compile, check, convert,
+/// opt, sim).
+void addStrictOption(CLI::App &cmd, DiagnosticOptions &opts);
+
 /// --schema FILE.exp (repeatable) and --no-schema.
 void addSchemaOptions(CLI::App &cmd, driver::SchemaOptions &opts);
 
-/// Owns the consumer and engine configured from DiagnosticOptions.
+/// Owns the consumer and engine configured from DiagnosticOptions. With
+/// --diagnostics=json, standard error is one JSON array for as long as the
+/// session lives: printToolError adds its message to it (an entry without a
+/// file) and printStatus prints nothing.
 class DiagnosticSession {
 public:
   explicit DiagnosticSession(const DiagnosticOptions &opts);
@@ -61,7 +71,20 @@ std::unique_ptr<SourceFile> openInput(const std::string &path);
 /// prints "stepnc: error: ..." and returns kExitUsage, else kExitOk.
 int writeText(const std::string &path, const std::string &text);
 
-/// Prints "stepnc: error: message" to stderr.
+/// Refuses, before any work, an output that would replace what `command`
+/// reads or what the user may not write: -o naming the input file (the same
+/// file by any path), an existing read-only file, a folder that does not
+/// exist (OutputFile::writable). Prints "stepnc: error: ..." and returns
+/// kExitUsage; kExitOk otherwise.
+int checkOutput(std::string_view command, const std::string &input, const std::string &output);
+
+/// Prints "stepnc: error: message" to stderr; while a JSON diagnostic
+/// session is open, an error entry without a file in its array instead.
 void printToolError(const std::string &message);
+
+/// Prints "stepnc: line" to stderr: what a command wrote, or why it wrote
+/// nothing. Nothing while a JSON diagnostic session is open: the array is
+/// all standard error holds, and the exit status says the same.
+void printStatus(const std::string &line);
 
 } // namespace stepnc::tool

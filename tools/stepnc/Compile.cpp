@@ -3,7 +3,8 @@
 // writes the feature IR, or runs the pass pipeline and writes the toolpath IR
 // or a controller program. `stepnc opt` (Opt.cpp) runs the same steps with
 // its own pipeline. Nothing is written when there are errors; files are
-// written atomically.
+// written atomically, and an output that is the input or read-only is
+// refused before reading (checkOutput).
 #include "tools/stepnc/Compile.h"
 
 #include "backends/Backend.h"
@@ -103,7 +104,7 @@ int writeOptimised(const CompileOptions &opts, const driver::SchemaSelection &sc
   std::unique_ptr<SourceFile> text;
   auto file = backends::buildOptimisedFile(input, module, options, text, diags);
   if (!file) {
-    std::cerr << "stepnc: cannot write optimised STEP-NC for " << opts.input << "; nothing written\n";
+    printStatus("cannot write optimised STEP-NC for " + opts.input + "; nothing written");
     return kExitDiagnostics;
   }
   OutputFile out;
@@ -117,7 +118,7 @@ int writeOptimised(const CompileOptions &opts, const driver::SchemaSelection &sc
                                 : !p21::writePart21(*file, out, diags)) {
     if (!usageError.empty())
       printToolError(usageError);
-    std::cerr << "stepnc: cannot write optimised STEP-NC for " << opts.input << "; nothing written\n";
+    printStatus("cannot write optimised STEP-NC for " + opts.input + "; nothing written");
     return diags.hasErrors() ? kExitDiagnostics : kExitUsage;
   }
   if (!out.commit(error)) {
@@ -125,8 +126,8 @@ int writeOptimised(const CompileOptions &opts, const driver::SchemaSelection &sc
     return kExitUsage;
   }
   if (opts.output != "-")
-    std::cerr << "stepnc: wrote " << opts.output << " (machine-optimised STEP-NC, " << file->entries().size()
-              << " instances)\n";
+    printStatus("wrote " + opts.output + " (machine-optimised STEP-NC, " + std::to_string(file->entries().size()) +
+                " instances)");
   return kExitOk;
 }
 
@@ -149,7 +150,7 @@ int compileSource(const CompileOptions &opts, const std::string &emit, std::uniq
       printToolError(usageError);
       return kExitUsage;
     }
-    std::cerr << "stepnc: " << opts.input << " has errors; nothing written\n";
+    printStatus(opts.input + " has errors; nothing written");
     return kExitDiagnostics;
   }
   if (emit == "stepnc" && !file) {
@@ -182,7 +183,7 @@ int compileSource(const CompileOptions &opts, const std::string &emit, std::uniq
       if (rc == kExitUsage)
         printToolError(usageError);
       if (rc == kExitDiagnostics)
-        std::cerr << "stepnc: the pass pipeline failed on " << opts.input << "; nothing written\n";
+        printStatus("the pass pipeline failed on " + opts.input + "; nothing written");
       return rc;
     }
   }
@@ -197,7 +198,7 @@ int compileSource(const CompileOptions &opts, const std::string &emit, std::uniq
         return kExitUsage;
       table = backends::ToolTable::parse(*tableFile, diags);
       if (!table) {
-        std::cerr << "stepnc: the tool table " << opts.toolTable << " has errors; nothing written\n";
+        printStatus("the tool table " + opts.toolTable + " has errors; nothing written");
         return kExitDiagnostics;
       }
     }
@@ -209,13 +210,13 @@ int compileSource(const CompileOptions &opts, const std::string &emit, std::uniq
     emitOptions.toolTable = table ? &*table : nullptr;
     std::optional<std::string> program = backend->emit(*module, emitOptions, diags);
     if (!program || diags.hasErrors()) {
-      std::cerr << "stepnc: cannot write a " << opts.target << " program for " << opts.input << "; nothing written\n";
+      printStatus("cannot write a " + opts.target + " program for " + opts.input + "; nothing written");
       return kExitDiagnostics;
     }
     const int rc = writeText(opts.output, *program);
     if (rc == kExitOk && opts.output != "-")
-      std::cerr << "stepnc: wrote " << opts.output << " (" << opts.target << ", "
-                << std::count(program->begin(), program->end(), '\n') << " lines)\n";
+      printStatus("wrote " + opts.output + " (" + opts.target + ", " +
+                  std::to_string(std::count(program->begin(), program->end(), '\n')) + " lines)");
     return rc;
   }
   ir::PrintOptions printOptions;
@@ -226,6 +227,9 @@ int compileSource(const CompileOptions &opts, const std::string &emit, std::uniq
 } // namespace
 
 int runCompile(const CompileOptions &opts) {
+  // First, so that with --diagnostics=json every message of the command is
+  // in the one array on stderr.
+  DiagnosticSession session(opts.diag);
   const std::string emit = !opts.emit.empty() ? opts.emit : opts.target.empty() ? "feature-ir" : "program";
   std::unique_ptr<backends::Backend> backend;
   if (emit == "program") {
@@ -260,16 +264,20 @@ int runCompile(const CompileOptions &opts) {
                    " plans the motion on a machine: give --machine FILE.toml or a shipped machine (" + names + ")");
     return kExitUsage;
   }
+  // Refused before reading: an output that is the input, or one the user
+  // may not write.
+  if (const int rc = checkOutput(opts.command, opts.input, opts.output); rc != kExitOk)
+    return rc;
   auto source = openInput(opts.input);
   if (!source)
     return kExitUsage;
-  DiagnosticSession session(opts.diag);
   if (!opts.verifyDiagnostics)
     return compileSource(opts, emit, source, backend.get(), session.engine());
   // --verify-diagnostics: collect instead of printing, then match the
   // expectations written in the input's comments (docs/diagnostics.md).
   DiagnosticCollector collector;
   DiagnosticEngine collecting(collector);
+  collecting.setStrict(opts.diag.strict);
   const int rc = compileSource(opts, emit, source, backend.get(), collecting);
   if (rc == kExitUsage)
     return rc;
@@ -285,6 +293,7 @@ void addCommonOptions(CLI::App &cmd, CompileOptions &opts) {
                "(exit 0 when they match) instead of printing them");
   addSchemaOptions(cmd, opts.schema);
   addDiagnosticOptions(cmd, opts.diag);
+  addStrictOption(cmd, opts.diag);
 }
 
 void registerCompile(CLI::App &app, std::function<void(int)> setResult) {

@@ -13,6 +13,7 @@
 namespace stepnc::tool {
 
 struct CompileOptions {
+  std::string command = "compile";  ///< the command run: compile or opt, for messages
   std::string input;
   std::string output = "-";
   std::string emit;  ///< feature-ir, toolpath-ir, motion-ir or program; empty: program with --target, else feature-ir

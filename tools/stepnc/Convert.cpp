@@ -1,7 +1,8 @@
 // `stepnc convert IN -o OUT`: re-writes a STEP file in stepnc's canonical Part 21
 // form, or as Part 28 XML when OUT ends in .stpx or .xml; the input may be
 // either. Nothing is written when the input has errors; the output appears
-// atomically (temporary file + rename).
+// atomically (temporary file + rename), and one that is the input or
+// read-only is refused before reading (checkOutput).
 #include "frontend/part21/Part21File.h"
 #include "frontend/part21/Writer.h"
 #include "support/OutputFile.h"
@@ -24,16 +25,22 @@ struct ConvertOptions {
 
 int runConvert(const ConvertOptions &opts) {
   const bool toXml = isPart28Path(opts.output);
+  // First, so that with --diagnostics=json every message of the command is
+  // in the one array on stderr.
+  DiagnosticSession session(opts.diag);
+  DiagnosticEngine &diags = session.engine();
+  // Refused before reading: an output that is the input, or one the user
+  // may not write.
+  if (const int rc = checkOutput("convert", opts.input, opts.output); rc != kExitOk)
+    return rc;
   auto source = openInput(opts.input);
   if (!source)
     return kExitUsage;
-  DiagnosticSession session(opts.diag);
-  DiagnosticEngine &diags = session.engine();
   driver::SchemaSelection schemas(opts.schema);
   if (const int rc = loadSchemas(schemas, diags); rc != kExitOk)
     return rc;
   auto nothingWritten = [&] {
-    std::cerr << "stepnc: " << opts.input << " has errors; nothing written\n";
+    printStatus(opts.input + " has errors; nothing written");
     return kExitDiagnostics;
   };
   if (!schemas.readAsPart21(source, diags))
@@ -81,6 +88,7 @@ void registerConvert(CLI::App &app, std::function<void(int)> setResult) {
   cmd->add_option("-o,--output", opts->output, "Output file ('-' for standard output)")->required();
   addSchemaOptions(*cmd, opts->schema);
   addDiagnosticOptions(*cmd, opts->diag);
+  addStrictOption(*cmd, opts->diag);
   cmd->callback([opts, setResult] { setResult(runConvert(*opts)); });
 }
 

@@ -34,6 +34,7 @@ std::string passNames() {
 
 void registerOpt(CLI::App &app, std::function<void(int)> setResult) {
   auto opts = std::make_shared<CompileOptions>();
+  opts->command = "opt";
   CLI::App *cmd = app.add_subcommand(
       "opt", "Read process IR text (or a STEP-NC file, lowered first), verify it, run a pass\n"
              "pipeline over it (--passes) and print it.");

@@ -70,11 +70,19 @@ std::string label(const ir::Node &e) {
 }
 
 int runSim(const SimCommandOptions &opts) {
+  // First, so that with --diagnostics=json every message of the command is
+  // in the one array on stderr.
+  DiagnosticSession session(opts.diag);
+  DiagnosticEngine &diags = session.engine();
+  // The report and the samples may replace neither the input nor a file the
+  // user may not write.
+  for (const std::string &out : {opts.output, opts.samples})
+    if (!out.empty())
+      if (const int rc = checkOutput("sim", opts.input, out); rc != kExitOk)
+        return rc;
   auto source = openInput(opts.input);
   if (!source)
     return kExitUsage;
-  DiagnosticSession session(opts.diag);
-  DiagnosticEngine &diags = session.engine();
   std::unique_ptr<SourceFile> machineFile;
   const std::string machineName = opts.machine.empty() ? std::string(kDefaultMachine) : opts.machine;
   const auto machine = runtime::loadMachine(machineName, machineFile, diags);
@@ -140,7 +148,7 @@ int runSim(const SimCommandOptions &opts) {
     program = ir::programPath(*module);
   }
   if (!trajectory || diags.hasErrors()) {
-    std::cerr << "stepnc: cannot simulate " << opts.input << '\n';
+    printStatus("cannot simulate " + opts.input);
     return kExitDiagnostics;
   }
   if (!trajectory->machine.empty() && trajectory->machine != machine->name)
@@ -226,6 +234,7 @@ void registerSim(CLI::App &app, std::function<void(int)> setResult) {
   cmd->add_option("-o,--output", opts->output, "Report file ('-', the default, for standard output)");
   addSchemaOptions(*cmd, opts->schema);
   addDiagnosticOptions(*cmd, opts->diag);
+  addStrictOption(*cmd, opts->diag);
   cmd->callback([opts, setResult] { setResult(runSim(*opts)); });
 }
 

@@ -69,7 +69,11 @@ struct Result {
   std::vector<std::string> messages;  // "line:col: severity: message" (notes excluded)
 };
 
-std::unique_ptr<Result> bindText(std::string_view data, bool strict = false) {
+/// How bindText reads: the binder's default, --strict's or the commands'
+/// lenient reading without it (driver::bindOptions).
+enum class Reading { Default, Strict, Lenient };
+
+std::unique_ptr<Result> bindText(std::string_view data, Reading reading = Reading::Default) {
   auto r = std::make_unique<Result>();
   r->source = SourceFile::fromString("t.stp", "ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION((''),'2;1');\n"
                                               "FILE_NAME('','',(''),(''),'','','');\nFILE_SCHEMA(('SHOP'));\n"
@@ -79,7 +83,8 @@ std::unique_ptr<Result> bindText(std::string_view data, bool strict = false) {
   r->file = p21::readPart21(*r->source, engine);
   binding::BindOptions opts;
   opts.aliases = &fixture().aliases;
-  opts.strict = strict;
+  opts.strict = reading == Reading::Strict;
+  opts.lenient = reading == Reading::Lenient;
   r->bound = binding::bind(*r->file, fixture().model, fixture().model.schemas().front(), engine, opts);
   for (const Diagnostic &d : r->diags.diags) {
     LineCol lc = d.loc.valid() ? d.loc.file->lineCol(d.loc.offset) : LineCol{};
@@ -109,11 +114,16 @@ TEST_CASE("binding errors name the instance, attribute, expectation and finding"
     CHECK(r->messages[0] == "8:1: error: unknown entity 'DRIL' in schema 'shop'");
     CHECK(r->diags.diags[0].notes[0].message == "did you mean 'drill'?");
   }
-  SECTION("alias: accepted with one warning naming it") {
-    auto r = bindText("#1=BORER('d',10.,118.);\n#3=BORER('e',12.,118.);\n#2=STEP(#1,(1.),(),LENGTH_MEASURE(3.),$);\n");
+  SECTION("alias: accepted with one warning naming it, one error with --strict") {
+    const char *text = "#1=BORER('d',10.,118.);\n#3=BORER('e',12.,118.);\n#2=STEP(#1,(1.),(),LENGTH_MEASURE(3.),$);\n";
+    auto r = bindText(text);
     REQUIRE(r->messages.size() == 1);
-    CHECK(r->messages[0] ==
-          "8:1: warning: 'BORER' is not an entity of schema 'shop'; read as its alias 'drill' (2 instances)");
+    CHECK(r->messages[0] == "8:1: warning: 'BORER' is not an entity of schema 'shop'; read as its alias 'drill' "
+                            "(2 instances; --strict makes each an error)");
+    auto strict = bindText(text, Reading::Strict);
+    CHECK(strict->messages == std::vector<std::string>{
+                                  "8:1: error: 'BORER' is not an entity of schema 'shop'; it is an alias of 'drill', "
+                                  "read as such without --strict (2 instances)"});
   }
   SECTION("abstract entity") {
     auto r = bindText("#1=TOOL('t',10.);\n");
@@ -201,11 +211,31 @@ TEST_CASE("drift: $ for an empty aggregate or a name is a warning unless strict"
                                  "--strict makes each an error)",
                                  "8:10: warning: '$' written for a mandatory string (a name, label or identifier); "
                                  "read as '' (1 place; --strict makes each an error)"});
-  auto strict = bindText(text, true);
+  auto strict = bindText(text, Reading::Strict);
   CHECK(strict->messages == std::vector<std::string>{
                                 "8:10: error: attribute 1 'name': '$' (no value) where a value is required (a label)",
                                 "9:17: error: attribute 3 'empty_ok': '$' (no value) where a value is required (a SET "
                                 "[0:?] OF tool)"});
+}
+
+TEST_CASE("the lenient reading: $ in another mandatory attribute and an abstract entity are warnings",
+          "[binding]") {
+  const char *text = "#1=DRILL('d',$,118.);\n#2=TOOL('t',10.);\n";
+  auto lenient = bindText(text, Reading::Lenient);
+  CHECK(lenient->messages ==
+        std::vector<std::string>{
+            "8:14: warning: attribute 2 'diameter': '$' (no value) where a value is required (a length_measure); "
+            "read as absent; --strict makes it an error",
+            "9:4: warning: entity 'tool' is abstract and cannot be instantiated; use one of its subtypes: drill, "
+            "mill, coated (read as written); --strict makes it an error"});
+  CHECK_FALSE(lenient->diags.diags[0].entityId == 0);
+  // Without it (what --strict asks for), each is an error.
+  auto strict = bindText(text, Reading::Strict);
+  CHECK(strict->messages ==
+        std::vector<std::string>{
+            "8:14: error: attribute 2 'diameter': '$' (no value) where a value is required (a length_measure)",
+            "9:4: error: entity 'tool' is abstract and cannot be instantiated; use one of its subtypes: drill, mill, "
+            "coated"});
 }
 
 TEST_CASE("integers where a REAL is expected are read with one warning", "[binding]") {

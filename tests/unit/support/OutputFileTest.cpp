@@ -102,3 +102,57 @@ TEST_CASE("output files open at the same time keep their own bytes", "[support]"
   CHECK(slurp(dir / "b.txt") == b);
   fs::remove_all(dir);
 }
+
+TEST_CASE("a read-only target is refused, not renamed over", "[support]") {
+  fs::path dir = scratchDir();
+  fs::path target = dir / "protected.txt";
+  { std::ofstream(target) << "old\n"; }
+  ::chmod(target.c_str(), 0444);
+  std::string error;
+  // Refused when asked first and when opened; for root too, since no one
+  // may write the file.
+  CHECK_FALSE(OutputFile::writable(target.string(), error));
+  CHECK(error == "cannot write '" + target.string() + "': the file is read-only; it is left as it is");
+  OutputFile out;
+  error.clear();
+  CHECK_FALSE(out.open(target.string(), error));
+  CHECK(error.find("read-only") != std::string::npos);
+  CHECK(slurp(target) == "old\n");
+  struct stat st {};
+  REQUIRE(::stat(target.c_str(), &st) == 0);
+  CHECK((st.st_mode & 07777) == 0444);
+  // No temporary file was left beside it.
+  CHECK(std::distance(fs::directory_iterator(dir), fs::directory_iterator()) == 1);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("what may be written is known before any work", "[support]") {
+  fs::path dir = scratchDir();
+  std::string error;
+  CHECK(OutputFile::writable("-", error));
+  CHECK(OutputFile::writable((dir / "new.txt").string(), error));
+  CHECK(OutputFile::writable("/dev/null", error));
+  CHECK_FALSE(OutputFile::writable((dir / "no" / "x.txt").string(), error));
+  CHECK(error == "cannot create '" + (dir / "no" / "x.txt").string() + "': the folder '" + (dir / "no").string() +
+                     "' does not exist");
+  CHECK_FALSE(OutputFile::writable(dir.string(), error));
+  CHECK(error.find("is a directory") != std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("a replaced file keeps its permissions", "[support]") {
+  fs::path dir = scratchDir();
+  fs::path target = dir / "shared.txt";
+  { std::ofstream(target) << "old\n"; }
+  ::chmod(target.c_str(), 0640);
+  std::string error;
+  OutputFile out;
+  REQUIRE(out.open(target.string(), error));
+  out.write("new\n");
+  REQUIRE(out.commit(error));
+  CHECK(slurp(target) == "new\n");
+  struct stat st {};
+  REQUIRE(::stat(target.c_str(), &st) == 0);
+  CHECK((st.st_mode & 07777) == 0640);
+  fs::remove_all(dir);
+}
