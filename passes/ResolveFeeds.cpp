@@ -58,10 +58,10 @@ private:
   }
 
   /// The spindle speed (rev/min, signed) assumed for `op` when its
-  /// technology gives none, with why; nullopt (after reporting) when there is
+  /// technology gives none, with why; nullopt when there is
   /// nothing to assume it from.
   std::optional<double> assumeSpindle(const ir::Node &op, const ir::Node *step, const ir::Node &tech,
-                                      const ir::Node *tool, DiagnosticEngine &diags, std::string &why) {
+                                      const ir::Node *tool, std::string &why) {
     const double diameter = tool ? tool->number("diameter").value_or(0.0) : 0.0;
     const std::string toolType = tool ? tool->text("type").value_or("") : "";
     if (diameter <= 0 || toolType.find("tap") != std::string::npos)
@@ -109,7 +109,7 @@ private:
     };
     if (!spindle) {
       std::string why;
-      if ((spindle = assumeSpindle(op, step, *tech, tool, diags, why))) {
+      if ((spindle = assumeSpindle(op, step, *tech, tool, why))) {
         tech->set("spindle", ir::Value::spindle(*spindle));
         note("spindle assumed " + why);
         diags.assumption(tech->origin.loc.valid() ? tech->origin.loc : op.origin.loc,

@@ -4,6 +4,7 @@
 
 #include "support/Format.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -299,7 +300,7 @@ constexpr std::pair<std::string_view, std::string_view> kAngles[] = {
 
 } // namespace
 
-void Lowerer::chooseAngleUnit() {
+void Lowerer::chooseAngleUnit(const std::vector<Instance> &withAngles) {
   using Angle = UnitConventions::Angle;
   if (options_.units.angles != Angle::Auto) {
     angleToDeg_ = options_.units.angles == Angle::Radian ? 180 / std::numbers::pi : 1.0;
@@ -309,11 +310,9 @@ void Lowerer::chooseAngleUnit() {
   // degrees: 0.349066 (20 deg) and 1.570796 (90 deg) read as radians; one
   // angle of 31 or 118 keeps the whole file in degrees. A file with no angle,
   // or only zeros, stays in degrees.
-  const auto &entries = bound_.file().entries();
   std::optional<std::pair<Instance, std::string_view>> example;
   double exampleValue = 0;
-  for (size_t i = 0; i < entries.size(); ++i) {
-    Instance inst(bound_, i);
+  for (const Instance &inst : withAngles) {
     for (const auto &[entity, attribute] : kAngles) {
       if (!inst.isA(entity))
         continue;
@@ -383,14 +382,10 @@ size_t chooseReading(const UnitReading (&readings)[N], const std::vector<SpeedVa
 
 } // namespace
 
-void Lowerer::chooseSpeedUnits() {
+void Lowerer::chooseSpeedUnits(const std::vector<Instance> &operations) {
   // Every technology an operation uses, with its tool's diameter.
   std::vector<SpeedValue> feeds, cutspeeds, spindles;
-  const auto &entries = bound_.file().entries();
-  for (size_t i = 0; i < entries.size(); ++i) {
-    Instance op(bound_, i);
-    if (!op.isA("machining_operation"))
-      continue;
+  for (const Instance &op : operations) {
     Instance tech = op.ref("its_technology");
     if (!tech)
       continue;
@@ -461,16 +456,22 @@ void Lowerer::chooseSpeedUnits() {
 
 std::unique_ptr<ir::Module> Lowerer::run() {
   const auto &entries = bound_.file().entries();
-  std::vector<Instance> projects, workplans;
+  // One pass over the file: the program's roots, and what the units are
+  // chosen from (the instances with angles, the operations' technologies).
+  std::vector<Instance> projects, workplans, withAngles, operations;
   for (size_t i = 0; i < entries.size(); ++i) {
     Instance inst(bound_, i);
     if (inst.isA("project"))
       projects.push_back(inst);
     else if (inst.isA("workplan"))
       workplans.push_back(inst);
+    else if (inst.isA("machining_operation"))
+      operations.push_back(inst);
+    else if (std::ranges::any_of(kAngles, [&](const auto &a) { return inst.isA(a.first); }))
+      withAngles.push_back(inst);
   }
-  chooseAngleUnit();
-  chooseSpeedUnits();
+  chooseAngleUnit(withAngles);
+  chooseSpeedUnits(operations);
   module_ = std::make_unique<ir::Module>();
   module_->sourceName = std::string(bound_.file().source().name());
   module_->sourceUnits = {feedToMmPerMin_, cutspeedToMmPerMin_, spindleToRevPerMin_};

@@ -149,10 +149,12 @@ private:
   std::optional<Node> workingstep(const Instance &ws);
   std::optional<Node> workplan(const Instance &wp);
   Node *findResource(const std::string &symbol);
-  /// Decides how the file's angles are read (options_.units.angles).
-  void chooseAngleUnit();
-  /// Decides how the file's feeds, cutting speeds and spindle speeds are read.
-  void chooseSpeedUnits();
+  /// Decides how the file's angles are read (options_.units.angles), from
+  /// the instances that have angles.
+  void chooseAngleUnit(const std::vector<Instance> &withAngles);
+  /// Decides how the file's feeds, cutting speeds and spindle speeds are
+  /// read, from the machining operations' technologies and tools.
+  void chooseSpeedUnits(const std::vector<Instance> &operations);
 
   const binding::BoundFile &bound_;
   DiagnosticEngine &diags_;
