@@ -458,17 +458,26 @@ std::unique_ptr<ir::Module> Lowerer::run() {
   const auto &entries = bound_.file().entries();
   // One pass over the file: the program's roots, and what the units are
   // chosen from (the instances with angles, the operations' technologies).
+  // Entities looked up by name once, not per instance.
+  const express::Model &model = bound_.model();
+  auto entity = [&](std::string_view name) { return model.findEntity(bound_.schema(), name); };
+  const express::EntityId projectEntity = entity("project"), workplanEntity = entity("workplan"),
+                          operationEntity = entity("machining_operation");
+  std::vector<express::EntityId> angleEntities;
+  for (const auto &a : kAngles)
+    if (express::EntityId e = entity(a.first); e != express::kNone)
+      angleEntities.push_back(e);
+  auto is = [&](size_t i, express::EntityId e) { return e != express::kNone && bound_.isA(i, e); };
   std::vector<Instance> projects, workplans, withAngles, operations;
   for (size_t i = 0; i < entries.size(); ++i) {
-    Instance inst(bound_, i);
-    if (inst.isA("project"))
-      projects.push_back(inst);
-    else if (inst.isA("workplan"))
-      workplans.push_back(inst);
-    else if (inst.isA("machining_operation"))
-      operations.push_back(inst);
-    else if (std::ranges::any_of(kAngles, [&](const auto &a) { return inst.isA(a.first); }))
-      withAngles.push_back(inst);
+    if (is(i, projectEntity))
+      projects.emplace_back(bound_, i);
+    else if (is(i, workplanEntity))
+      workplans.emplace_back(bound_, i);
+    else if (is(i, operationEntity))
+      operations.emplace_back(bound_, i);
+    else if (std::ranges::any_of(angleEntities, [&](express::EntityId e) { return is(i, e); }))
+      withAngles.emplace_back(bound_, i);
   }
   chooseAngleUnit(withAngles);
   chooseSpeedUnits(operations);
