@@ -11,6 +11,9 @@
 // workpiece material for coated carbide (cutting/materials.toml), half of it
 // for hole-making tools:
 //   spindle [rev/min] = cutting speed [mm/min] / (pi x tool diameter [mm])
+// A feed the file gives as 0 or not at all (with no feed per tooth either)
+// is assumed the same way from the material's target chip thickness h*:
+//   feed [mm/min] = h* [mm] x flutes x |spindle| [rev/min]
 #include "passes/Pass.h"
 
 #include "cutting/CuttingData.h"
@@ -71,9 +74,7 @@ private:
     if (vc > 0) {
       why = "from its cutting speed " + formatFixed(vc / 1000, 1) + " m/min";
     } else {
-      const ir::Node *feature = step ? ir::findFeature(*module_, step->text("feature").value_or("")) : nullptr;
-      const ir::Node *workpiece = feature ? ir::workpieceOf(*module_, *feature) : nullptr;
-      const MaterialChoice material = chooseMaterial(workpiece, cutting::shippedCuttingData());
+      const MaterialChoice material = materialOf(step);
       if (!material.material || material.material->cuttingSpeed <= 0)
         return std::nullopt;
       const bool holeMaking = ir::hasTraits(op.kind, ir::Trait::HoleMaking);
@@ -88,6 +89,31 @@ private:
       why += "; " + materialNote;
     // Clockwise (M3) for a right-hand tool, the usual cut.
     return tool->text("hand") == "left" ? n : -n;
+  }
+
+  /// The workpiece material of the feature `step` machines, as the shipped
+  /// cutting data knows it.
+  MaterialChoice materialOf(const ir::Node *step) const {
+    const ir::Node *feature = step ? ir::findFeature(*module_, step->text("feature").value_or("")) : nullptr;
+    const ir::Node *workpiece = feature ? ir::workpieceOf(*module_, *feature) : nullptr;
+    return chooseMaterial(workpiece, cutting::shippedCuttingData());
+  }
+
+  /// The feed (mm/min) assumed for an operation whose technology gives a
+  /// feed of 0 or none: the material's target chip thickness per tooth, with
+  /// why; nullopt without flutes, a spindle speed or a material to take it from.
+  std::optional<double> assumeFeed(const ir::Node *step, int64_t flutes, double n, std::string &why) const {
+    if (flutes <= 0 || n <= 0)
+      return std::nullopt;
+    const MaterialChoice material = materialOf(step);
+    if (!material.material || material.material->chipThickness <= 0)
+      return std::nullopt;
+    const double fz = material.material->chipThickness;
+    why = "= " + formatFixed(fz, 4) + " mm per tooth (the target chip thickness of " + material.material->key +
+          ") x " + std::to_string(flutes) + " flutes x " + formatFixed(n, 1) + " rev/min";
+    if (!material.note.empty())
+      why += "; " + material.note;
+    return fz * static_cast<double>(flutes) * n;
   }
 
   void resolve(ir::Node &op, const ir::Node *step, const ir::Node *tool, DiagnosticEngine &diags,
@@ -121,12 +147,26 @@ private:
       }
     }
     const double n = spindle ? std::abs(*spindle) : 0.0;
-    if (!tech->has("feed")) {
-      if (auto fz = tech->number("feed_per_tooth"); fz && flutes > 0 && n > 0) {
+    // A feed of 0 moves nothing: generators write it for "not given".
+    const bool zeroFeed = tech->number("feed") == 0.0;
+    if (!tech->has("feed") || zeroFeed) {
+      std::string why;
+      if (auto fz = tech->number("feed_per_tooth"); fz && *fz > 0 && flutes > 0 && n > 0) {
         tech->set("feed", ir::Value::feed(*fz * static_cast<double>(flutes) * n));
         note("feed = " + formatFixed(*fz, 4) + " mm x " + std::to_string(flutes) + " flutes x " +
              formatFixed(n, 1) + " rev/min");
         ++stats["feeds computed"];
+      } else if (auto feed = assumeFeed(step, flutes, n, why)) {
+        tech->set("feed", ir::Value::feed(*feed));
+        tech->set("feed_per_tooth", ir::Value::length(*feed / (static_cast<double>(flutes) * n)));
+        note("feed assumed " + why);
+        diags.assumption(tech->origin.loc.valid() ? tech->origin.loc : op.origin.loc,
+                         op.kindName() + " '" + op.label + "' gives " + (zeroFeed ? "a feed of 0" : "no feed") +
+                             "; assumed " + formatFixed(*feed, 1) + " mm/min " + why)
+            .entity(tech->origin.entityId ? tech->origin.entityId : op.origin.entityId);
+        ++stats["feeds assumed"];
+      } else if (zeroFeed) {
+        // expand-strategies refuses the step, naming it.
       } else {
         diags.warning(op.origin.loc, op.kindName() + " '" + op.label +
                                          "' has no feed: neither a feed nor a feed per tooth with the tool's "

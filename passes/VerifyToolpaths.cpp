@@ -631,10 +631,16 @@ private:
   void checkUncut(Step &s, const std::vector<Cut> &cuts) {
     const bool explicitPaths = s.op->kind == ir::Kind::FreeformOperation;
     const double targetArea = s.shape->target.area();
+    // The floor level is that of the lowest horizontal cut; a step that only
+    // plunges (a tool as wide as the hole it mills) reaches it by its plunges.
     std::optional<double> floorZ;
     for (const Cut &c : cuts)
       if (c.horizontal && (!floorZ || c.low < *floorZ))
         floorZ = c.low;
+    if (!floorZ)
+      for (const Cut &c : cuts)
+        if (!floorZ || c.low < *floorZ)
+          floorZ = c.low;
     std::vector<Offence> offences;
     if (!floorZ) {
       if (!explicitPaths)

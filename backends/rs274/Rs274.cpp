@@ -120,8 +120,15 @@ private:
       // LinuxCNC's G84 under G98 feeds out all the way to the first height:
       // G99 stops at R, and the plan's rapid up follows the cycle.
       words = "G99 G84 " + xyzr;
+      // LinuxCNC keeps P from an earlier cycle (G80 does not clear it), and
+      // its G84 dwells P at the bottom: a tap must not wait there.
+      if (stickyDwell_)
+        words += " P0";
+      stickyDwell_ = false;
       break;
     }
+    if (c.dwell > 0)
+      stickyDwell_ = true;
     positionFor(s);
     modal_.forget("F");
     out_.block(words + feedWord(c.feed));
@@ -134,6 +141,8 @@ private:
     }
     return true;
   }
+
+  bool stickyDwell_ = false;  ///< an earlier cycle set P, which LinuxCNC keeps
 };
 
 } // namespace

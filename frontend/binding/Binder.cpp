@@ -487,9 +487,20 @@ bool Binder::checkValue(const Value &v, TypeId type, const Context &ctx, bool op
     }
     bool ok = true;
     if (static_cast<int64_t>(v.count) < t.lower || (t.upper >= 0 && static_cast<int64_t>(v.count) > t.upper)) {
-      error(ctx, v, "expected " + expected(type) + ", found " + std::to_string(v.count) +
-                        (v.count == 1 ? " element" : " elements"));
-      ok = false;
+      const std::string what = "expected " + expected(type) + ", found " + std::to_string(v.count) +
+                               (v.count == 1 ? " element" : " elements");
+      if (options_.lenient) {
+        // Generators write () for a list the file has nothing for; what
+        // needs its elements says so where it reads them.
+        const p21::InstanceEntry &e = entry(ctx.entry);
+        diags_.assumption(file_.loc(e.begin() + v.offset), "attribute " + std::to_string(ctx.position) + " '" +
+                                                               (ctx.slot ? ctx.slot->name : "") + "'" + ctx.path +
+                                                               ": " + what + "; read as written")
+            .entity(e.id, entityName(ctx.entry));
+      } else {
+        error(ctx, v, what);
+        ok = false;
+      }
     }
     auto children = arena_->children(v);
     for (size_t i = 0; i < children.size(); ++i) {

@@ -14,8 +14,18 @@ namespace {
 
 // `depth` is a plane in the feature's frame: the feature goes down to it.
 void setDepth(Lowerer &l, Node &n, const Instance &f) {
-  if (auto z = l.planeHeight(f, "depth", "feature depth"))
-    n.set("depth", Value::length(-*z));
+  std::optional<double> z = l.planeHeight(f, "depth", "feature depth");
+  if (!z)
+    return;
+  if (*z > 1e-9) {
+    // The depth plane lies below the feature's origin, at negative z of its
+    // frame; some generators write its distance instead.
+    l.assumed(f.ref("depth"), "position",
+              "places the floor " + formatFixed(*z, 4) + " mm above the feature's origin, where no floor can be; "
+              "read as a depth of " + formatFixed(*z, 4) + " mm below it");
+    *z = -*z;
+  }
+  n.set("depth", Value::length(-*z));
 }
 
 std::string describe(const Instance &inst) { return hashId(inst.id()) + " " + std::string(inst.entityName()); }
@@ -82,6 +92,49 @@ std::optional<RawExtent> Lowerer::rawExtent(const Instance &wp) {
   return e;
 }
 
+namespace {
+
+/// The rotation taking a placement's axes (ref, axis x ref, axis) to its parent's.
+Eigen::Matrix3d rotation(const Placement &p) {
+  Eigen::Matrix3d r;
+  r.col(0) = p.ref;
+  r.col(1) = p.axis.cross(p.ref);
+  r.col(2) = p.axis;
+  return r;
+}
+
+} // namespace
+
+void Lowerer::placeProfileOnce(const Instance &profileInstance, Node &profile, const Placement &frame,
+                               const Instance &workpiece) {
+  const std::optional<Vec3> at = profile.vec("at");
+  std::optional<RawExtent> raw = rawExtent(workpiece);
+  if (!at || !raw || at->head<2>().isZero(1e-9))
+    return;
+  const Eigen::Matrix3d r = rotation(frame);
+  const Vec3 composed = frame.at + r * *at;
+  auto insideXY = [&](const Vec3 &q) {
+    return q.x() >= raw->min.x() - 1e-6 && q.x() <= raw->max.x() + 1e-6 && q.y() >= raw->min.y() - 1e-6 &&
+           q.y() <= raw->max.y() + 1e-6;
+  };
+  if (insideXY(composed) || !insideXY(*at))
+    return;
+  // Read in workpiece coordinates, the profile's placement relative to the feature is:
+  const Vec3 relative = r.transpose() * (*at - frame.at);
+  profile.set("at", Value::point(relative));
+  if (auto axis = profile.vec("axis"))
+    profile.set("axis", Value::direction(r.transpose() * *axis));
+  if (auto ref = profile.vec("ref"))
+    profile.set("ref", Value::direction(r.transpose() * *ref));
+  assumed(profileInstance, "placement",
+          "origin " + formatTuple({at->x(), at->y(), at->z()}, 4) +
+              " mm, placed in the feature's frame as ISO 14649 has it, lies at " +
+              formatTuple({composed.x(), composed.y(), composed.z()}, 4) + " mm, outside the raw piece " +
+              describe(raw->block) + "; read in workpiece coordinates (where it lies inside), as the generator "
+              "evidently wrote it: " + formatTuple({relative.x(), relative.y(), relative.z()}, 4) +
+              " mm from the feature's origin");
+}
+
 std::optional<std::string> Lowerer::feature(const Instance &f) {
   if (!f)
     return std::nullopt;
@@ -108,10 +161,12 @@ std::optional<std::string> Lowerer::feature(const Instance &f) {
       n.set(std::string(irName), Value::length(*v));
   };
   auto addProfile = [&](std::string_view attribute, bool required) {
-    if (auto p = profile(f.ref(attribute)))
+    if (auto p = profile(f.ref(attribute))) {
+      placeProfileOnce(f.ref(attribute), *p, frame, wpInstance);
       n.add(std::move(*p));
-    else if (required)
+    } else if (required) {
       missing(f, attribute);
+    }
   };
   auto addPath = [&](std::string_view attribute, bool required) {
     if (auto p = path(f.ref(attribute)))

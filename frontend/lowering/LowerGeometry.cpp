@@ -81,18 +81,27 @@ std::optional<Placement> Lowerer::placement(const Instance &a) {
     return std::nullopt;
   }
   Placement p;
-  if (auto at = point(a.ref("location")))
+  if (Instance location = a.ref("location")) {
+    auto at = point(location);
+    if (!at)
+      return std::nullopt;  // point() said why
     p.at = *at;
-  else {
+  } else if (!a.ref("axis") && !a.ref("ref_direction")) {
+    // A placement with no location and no directions is its parent frame.
+    assumed(a, "location", "absent (and no axis or ref_direction); assumed (0, 0, 0): the frame it is placed in");
+  } else {
     missing(a, "location");
     return std::nullopt;
   }
-  if (Instance axis = a.ref("axis"))
-    if (auto v = direction(axis))
+  Instance axisInstance = a.ref("axis"), refInstance = a.ref("ref_direction");
+  if (swapAxisAndRef_ && axisInstance && refInstance)
+    std::swap(axisInstance, refInstance);  // choosePlacementReading says why
+  if (axisInstance)
+    if (auto v = direction(axisInstance))
       p.axis = *v;
   Vec3 ref = Vec3::UnitX();
-  if (Instance r = a.ref("ref_direction"))
-    if (auto v = direction(r))
+  if (refInstance)
+    if (auto v = direction(refInstance))
       ref = *v;
   // ISO 10303-42: the x axis is the ref direction projected normal to z; when
   // it is (nearly) parallel to z, the standard's default takes over.
@@ -126,7 +135,16 @@ std::optional<double> Lowerer::planeHeight(const Instance &owner, std::string_vi
     missing(plane, "position");
     return std::nullopt;
   }
-  if (std::abs(std::abs(p->axis.z()) - 1.0) > 1e-9) {
+  if (std::abs(std::abs(p->axis.z()) - 1.0) > 1e-9 && std::abs(std::abs(p->ref.z()) - 1.0) < 1e-9 &&
+      std::abs(p->axis.z()) < 1e-9) {
+    // A plane of heights whose placement gives a horizontal normal and its
+    // ref_direction along z: the two written the wrong way round (the height
+    // is read from the location's z either way).
+    assumed(plane.ref("position"), "axis",
+            "(" + formatFixed(p->axis.x(), 4) + ", " + formatFixed(p->axis.y(), 4) + ", " +
+                formatFixed(p->axis.z(), 4) + ") makes " + std::string(role) + " " + hashId(plane.id()) +
+                " vertical; its ref_direction is along z: read with the two swapped, the plane normal to z");
+  } else if (std::abs(std::abs(p->axis.z()) - 1.0) > 1e-9) {
     char normal[96];
     std::snprintf(normal, sizeof normal, "(%g, %g, %g)", p->axis.x(), p->axis.y(), p->axis.z());
     unsupported(plane, std::string(role) + " whose normal " + normal + " is not the z axis");

@@ -51,6 +51,45 @@ constexpr std::pair<std::string_view, std::string_view> kStrategies[] = {
 
 } // namespace
 
+bool Lowerer::toolFromUse(const Instance &t, Node &n) {
+  const Instance &op = use_.operation, &f = use_.feature;
+  if (!op || !f)
+    return false;
+  std::string_view type;
+  std::optional<double> diameter;
+  std::string why;
+  if (op.isA("drilling_type_operation") && f.isA("round_hole")) {
+    type = op.isA("reaming")                                  ? "reamer"
+           : op.isA("tapping") || op.isA("thread_drilling")   ? "tap"
+           : op.isA("boring_operation")                       ? "boring_tool"
+           : op.isA("center_drilling")                        ? "center_drill"
+                                                              : "twist_drill";
+    diameter = toleranced(f, "diameter");
+    why = "the diameter of the hole " + hashId(f.id()) + " it makes";
+  } else if (op.isA("milling_type_operation") && f.isA("slot")) {
+    Instance shape = f.ref("swept_shape");
+    if (!shape.isA("square_u_profile") && !shape.isA("rounded_u_profile"))
+      return false;
+    const std::optional<double> width = toleranced(shape, "width");
+    const double allowance = op.real("allowance_side").value_or(0.0);
+    if (!width)
+      return false;
+    type = "endmill";
+    diameter = *width - 2 * allowance;
+    why = "the width " + formatFixed(*width, 4) + " mm of the slot " + hashId(f.id()) + " it mills" +
+          (allowance > 0 ? " less twice the side allowance " + formatFixed(allowance, 4) + " mm" : "");
+  }
+  if (type.empty() || !diameter || *diameter <= 0)
+    return false;
+  n.set("type", Value::word(std::string(type)));
+  n.set("diameter", Value::length(*diameter));
+  assumed(t, "its_tool_body",
+          "absent (no type, no dimension); assumed from its use by " + hashId(op.id()) + " " +
+              std::string(op.entityName()) + ": type " + std::string(type) + ", diameter " +
+              formatFixed(*diameter, 4) + " mm (" + why + ")");
+  return true;
+}
+
 std::optional<std::string> Lowerer::tool(const Instance &t) {
   if (!t)
     return std::nullopt;
@@ -91,7 +130,7 @@ std::optional<std::string> Lowerer::tool(const Instance &t) {
       n.set("hand", Value::word(*hand));
     copyFlag(n, "coolant_through", body, "coolant_through_tool");
     copyAngle(n, "taper_angle", body, "taper_angle");
-  } else {
+  } else if (!toolFromUse(t, n)) {
     missing(t, "its_tool_body");
   }
   copyReal(n, "overall_length", t, "overall_assembly_length", Value::length);
@@ -290,10 +329,18 @@ std::optional<Node> Lowerer::operation(const Instance &op) {
   copyFlag(n, "compensation_chuck", op, "compensation_chuck");
   copyFlag(n, "helical_movement", op, "helical_movement_on_forward");
 
-  if (Instance tech = op.ref("its_technology"))
+  if (Instance tech = op.ref("its_technology")) {
     n.add(technology(*this, tech));
-  else
-    missing(op, "its_technology");
+  } else {
+    // Nothing given is still a technology: resolve-feeds assumes the spindle
+    // speed and the feed from the tool and the workpiece material, and says so.
+    Node empty(ir::Kind::Technology);
+    empty.set("feed_reference", Value::word("tcp"));
+    n.add(std::move(empty));
+    assumed(op, "its_technology",
+            "absent; assumed a technology that gives no feed or speed (resolve-feeds assumes them from the tool "
+            "and the workpiece material)");
+  }
   if (Instance mf = op.ref("its_machine_functions"))
     n.add(machineFunctions(mf));
   if (Instance strategy = op.ref("its_machining_strategy")) {

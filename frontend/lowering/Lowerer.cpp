@@ -207,7 +207,10 @@ std::optional<Node> Lowerer::workingstep(const Instance &ws) {
   if (auto h = planeHeight(ws, "its_secplane", "security plane"))
     node.set("secplane", Value::length(*h));
   if (Instance op = ws.ref("its_operation")) {
-    if (auto lowered = operation(op))
+    use_ = {op, ws.ref("its_feature")};
+    std::optional<Node> lowered = operation(op);
+    use_ = {};
+    if (lowered)
       node.add(std::move(*lowered));
   } else {
     missing(ws, "its_operation");
@@ -454,6 +457,39 @@ void Lowerer::chooseSpeedUnits(const std::vector<Instance> &operations) {
   }
 }
 
+void Lowerer::choosePlacementReading(const std::vector<Instance> &placements) {
+  // Swapped when every placement that gives both directions has its axis
+  // horizontal and its ref_direction along z: such a file has no frame with
+  // z up, not even its raw piece's or its setup's, yet places depths and
+  // heights along z. A file with one frame whose axis is z keeps the
+  // standard's reading for all of them.
+  Instance first;
+  size_t swapped = 0;
+  for (const Instance &a : placements) {
+    std::optional<Vec3> axis, ref;
+    if (Instance i = a.ref("axis"))
+      axis = direction(i);
+    if (Instance r = a.ref("ref_direction"))
+      ref = direction(r);
+    if (!axis || !ref)
+      continue;
+    if (std::abs(axis->z()) > 1e-9 || std::abs(std::abs(ref->z()) - 1) > 1e-9)
+      return;
+    if (!swapped++)
+      first = a;
+  }
+  if (swapped < 2)
+    return;
+  swapAxisAndRef_ = true;
+  diags_
+      .assumption(first.loc(),
+                  "every AXIS2_PLACEMENT_3D of the file that gives both directions (" + std::to_string(swapped) +
+                      ", the raw piece's and the setup's included) has a horizontal axis and its ref_direction "
+                      "along z, though its depths and heights are given along z: read with axis and "
+                      "ref_direction swapped (z up), as the generator evidently meant")
+      .entity(first.id(), std::string(first.entityName()));
+}
+
 std::unique_ptr<ir::Module> Lowerer::run() {
   const auto &entries = bound_.file().entries();
   // One pass over the file: the program's roots, and what the units are
@@ -462,15 +498,18 @@ std::unique_ptr<ir::Module> Lowerer::run() {
   const express::Model &model = bound_.model();
   auto entity = [&](std::string_view name) { return model.findEntity(bound_.schema(), name); };
   const express::EntityId projectEntity = entity("project"), workplanEntity = entity("workplan"),
-                          operationEntity = entity("machining_operation");
+                          operationEntity = entity("machining_operation"),
+                          placementEntity = entity("axis2_placement_3d");
   std::vector<express::EntityId> angleEntities;
   for (const auto &a : kAngles)
     if (express::EntityId e = entity(a.first); e != express::kNone)
       angleEntities.push_back(e);
   auto is = [&](size_t i, express::EntityId e) { return e != express::kNone && bound_.isA(i, e); };
-  std::vector<Instance> projects, workplans, withAngles, operations;
+  std::vector<Instance> projects, workplans, withAngles, operations, placements;
   for (size_t i = 0; i < entries.size(); ++i) {
-    if (is(i, projectEntity))
+    if (is(i, placementEntity))
+      placements.emplace_back(bound_, i);
+    else if (is(i, projectEntity))
       projects.emplace_back(bound_, i);
     else if (is(i, workplanEntity))
       workplans.emplace_back(bound_, i);
@@ -481,6 +520,7 @@ std::unique_ptr<ir::Module> Lowerer::run() {
   }
   chooseAngleUnit(withAngles);
   chooseSpeedUnits(operations);
+  choosePlacementReading(placements);
   module_ = std::make_unique<ir::Module>();
   module_->sourceName = std::string(bound_.file().source().name());
   module_->sourceUnits = {feedToMmPerMin_, cutspeedToMmPerMin_, spindleToRevPerMin_};

@@ -127,6 +127,17 @@ public:
   void slotDepthFromProfile(Node &slot, const Instance &feature);
   /// The raw piece of a workpiece as an extent; nullopt when it has no block.
   std::optional<RawExtent> rawExtent(const Instance &workpiece);
+  /// Whether the file writes every placement with axis and ref_direction
+  /// swapped (then `placement` reads them swapped), with a warning.
+  void choosePlacementReading(const std::vector<Instance> &placements);
+  /// ISO 14649 places a profile in its feature's frame; some generators write
+  /// the profile's placement in workpiece coordinates (the feature's own
+  /// placement again, say), which composed with the feature's puts it
+  /// elsewhere. When the composed origin lies outside the raw piece of
+  /// `workpiece` and the placement read in workpiece coordinates inside, the
+  /// latter is taken: `profile` is placed relative to `frame`, with a warning.
+  void placeProfileOnce(const Instance &profileInstance, Node &profile, const Placement &frame,
+                        const Instance &workpiece);
 
   /// The feature's symbol, lowering it under its workpiece the first time.
   std::optional<std::string> feature(const Instance &feature);
@@ -134,6 +145,11 @@ public:
   // --- operations (LowerOperations.cpp) --------------------------------------
   std::optional<Node> operation(const Instance &op);
   std::optional<std::string> tool(const Instance &tool);
+  /// A tool the file gives no body for (no type, no dimension), assumed
+  /// from its use (use_): a hole's diameter for the hole-making tool, a
+  /// slot's width less the side allowances for the end mill that mills it.
+  /// False (nothing assumed) when the use does not say.
+  bool toolFromUse(const Instance &tool, Node &n);
   /// Adds the toolpaths of a toolpath_list as children of `parent`.
   void toolpaths(const Instance &list, Node &parent);
 
@@ -166,6 +182,11 @@ private:
   std::set<size_t> workplansOnStack_;      ///< cycle guard for nested workplans
   std::vector<Instance> projectWorkpieces_;  ///< the project's its_workpieces
   double angleToDeg_ = 1.0;                  ///< plane_angle_measure to deg
+  bool swapAxisAndRef_ = false;              ///< choosePlacementReading
+  /// The operation being lowered and the feature it machines (toolFromUse).
+  struct Use {
+    Instance operation, feature;
+  } use_;
   double feedToMmPerMin_ = 60000.0;          ///< a technology's feedrate to mm/min
   double cutspeedToMmPerMin_ = 60000.0;      ///< its cutspeed to mm/min
   double spindleToRevPerMin_ = 60.0;         ///< its spindle to rev/min

@@ -331,6 +331,7 @@ std::optional<RawBlock> rawBlock(const ir::Node *workpiece) {
   RawBlock block;
   for (const Vec2 &c : {Vec2(0, 0), Vec2(size.x(), 0), Vec2(size.x(), size.y()), Vec2(0, size.y())})
     block.box.add(fr.frame->map(c));
+  block.bottom = fr.frame->z;
   block.top = fr.frame->z + size.z();
   return block;
 }

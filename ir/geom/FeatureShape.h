@@ -91,7 +91,7 @@ double pointLength(const ir::Node &tool);
 /// and the height of its top; nullopt when it has none or another shape.
 struct RawBlock {
   geom::Box box;
-  double top = 0;
+  double bottom = 0, top = 0;
 };
 std::optional<RawBlock> rawBlock(const ir::Node *workpiece);
 

@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <array>
+#include <set>
 
 namespace stepnc::passes {
 
@@ -249,11 +250,11 @@ private:
       }
       const ir::FeatureShape &s = *shape.shape;
       const double secplane = ws.number("secplane").value_or(0);
-      if (secplane < s.top && !raiseSecplaneOverAir(ws, *op, *feature, s, secplane, moves)) {
-        x_.report(ws, "its security plane z=" + formatFixed(secplane, 4) + " mm is below the top of " + s.symbol +
-                          " (z=" + formatFixed(s.top, 4) + " mm): there is no safe height to travel at");
-        return;
-      }
+      const std::optional<ir::RawBlock> raw = ir::rawBlock(ir::workpieceOf(*x_.module, *feature));
+      if (raw)
+        reportOutsideRaw(ws, s, *raw);
+      if (secplane < s.top || (raw && secplane < raw->top))
+        raiseSecplane(ws, *op, s, raw, secplane, moves);
       p.clearanceZ = clearanceAbove(s.top);
       expanded = dispatch(*family, Step{ws, *op, sel.node, &s, nullptr, p, moves});
     }
@@ -261,26 +262,62 @@ private:
       x_.attach(ws, std::move(moves));
   }
 
-  /// A feature wholly above the raw piece (a generator's misplaced feature:
-  /// its machining cuts air) may have its security plane below its top and
-  /// still above the material: the step then travels at the feature's top
-  /// plus the retract plane, reported. False (nothing changed) otherwise.
-  bool raiseSecplaneOverAir(Node &ws, const Node &op, const Node &feature, const ir::FeatureShape &s,
-                            double secplane, Node &moves) {
-    const std::optional<ir::RawBlock> raw = ir::rawBlock(ir::workpieceOf(*x_.module, feature));
-    if (!raw || secplane < raw->top || s.bottom < raw->top)
-      return false;
-    const double raised = s.top + op.number("retract_plane").value_or(kDefaultClearance);
-    x_.assumed(ws, ws,
-               s.symbol + " lies wholly above the raw piece (its floor z=" + formatFixed(s.bottom, 4) +
-                   " mm, the raw piece's top z=" + formatFixed(raw->top, 4) +
-                   " mm): its machining cuts no material. Its security plane z=" + formatFixed(secplane, 4) +
-                   " mm is below its top z=" + formatFixed(s.top, 4) + " mm; assumed z=" + formatFixed(raised, 4) +
-                   " mm (the top plus the retract plane) for this workingstep");
+  /// A security plane below the feature's top or the raw piece's leaves no
+  /// safe height to travel at as written (generators write a fixed height,
+  /// or place the feature above the raw piece); the raw piece's top is where
+  /// material may remain. The step then travels at the feature's
+  /// top or the raw piece's, whichever is higher, plus the retract plane:
+  /// an assumption, reported (an error with --strict).
+  void raiseSecplane(Node &ws, const Node &op, const ir::FeatureShape &s, const std::optional<ir::RawBlock> &raw,
+                     double secplane, Node &moves) {
+    const double top = raw ? std::max(s.top, raw->top) : s.top;
+    const double raised = top + op.number("retract_plane").value_or(kDefaultClearance);
+    const bool belowRaw = raw && raw->top > s.top;
+    std::string why = "its security plane z=" + formatFixed(secplane, 4) + " mm is below the top of " +
+                      (belowRaw ? "the raw piece" : s.symbol) + " (z=" + formatFixed(top, 4) +
+                      " mm): no safe height to travel at as written; assumed z=" +
+                      formatFixed(raised, 4) + " mm (the top of " +
+                      (belowRaw ? "the raw piece" : s.symbol) +
+                      " plus the retract plane) for this workingstep";
+    x_.assumed(ws, ws, why);
     ws.set("secplane", ir::Value::length(raised));
     moves.set("secplane", ir::Value::length(raised));
-    return true;
   }
+
+  /// Says, once per feature, where it lies outside the raw piece: wholly
+  /// (its machining cuts no material: a generator's misplaced feature, as a
+  /// rule) or in part in the plane (that part is cut in air).
+  void reportOutsideRaw(const Node &ws, const ir::FeatureShape &s, const ir::RawBlock &raw) {
+    if (s.unbounded || !outsideReported_.insert(s.symbol).second)
+      return;
+    const geom::Box box = s.target.box();
+    if (box.empty())
+      return;
+    constexpr double eps = 1e-6;
+    auto extent = [](const geom::Box &b, double low, double high) {
+      return "x " + formatFixed(b.lo.x(), 4) + " .. " + formatFixed(b.hi.x(), 4) + ", y " + formatFixed(b.lo.y(), 4) +
+             " .. " + formatFixed(b.hi.y(), 4) + ", z " + formatFixed(low, 4) + " .. " + formatFixed(high, 4) +
+             " mm";
+    };
+    const std::string where =
+        " (" + extent(box, s.bottom, s.top) + "; the raw piece " + extent(raw.box, raw.bottom, raw.top) + ")";
+    const geom::Box inside = raw.box.grown(eps);
+    const bool apart = !box.overlaps(inside) || s.bottom >= raw.top - eps || s.top <= raw.bottom + eps;
+    const bool beyond = box.lo.x() < inside.lo.x() || box.lo.y() < inside.lo.y() || box.hi.x() > inside.hi.x() ||
+                        box.hi.y() > inside.hi.y();
+    if (apart)
+      x_.diags->warning(ws.origin.loc, ws.kindName() + " " + ws.symbol + ": " + s.symbol +
+                                           " lies wholly outside the raw piece" + where +
+                                           ": its machining cuts no material")
+          .entity(ws.origin.entityId);
+    else if (beyond)
+      x_.diags->warning(ws.origin.loc, ws.kindName() + " " + ws.symbol + ": " + s.symbol +
+                                           " extends beyond the raw piece in x or y" + where +
+                                           ": what lies outside is cut in air")
+          .entity(ws.origin.entityId);
+  }
+
+  std::set<std::string> outsideReported_;
 
   /// Runs the family on the step; when it made moves without an error,
   /// says where they do not follow the operation's approach or retract.

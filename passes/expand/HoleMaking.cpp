@@ -122,6 +122,11 @@ void reportIgnored(Expander &x, const Step &step) {
                 "retract_distance " + formatFixed(*distance, 3) +
                     " mm is not supported: out to the clearance height between pecks");
   if (op.is(ir::Trait::TapCycle))
+    if (auto ratio = op.number("feed_on_retract"); ratio && std::abs(*ratio - 1) > 1e-9)
+      x.assumed(ws, op,
+                "feed_on_retract " + formatFixed(*ratio, 3) +
+                    " does not apply to tapping: the tap leaves by its thread's pitch, at the feed it entered with");
+  if (op.is(ir::Trait::TapCycle))
     for (std::string_view dwell : {"dwell_bottom", "dwell_step"})
       if (auto seconds = op.number(dwell); seconds && *seconds > 0)
         x.assumed(ws, op,
@@ -202,7 +207,7 @@ bool expandHoleMaking(Expander &x, const Step &step) {
   // Reamers, boring bars and taps leave at feed (a tap with the spindle
   // reversed: the backend's tapping cycle); drills leave at rapid.
   const bool feedOut = op.spec().isAny(ir::Trait::BoreCycle | ir::Trait::TapCycle);
-  const double outFeed = p.feed * op.number("feed_on_retract").value_or(1.0);
+  const double outFeed = op.is(ir::Trait::TapCycle) ? p.feed : p.feed * op.number("feed_on_retract").value_or(1.0);
   if (feedOut)
     e.linear(at(c, p.clearanceZ), outFeed, "retract");
   e.retract();
