@@ -14,7 +14,8 @@ binding::BindOptions bindOptions(const DiagnosticEngine &diags) {
 
 std::unique_ptr<ir::Module> loadModule(std::unique_ptr<SourceFile> &source, const SchemaSelection &schemas,
                                        DiagnosticEngine &diags, std::string &usageError,
-                                       std::unique_ptr<p21::Part21File> *keep) {
+                                       std::unique_ptr<p21::Part21File> *keep,
+                                       const lowering::LowerOptions &lower) {
   if (!schemas.readAsPart21(source, diags))
     return nullptr;
   std::string_view text = source->text();
@@ -42,7 +43,7 @@ std::unique_ptr<ir::Module> loadModule(std::unique_ptr<SourceFile> &source, cons
   auto bound = binding::bind(*file, *model, *schema, diags, bindOptions(diags));
   if (diags.hasErrors())
     return nullptr;
-  auto module = lowering::lowerToFeatureIR(*bound, diags);
+  auto module = lowering::lowerToFeatureIR(*bound, diags, lower);
   if (!module || diags.hasErrors())
     return nullptr;
   if (keep)

@@ -6,6 +6,7 @@
 
 #include "driver/SchemaSelection.h"
 #include "frontend/binding/Binder.h"
+#include "frontend/lowering/Lowering.h"
 #include "frontend/part21/Part21File.h"
 #include "ir/Node.h"
 #include "support/Diagnostics.h"
@@ -29,9 +30,11 @@ binding::BindOptions bindOptions(const DiagnosticEngine &diags);
 /// after reporting the input's errors to `diags` (a FILE_SCHEMA that names
 /// no schema stepnc compiles is one, located there), or with `usageError` set
 /// when the caller is at fault (--no-schema). `file`, when given, receives
-/// the Part 21 file read (null for IR text).
+/// the Part 21 file read (null for IR text). `lower` says how lowering reads
+/// the file's units (--feed-unit, ...).
 std::unique_ptr<ir::Module> loadModule(std::unique_ptr<SourceFile> &source, const SchemaSelection &schemas,
                                        DiagnosticEngine &diags, std::string &usageError,
-                                       std::unique_ptr<p21::Part21File> *file = nullptr);
+                                       std::unique_ptr<p21::Part21File> *file = nullptr,
+                                       const lowering::LowerOptions &lower = {});
 
 } // namespace stepnc::driver

@@ -345,13 +345,6 @@ void Lowerer::chooseAngleUnit(const std::vector<Instance> &withAngles) {
 
 namespace {
 
-/// A reading of a unit the ARM leaves implicit: its name and its factor to
-/// the IR's unit (mm/min, rev/min).
-struct UnitReading {
-  std::string_view name;
-  double factor;
-};
-
 /// The readings of speed_measure and rot_speed_measure, the standard's first.
 constexpr UnitReading kSpeedReadings[] = {{"m/s", 60000}, {"mm/min", 1}, {"m/min", 1000}, {"mm/s", 60}};
 constexpr UnitReading kSpindleReadings[] = {{"rev/s", 60}, {"rev/min", 1}};
@@ -385,6 +378,9 @@ size_t chooseReading(const UnitReading (&readings)[N], const std::vector<SpeedVa
 
 } // namespace
 
+std::span<const UnitReading> speedReadings() { return kSpeedReadings; }
+std::span<const UnitReading> spindleReadings() { return kSpindleReadings; }
+
 void Lowerer::chooseSpeedUnits(const std::vector<Instance> &operations) {
   // Every technology an operation uses, with its tool's diameter.
   std::vector<SpeedValue> feeds, cutspeeds, spindles;
@@ -414,8 +410,8 @@ void Lowerer::chooseSpeedUnits(const std::vector<Instance> &operations) {
   };
   const size_t spindle = chooseReading(kSpindleReadings, spindles, plausibleSpindle);
   const UnitConventions &u = options_.units;
-  feedToMmPerMin_ = u.speedToMmPerMin > 0 ? u.speedToMmPerMin : kSpeedReadings[feed].factor;
-  cutspeedToMmPerMin_ = u.speedToMmPerMin > 0 ? u.speedToMmPerMin : kSpeedReadings[cutspeed].factor;
+  feedToMmPerMin_ = u.feedToMmPerMin > 0 ? u.feedToMmPerMin : kSpeedReadings[feed].factor;
+  cutspeedToMmPerMin_ = u.cutspeedToMmPerMin > 0 ? u.cutspeedToMmPerMin : kSpeedReadings[cutspeed].factor;
   spindleToRevPerMin_ = u.rotSpeedToRevPerMin > 0 ? u.rotSpeedToRevPerMin : kSpindleReadings[spindle].factor;
   // Say which reading was taken when it is not the standard's.
   auto report = [&](const std::vector<SpeedValue> &values, const UnitReading &chosen, const UnitReading &standard,
@@ -432,10 +428,10 @@ void Lowerer::chooseSpeedUnits(const std::vector<Instance> &operations) {
                         std::string(standard.name) + ", " + formatFixed(std::abs(v.value) * standard.factor, 1) + ")")
         .entity(v.tech.id(), std::string(v.tech.entityName()));
   };
-  if (u.speedToMmPerMin <= 0) {
+  if (u.feedToMmPerMin <= 0)
     report(feeds, kSpeedReadings[feed], kSpeedReadings[0], "feeds", "mm/min");
+  if (u.cutspeedToMmPerMin <= 0)
     report(cutspeeds, kSpeedReadings[cutspeed], kSpeedReadings[0], "cutting speeds", "mm/min");
-  }
   if (u.rotSpeedToRevPerMin <= 0)
     report(spindles, kSpindleReadings[spindle], kSpindleReadings[0], "spindle speeds", "rev/min");
   // A spindle speed that no reading makes plausible with the others: say

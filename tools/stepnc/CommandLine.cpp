@@ -5,6 +5,8 @@
 #include <CLI/CLI.hpp>
 #include <filesystem>
 #include <iostream>
+#include <span>
+#include <vector>
 
 namespace stepnc::tool {
 
@@ -33,6 +35,58 @@ void addStrictOption(CLI::App &cmd, DiagnosticOptions &opts) {
                "Make every assumption an error: '$' where the schema wants a value, an alias for an\n"
                "entity name, an abstract entity instantiated, a value lowering had to assume (without\n"
                "--strict each is a warning that ends '--strict makes it an error')");
+}
+
+namespace {
+
+std::vector<std::string> unitNames(std::span<const lowering::UnitReading> readings) {
+  std::vector<std::string> names = {"auto"};
+  for (const lowering::UnitReading &r : readings)
+    names.emplace_back(r.name);
+  return names;
+}
+
+/// The factor of unit `name` among `readings`; 0 (chosen per file) for "auto".
+double factorOf(std::span<const lowering::UnitReading> readings, const std::string &name) {
+  for (const lowering::UnitReading &r : readings)
+    if (r.name == name)
+      return r.factor;
+  return 0.0;
+}
+
+} // namespace
+
+lowering::UnitConventions UnitOptions::conventions() const {
+  lowering::UnitConventions u;
+  u.feedToMmPerMin = factorOf(lowering::speedReadings(), feed);
+  u.cutspeedToMmPerMin = factorOf(lowering::speedReadings(), cuttingSpeed);
+  u.rotSpeedToRevPerMin = factorOf(lowering::spindleReadings(), spindle);
+  using Angle = lowering::UnitConventions::Angle;
+  u.angles = angle == "deg" ? Angle::Degree : angle == "rad" ? Angle::Radian : Angle::Auto;
+  return u;
+}
+
+void addUnitOptions(CLI::App &cmd, UnitOptions &opts) {
+  const std::vector<std::string> speeds = unitNames(lowering::speedReadings());
+  cmd.add_option("--feed-unit", opts.feed,
+                 "Read the file's feedrates in this unit instead of choosing by plausibility (auto; "
+                 "ISO 14649-11 reads m/s)")
+      ->check(CLI::IsMember(speeds))
+      ->default_str("auto");
+  cmd.add_option("--cutting-speed-unit", opts.cuttingSpeed,
+                 "Read the file's cutting speeds (cutspeed) in this unit instead of choosing by plausibility")
+      ->check(CLI::IsMember(speeds))
+      ->default_str("auto");
+  cmd.add_option("--spindle-unit", opts.spindle,
+                 "Read the file's spindle speeds in this unit instead of choosing by plausibility (ISO "
+                 "14649-11 reads rev/s)")
+      ->check(CLI::IsMember(unitNames(lowering::spindleReadings())))
+      ->default_str("auto");
+  cmd.add_option("--angle-unit", opts.angle,
+                 "Read the file's angles in this unit instead of choosing (auto: radians when every angle "
+                 "is below 2 pi and none a whole number of degrees)")
+      ->check(CLI::IsMember({"auto", "deg", "rad"}))
+      ->default_str("auto");
 }
 
 void addSchemaOptions(CLI::App &cmd, driver::SchemaOptions &opts) {

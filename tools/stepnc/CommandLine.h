@@ -5,6 +5,7 @@
 
 #include "driver/ExitCode.h"
 #include "driver/SchemaSelection.h"
+#include "frontend/lowering/Lowering.h"
 #include "support/Diagnostics.h"
 #include "support/SourceFile.h"
 
@@ -37,6 +38,17 @@ void addDiagnosticOptions(CLI::App &cmd, DiagnosticOptions &opts);
 /// --strict, for the commands that read STEP-NC (compile, check, convert,
 /// opt, sim).
 void addStrictOption(CLI::App &cmd, DiagnosticOptions &opts);
+
+/// How the speeds and angles of a STEP-NC file are read: "auto" (chosen per
+/// file by plausibility, docs/ir.md) or a unit.
+struct UnitOptions {
+  std::string feed = "auto", cuttingSpeed = "auto", spindle = "auto", angle = "auto";
+  lowering::UnitConventions conventions() const;
+};
+
+/// --feed-unit, --cutting-speed-unit, --spindle-unit, --angle-unit, for the
+/// commands that lower STEP-NC (compile, opt, sim).
+void addUnitOptions(CLI::App &cmd, UnitOptions &opts);
 
 /// --schema FILE.exp (repeatable) and --no-schema.
 void addSchemaOptions(CLI::App &cmd, driver::SchemaOptions &opts);

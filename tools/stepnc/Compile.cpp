@@ -142,7 +142,8 @@ int compileSource(const CompileOptions &opts, const std::string &emit, std::uniq
   std::unique_ptr<p21::Part21File> file;
   std::string usageError;
   std::unique_ptr<ir::Module> module =
-      driver::loadModule(source, schemas, diags, usageError, emit == "stepnc" ? &file : nullptr);
+      driver::loadModule(source, schemas, diags, usageError, emit == "stepnc" ? &file : nullptr,
+                         lowering::LowerOptions{opts.units.conventions()});
   if (module && !ir::verifyModule(*module, diags))
     module.reset();
   if (!module) {
@@ -292,6 +293,7 @@ void addCommonOptions(CLI::App &cmd, CompileOptions &opts) {
                "Check the diagnostics against the expected-error/warning comments in the input\n"
                "(exit 0 when they match) instead of printing them");
   addSchemaOptions(cmd, opts.schema);
+  addUnitOptions(cmd, opts.units);
   addDiagnosticOptions(cmd, opts.diag);
   addStrictOption(cmd, opts.diag);
 }

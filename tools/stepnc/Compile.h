@@ -41,6 +41,7 @@ struct CompileOptions {
   /// instead of printing them (docs/diagnostics.md).
   bool verifyDiagnostics = false;
   driver::SchemaOptions schema;
+  UnitOptions units;
   DiagnosticOptions diag;
 };
 

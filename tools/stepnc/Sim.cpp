@@ -41,6 +41,7 @@ struct SimCommandOptions {
   std::string samples;  ///< CSV of every sample
   std::string output = "-";
   driver::SchemaOptions schema;
+  UnitOptions units;
   DiagnosticOptions diag;
 };
 
@@ -112,7 +113,8 @@ int runSim(const SimCommandOptions &opts) {
     if (const int rc = loadSchemas(schemas, diags); rc != kExitOk)
       return rc;
     std::string usageError;
-    module = driver::loadModule(source, schemas, diags, usageError);
+    module = driver::loadModule(source, schemas, diags, usageError, nullptr,
+                                lowering::LowerOptions{opts.units.conventions()});
     if (!module) {
       if (usageError.empty())
         return kExitDiagnostics;
@@ -233,6 +235,7 @@ void registerSim(CLI::App &app, std::function<void(int)> setResult) {
   cmd->add_option("--samples", opts->samples, "Write every sample (position, velocity, acceleration, jerk) as CSV");
   cmd->add_option("-o,--output", opts->output, "Report file ('-', the default, for standard output)");
   addSchemaOptions(*cmd, opts->schema);
+  addUnitOptions(*cmd, opts->units);
   addDiagnosticOptions(*cmd, opts->diag);
   addStrictOption(*cmd, opts->diag);
   cmd->callback([opts, setResult] { setResult(runSim(*opts)); });
