@@ -221,9 +221,11 @@ std::optional<Node> Lowerer::profile(const Instance &p) {
     n.kind = ir::Kind::GeneralProfile;
     const bool closed = p.isA("general_closed_profile");
     n.set("closed", Value::boolean(closed));
-    if (auto c = curve(p.ref(closed ? "closed_profile_shape" : "its_profile")))
+    if (auto c = curve(p.ref(closed ? "closed_profile_shape" : "its_profile"))) {
+      if (closed)
+        closePolyline(p.ref("closed_profile_shape"), *c);
       n.add(std::move(*c));
-    else
+    } else
       missing(p, closed ? "closed_profile_shape" : "its_profile");
   } else {
     unsupported(p, "profile");
@@ -287,6 +289,20 @@ std::optional<Node> Lowerer::path(const Instance &t, const PathContext *context)
   }
   unsupported(t, "travel path");
   return std::nullopt;
+}
+
+void Lowerer::closePolyline(const Instance &shape, Node &curve) {
+  if (curve.kind != ir::Kind::Polyline || curve.children.size() < 3)
+    return;
+  const std::optional<Vec3> first = curve.children.front().vec("at"), last = curve.children.back().vec("at");
+  if (!first || !last || (*first - *last).norm() <= 1e-6)
+    return;
+  Node closing = curve.children.front();
+  curve.add(std::move(closing));
+  assumed(shape, "points",
+          "end at " + formatTuple({last->x(), last->y(), last->z()}, 4) + " mm, not at the first point " +
+              formatTuple({first->x(), first->y(), first->z()}, 4) +
+              " mm, in a closed profile: closed with a line back to the first point");
 }
 
 std::optional<Node> Lowerer::curve(const Instance &c) {

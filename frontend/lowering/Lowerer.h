@@ -127,6 +127,9 @@ public:
   void slotDepthFromProfile(Node &slot, const Instance &feature);
   /// The raw piece of a workpiece as an extent; nullopt when it has no block.
   std::optional<RawExtent> rawExtent(const Instance &workpiece);
+  /// A polyline `curve` of closed profile shape `shape` whose last point is
+  /// not its first: closed with its first point again, with a warning.
+  void closePolyline(const Instance &shape, Node &curve);
   /// Whether the file writes every placement with axis and ref_direction
   /// swapped (then `placement` reads them swapped), with a warning.
   void choosePlacementReading(const std::vector<Instance> &placements);

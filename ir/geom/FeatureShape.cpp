@@ -336,6 +336,24 @@ std::optional<RawBlock> rawBlock(const ir::Node *workpiece) {
   return block;
 }
 
+namespace {
+
+/// ISO 14649-10: a pocket's orthogonal_radius is the radius between its
+/// walls, whatever its profile. A rectangle is built with it; a general
+/// profile's every corner that turns into the pocket is rounded here: the
+/// opening of the area by the radius (shrunk, then grown back), which rounds
+/// exactly the corners sharper than the radius and leaves the rest.
+void roundCorners(const ir::Node &feature, FeatureShape &s) {
+  const double radius = feature.number("orthogonal_radius").value_or(0);
+  const ir::Node *profile = feature.child(ir::Kind::GeneralProfile);
+  if (radius <= 0 || !profile)
+    return;
+  s.target = geom::growExact(geom::shrinkExact(s.target, radius), radius);
+  s.limit = s.target;
+}
+
+} // namespace
+
 ShapeResult featureShape(const ir::Module &module, const ir::Node &feature) {
   const Node *workpiece = workpieceOf(module, feature);
   FrameResult fr = planeFrame(feature);
@@ -358,6 +376,7 @@ ShapeResult featureShape(const ir::Module &module, const ir::Node &feature) {
     } else if (auto l = b.closedProfile(feature, feature.number("orthogonal_radius").value_or(0))) {
       s.target = outer(mapLoop(*l, s.frame));
       s.limit = s.target;
+      roundCorners(feature, s);
     }
     b.islands(feature, s);
   } else if (feature.kind == ir::Kind::PlanarFace) {
