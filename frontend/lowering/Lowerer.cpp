@@ -116,8 +116,19 @@ std::optional<std::string> Lowerer::workpiece(const Instance &wp) {
     if (auto standard = material.string("standard_identifier"))
       node.set("material_standard", Value::string(*standard));
   }
-  if (auto tol = wp.real("global_tolerance"))
-    node.set("global_tolerance", Value::length(*tol));
+  if (auto tol = wp.real("global_tolerance")) {
+    // The verifier checks toolpaths to this tolerance; a value no machined
+    // part is toleranced to (some generators write 50 mm) would let it pass
+    // gouges and uncut floors.
+    constexpr double kMaxTolerance = 1.0;  // mm
+    if (*tol > 0 && *tol <= kMaxTolerance)
+      node.set("global_tolerance", Value::length(*tol));
+    else
+      assumed(wp, "global_tolerance",
+              formatFixed(*tol, 4) + " mm is no machining tolerance (it must be above 0 and at most " +
+                  formatFixed(kMaxTolerance, 1) + " mm); not used: toolpaths are verified to 0.01 mm "
+                  "(verify-toolpaths<tolerance=...> sets another)");
+  }
   if (Instance bounding = rawBounding(wp)) {
     if (bounding.isA("block")) {
       Node raw(ir::Kind::Rawpiece);
