@@ -17,6 +17,10 @@
 //           grown by it (round holes: on the axis, tool no wider than the hole);
 //   uncut   at the floor level the sweep covers what the tool can reach
 //           (the opening of the allowed area with the tool radius);
+//   slots with slanted or curved walls instead: the tool as a body (its
+//           corner or ball), grown by the side allowance, at sampled
+//           heights within the slot's cross-section there; each level
+//           reaching as far as the tool fits;
 // then, per feature, the floors of roughing and finishing together cover what
 // the smallest tool can reach. Figures go into the `moves` node's comment.
 // Moves are read on the path the tool is predicted to follow: a move
@@ -470,6 +474,10 @@ private:
     for (const ir::Move &m : s.moves)
       if (m.isFeed() && m.from && std::min(m.from->z(), m.to.z()) < s.shape->top - s.tol)
         cuts.push_back(cutOf(m));
+    if (s.shape->section) {
+      checkSection(s, cuts);
+      return;
+    }
     checkGouge(s, cuts);
     if (s.op && isMilling(s.op->kind))
       checkUncut(s, cuts);
@@ -697,6 +705,241 @@ private:
       return cache_.reachable(*s.shape, s.radius, s.allowanceSide, idx);
     const double band = s.op->number("radial_depth").value_or(s.radius);
     return cache_.sideBand(*s.shape, s.radius, s.allowanceSide, band > 0 ? band : s.radius, idx);
+  }
+
+  // --- Slots with slanted or curved walls -----------------------------------------------
+  //
+  // The tool is a body, not a disc: at height h above its tip it is a disc of
+  // radius R - rc + sqrt(rc^2 - (rc - h)^2) below its corner (rc), R above.
+  // Grown all round by the side allowance (R + a, rc + a, its tip a lower) it
+  // must stay, at every height, within the slot's outline at that height
+  // (ir::SlotSection, the walls as the profile gives them). Heights are
+  // sampled: finely through the corner, at every vertex of the walls and at
+  // the top, where the room left between body and wall is smallest on
+  // straight walls and arcs that open upwards.
+
+  /// The grown tool's radius at height h above its (grown) tip; < 0 below it.
+  static double bodyRadius(double radius, double corner, double h) {
+    if (h < 0)
+      return -1;
+    if (h >= corner)
+      return radius;
+    return radius - corner + std::sqrt(std::max(0.0, corner * corner - (corner - h) * (corner - h)));
+  }
+
+  /// The heights (workpiece z) at which a grown tool with its tip at `tip` is
+  /// measured against the walls: through its corner, the walls' vertices, the top.
+  static std::vector<double> sampleHeights(const ir::FeatureShape &shape, double tip, double corner) {
+    constexpr int kCornerSamples = 32;
+    std::vector<double> out;
+    for (int k = 0; k <= kCornerSamples; ++k)
+      out.push_back(tip + corner * k / kCornerSamples);
+    for (double b : shape.section->breaks())
+      out.push_back(shape.bottom + b);
+    out.push_back(shape.top - 1e-9);
+    std::erase_if(out, [&](double z) { return z < tip || z < shape.bottom || z >= shape.top; });
+    std::sort(out.begin(), out.end());
+    return out;
+  }
+
+  /// Where the tool centre may be across the slot (left of its course) with
+  /// the tool's tip at z: every sampled height leaves room for the grown
+  /// body's disc between the walls. Empty (lo > hi) where it does not fit.
+  std::pair<double, double> centreRoom(const Step &s, double z) const {
+    const double a = s.allowanceSide, corner = ir::cornerRadius(*s.tool) + a, radius = s.radius + a;
+    const double tip = z - a;
+    // The room each height leaves on either side (lo: the least u, hi: the
+    // most); none where the body or the walls are not there.
+    auto room = [&](double v) -> std::optional<std::pair<double, double>> {
+      const double rho = bodyRadius(radius, corner, v - tip);
+      const auto span = s.shape->section->span(v - s.shape->bottom);
+      if (rho < 0 || !span)
+        return std::nullopt;
+      return std::pair(span->first + rho, span->second - rho);
+    };
+    const std::vector<double> heights = sampleHeights(*s.shape, tip, corner);
+    double lo = -1e300, hi = 1e300;
+    for (const bool low : {true, false}) {
+      // The tightest sample, then the tightest height between its neighbours
+      // (golden section: the room is smooth there).
+      size_t best = heights.size();
+      double bound = low ? -1e300 : 1e300;
+      for (size_t k = 0; k < heights.size(); ++k)
+        if (auto r = room(heights[k]); r && (low ? r->first > bound : r->second < bound)) {
+          bound = low ? r->first : r->second;
+          best = k;
+        }
+      if (best == heights.size())
+        continue;
+      double x0 = heights[best > 0 ? best - 1 : best], x1 = heights[best + 1 < heights.size() ? best + 1 : best];
+      auto value = [&](double v) {
+        const auto r = room(v);
+        return !r ? (low ? -1e300 : 1e300) : (low ? r->first : r->second);
+      };
+      constexpr double kGolden = 0.6180339887498949;
+      for (int i = 0; i < 60 && x1 - x0 > 1e-9; ++i) {
+        const double m0 = x1 - kGolden * (x1 - x0), m1 = x0 + kGolden * (x1 - x0);
+        const bool firstTighter = low ? value(m0) > value(m1) : value(m0) < value(m1);
+        (firstTighter ? x1 : x0) = firstTighter ? m1 : m0;
+        bound = low ? std::max(bound, value(m0)) : std::min(bound, value(m0));
+      }
+      (low ? lo : hi) = bound;
+    }
+    return {lo, hi};
+  }
+
+  void checkSection(Step &s, const std::vector<Cut> &cuts) {
+    const ir::FeatureShape &shape = *s.shape;
+    // Moves read back from IR text are rounded to 0.0001 mm: a tool on a
+    // slanted wall may stand a few times that into it, when its height is
+    // rounded down. Half a micrometre is let pass.
+    constexpr double kTextPrecision = 5e-4;
+    const double a = s.allowanceSide, corner = ir::cornerRadius(*s.tool) + a,
+                 radius = s.radius + a - kTextPrecision;
+    std::vector<const Cut *> all;
+    for (const Cut &c : cuts)
+      all.push_back(&c);
+    const auto levels = byLevel(all);
+    // Gouge: per level, the worst sampled height.
+    std::vector<Offence> gouges;
+    double gougeTotal = 0;
+    for (const auto &level : levels) {
+      const double tip = level.front()->low - a;
+      double worst = 0, worstZ = tip;
+      for (double v : sampleHeights(shape, tip, corner)) {
+        const double rho = bodyRadius(radius, corner, v - tip);
+        const auto span = shape.section->span(v - shape.bottom);
+        if (rho <= 0 || !span)
+          continue;
+        const Region allowed = ir::slotBetween(shape, span->first, span->second).limit;
+        if (discsInside(level, allowed, rho))
+          continue;
+        const double area = geom::subtract(sweep(level, rho), allowed).area();
+        if (area > worst) {
+          worst = area;
+          worstZ = v;
+        }
+      }
+      gougeTotal += worst;
+      if (worst > s.tol * s.tol)
+        gouges.push_back({s.exec, "gouge of " + mm2(worst) + " into the walls of " + shape.symbol +
+                                      " at depth level z=" + mm(level.front()->low) + ", at z=" + mm(worstZ) +
+                                      " (tool " + s.tool->symbol + ", radius " + mm(s.radius) + ", corner radius " +
+                                      mm(corner - a) + ", allowance_side " + mm(a) + ")"});
+    }
+    s.figures.gouge = gougeTotal;
+    if (ir::runsAsWritten(*s.exec)) {
+      // As for any feature: the file's required toolpaths run as written.
+      for (Offence &o : gouges)
+        o.message += " (a required toolpath of the file, run as written)";
+      report(s, gouges, "gouges of required toolpaths", /*warning=*/true);
+    } else {
+      report(s, gouges, "gouge errors");
+    }
+    if (!isMilling(s.op->kind))
+      return;
+    checkSectionUncut(s, cuts);
+  }
+
+  /// True when every segment of the cuts keeps a disc of radius rho inside
+  /// `allowed` (its start inside, the whole segment at least rho from the boundary).
+  static bool discsInside(const std::vector<const Cut *> &cuts, const Region &allowed, double rho) {
+    std::vector<Seg> boundary;
+    for (const geom::Loop &l : allowed.loops)
+      boundary.insert(boundary.end(), l.segs.begin(), l.segs.end());
+    for (const Cut *c : cuts)
+      for (const Seg &seg : c->segs) {
+        if (!allowed.contains(seg.a))
+          return false;
+        for (const Seg &b : boundary)
+          if (geom::distance(seg, b) < rho - geom::kEps)
+            return false;
+      }
+    return true;
+  }
+
+  /// Uncut, level by level: each level's horizontal cuts sweep what the tool
+  /// reaches at that level with its full radius (the room found by
+  /// centreRoom, widened by the radius): all of it when roughing and at the
+  /// last level, the band along each wall when finishing the walls above.
+  /// The lowest level must be as low as the tool fits (or the floor).
+  void checkSectionUncut(Step &s, const std::vector<Cut> &cuts) {
+    const ir::FeatureShape &shape = *s.shape;
+    const double targetArea = shape.target.area();
+    std::vector<const Cut *> flat;
+    for (const Cut &c : cuts)
+      if (c.horizontal)
+        flat.push_back(&c);
+    std::vector<Offence> offences;
+    if (flat.empty()) {
+      offences.push_back({s.exec, "no cutting move below the top of " + shape.symbol + " (z=" + mm(shape.top) +
+                                      "): nothing of it is cleared"});
+      report(s, offences, "uncut errors");
+      return;
+    }
+    const auto levels = byLevel(flat);
+    const bool wallsOnly = isSideMilling(s.op->kind);
+    const bool finishing = isFinishing(s.op->kind);
+    double uncutTotal = 0;
+    std::vector<Offence> uncut;
+    for (size_t i = 0; i < levels.size(); ++i) {
+      const double z = levels[i].front()->low;
+      const auto [lo, hi] = centreRoom(s, z);
+      if (lo > hi + s.tol)
+        continue;  // the tool does not fit here: a gouge, reported above
+      const double reachLo = std::min(lo, hi) - s.radius, reachHi = std::max(lo, hi) + s.radius;
+      Region required = reachOf(shape, reachLo, reachHi, s.radius);
+      // Finishing follows the walls above its last (lowest) level.
+      const bool band = wallsOnly || (finishing && i > 0);
+      if (band && reachHi - reachLo > 2 * s.radius + 1e-6)
+        required = geom::subtract(required, ir::slotBetween(shape, reachLo + s.radius, reachHi - s.radius).target);
+      const Region swept = sweep(levels[i], s.radius);
+      const double area = geom::subtract(required, swept).area();
+      uncutTotal += area;
+      if (i == 0)
+        s.figures.swept = swept.area();
+      if (area > kUncutShare * targetArea)
+        uncut.push_back({s.exec, "leaves " + mm2(area) + " of " + shape.symbol + " uncut at depth level z=" + mm(z) +
+                                     " (tool " + s.tool->symbol + ", radius " + mm(s.radius) + ", allowance_side " +
+                                     mm(s.allowanceSide) + ")"});
+    }
+    s.figures.uncut = uncutTotal;
+    s.figures.uncutPercent = targetArea > 0 ? 100 * uncutTotal / targetArea : 0.0;
+    if (s.op->kind == ir::Kind::FreeformOperation)
+      return;
+    if (finishing)
+      offences.insert(offences.end(), uncut.begin(), uncut.end());
+    else
+      report(s, uncut, "roughing steps leaving uncut area", /*warning=*/true);
+    // The lowest level: where the tool stops fitting, or the floor.
+    const double floor = shape.bottom + s.allowanceBottom;
+    double fits = shape.top, below = floor;
+    auto roomAt = [&](double z) {
+      const auto [lo, hi] = centreRoom(s, z);
+      return lo <= hi + 1e-9;
+    };
+    if (roomAt(floor)) {
+      fits = floor;
+    } else {
+      for (int k = 0; k < 60 && fits - below > 1e-7; ++k) {
+        const double mid = (fits + below) / 2;
+        (roomAt(mid) ? fits : below) = mid;
+      }
+    }
+    const double lowest = levels.front().front()->low;
+    if (lowest > fits + s.tol)
+      offences.push_back({s.exec, "its lowest cutting level z=" + mm(lowest) + " is above the lowest the tool fits in " +
+                                      shape.symbol + ", z=" + mm(fits)});
+    report(s, offences, "uncut errors");
+  }
+
+  /// What a tool of radius r reaches of the slot between lo and hi (left of
+  /// its course): the slot's outline there, opened by r where an end is not open.
+  static Region reachOf(const ir::FeatureShape &shape, double lo, double hi, double r) {
+    const ir::FeatureShape level = ir::slotBetween(shape, lo, hi);
+    if (shape.slot->end1 == "open" && shape.slot->end2 == "open")
+      return level.target;
+    return geom::intersect(geom::growExact(geom::shrinkExact(level.limit, r), r), level.target);
   }
 
   // --- Roughing and finishing together ---------------------------------------------------

@@ -5,7 +5,9 @@
 #include "ir/geom/Curves.h"
 #include "support/Format.h"
 
+#include <algorithm>
 #include <cmath>
+#include <tuple>
 #include <numbers>
 
 namespace stepnc::ir {
@@ -43,6 +45,45 @@ Loop mapLoop(const Loop &l, const PlaneFrame &f) {
     out.segs.push_back(m);
   }
   return out;
+}
+
+/// The outline of a slot with vertical walls along the line a -> b (its
+/// middle), `width` wide: the straight part with half circles for radiused
+/// ends (target), and the width continued into the air past open ends (limit).
+/// `united`: the limit as the union of the target and the open ends' strips
+/// (how slots have always been outlined); else the same region drawn as one
+/// loop, without a Boolean (the outline of every height of a sectioned slot).
+void outlineSlot(FeatureShape &s, const Vec2 &a, const Vec2 &b, double width, const std::string &end1,
+                 const std::string &end2, bool united = true) {
+  const Vec2 along = (b - a).normalized();
+  const Vec2 n(-along.y() * width / 2, along.x() * width / 2);
+  const Vec2 e = along * kOpenReach;
+  auto outline = [&](const Vec2 &from, const Vec2 &to, bool reach) {
+    const Vec2 p = reach && end1 == "open" ? from - e : from, q = reach && end2 == "open" ? to + e : to;
+    Loop l;
+    l.segs.push_back(Seg::line(p - n, q - n));
+    if (end2 == "radiused")
+      l.segs.push_back(Seg::arc(q - n, q + n, q, true));
+    else
+      l.segs.push_back(Seg::line(q - n, q + n));
+    l.segs.push_back(Seg::line(q + n, p + n));
+    if (end1 == "radiused")
+      l.segs.push_back(Seg::arc(p + n, p - n, p, true));
+    else
+      l.segs.push_back(Seg::line(p + n, p - n));
+    return outer(l);
+  };
+  s.target = outline(a, b, false);
+  s.slot = FeatureShape::SlotPath{a, b, width, end1, end2};
+  if (!united) {
+    s.limit = outline(a, b, true);
+    return;
+  }
+  s.limit = s.target;
+  if (end1 == "open")
+    s.limit = geom::unite(s.limit, outer(geom::polygon({a - n - e, a - n, a + n, a + n - e})));
+  if (end2 == "open")
+    s.limit = geom::unite(s.limit, outer(geom::polygon({b - n, b - n + e, b + n + e, b + n})));
 }
 
 class ShapeBuilder {
@@ -238,45 +279,108 @@ public:
     if (!path)
       return false;
     const auto [a, b] = *path;
-    double width = 0;
-    if (const Node *p = feature.child(ir::Kind::SquareUProfile))
-      width = *p->number("width");
-    else if (const Node *q = feature.child(ir::Kind::RoundedUProfile))
-      width = *q->number("width");
-    else if (feature.child(ir::Kind::VeeProfile) || feature.child(ir::Kind::PartialCircularProfile))
-      return fail("slot " + feature.symbol + " has slanted or curved walls; 2.5D strategies cut vertical walls "
-                  "only (plan: z-level passes with a form or tapered tool)");
-    else
-      return fail("slot " + feature.symbol + " has no cross-section profile");
-    const Vec2 along = (b - a).normalized();
-    const Vec2 n(-along.y() * width / 2, along.x() * width / 2);
-    const bool open1 = feature.text("end_1") == "open", open2 = feature.text("end_2") == "open";
-    const bool round1 = feature.text("end_1") == "radiused", round2 = feature.text("end_2") == "radiused";
     for (const char *end : {"end_1", "end_2"})
       if (auto w = feature.text(end); w == "woodruff" || w == "loop")
         return fail("slot " + feature.symbol + ": " + *w + " slot ends are not supported yet");
-    // The target: the straight part, with half circles for radiused ends.
-    Loop l;
-    l.segs.push_back(Seg::line(a - n, b - n));
-    if (round2)
-      l.segs.push_back(Seg::arc(b - n, b + n, b, true));
-    else
-      l.segs.push_back(Seg::line(b - n, b + n));
-    l.segs.push_back(Seg::line(b + n, a + n));
-    if (round1)
-      l.segs.push_back(Seg::arc(a + n, a - n, a, true));
-    else
-      l.segs.push_back(Seg::line(a + n, a - n));
-    s.target = outer(l);
-    s.slot = FeatureShape::SlotPath{a, b, width, std::string(*feature.text("end_1")), std::string(*feature.text("end_2"))};
-    // Open ends: the slot's width continued into the air past them.
-    const Vec2 e = along * kOpenReach;
-    s.limit = s.target;
-    if (open1)
-      s.limit = geom::unite(s.limit, outer(geom::polygon({a - n - e, a - n, a + n, a + n - e})));
-    if (open2)
-      s.limit = geom::unite(s.limit, outer(geom::polygon({b - n, b - n + e, b + n + e, b + n})));
+    const double depth = s.top - s.bottom;
+    double lo = 0, hi = 0;  // the walls at the top, left of the course
+    if (const Node *p = feature.child(ir::Kind::SquareUProfile)) {
+      hi = *p->number("width") / 2;
+      lo = -hi;
+    } else {
+      std::optional<SlotSection> section;
+      if (const Node *q = feature.child(ir::Kind::RoundedUProfile))
+        section = circularSection(feature, *q->number("width") / 2, 180, depth);
+      else if (const Node *v = feature.child(ir::Kind::VeeProfile))
+        section = veeSection(feature, *v, depth);
+      else if (const Node *c = feature.child(ir::Kind::PartialCircularProfile))
+        section = circularSection(feature, *c->number("radius"), *c->number("sweep_angle"), depth);
+      else
+        return fail("slot " + feature.symbol + " has no cross-section profile");
+      if (!section)
+        return false;
+      std::tie(lo, hi) = *section->span(depth);
+      s.section = std::move(*section);
+    }
+    if (hi - lo <= geom::kEps)
+      return fail("slot " + feature.symbol + " has no width at its top");
+    const Vec2 left = Vec2(-(b - a).y(), (b - a).x()).normalized();
+    const double mid = (lo + hi) / 2;
+    outlineSlot(s, a + left * mid, b + left * mid, hi - lo, std::string(*feature.text("end_1")),
+                std::string(*feature.text("end_2")));
     return true;
+  }
+
+  /// A partial circular profile of radius r and sweep (deg) whose lowest
+  /// point is the slot's floor, its ends at the same height; above them, to
+  /// the slot's top, vertical walls (a rounded-U profile is one of 180 deg
+  /// under its straight part). A slot shallower than the arc cuts it there.
+  std::optional<SlotSection> circularSection(const Node &feature, double r, double sweepDeg, double depth) {
+    if (!(r > geom::kEps) || !(sweepDeg > 0 && sweepDeg <= 180 + 1e-9)) {
+      fail("slot " + feature.symbol + ": a circular cross-section of radius " + formatFixed(r, 4) + " mm and sweep " +
+           formatFixed(sweepDeg, 4) + " deg is not one a tool from above can cut (a radius above 0, a sweep up to 180 deg)");
+      return std::nullopt;
+    }
+    const double half = std::min(sweepDeg, 180.0) / 2 * std::numbers::pi / 180;
+    const Vec2 c(0, r);
+    const double endHeight = r * (1 - std::cos(half));
+    SlotSection sec;
+    sec.depth = depth;
+    if (depth <= endHeight + 1e-9) {
+      const double u = std::sqrt(std::max(0.0, r * r - (r - depth) * (r - depth)));
+      sec.walls.push_back(Seg::arc(Vec2(-u, depth), Vec2(u, depth), c, true));
+      return sec;
+    }
+    const Vec2 e1(-r * std::sin(half), endHeight), e2(r * std::sin(half), endHeight);
+    sec.walls.push_back(Seg::line(Vec2(e1.x(), depth), e1));
+    sec.walls.push_back(Seg::arc(e1, e2, c, true));
+    sec.walls.push_back(Seg::line(e2, Vec2(e2.x(), depth)));
+    return sec;
+  }
+
+  /// A vee profile: two straight flanks profile_angle apart, the first (on
+  /// the right of the course of travel) tilt_angle from the vertical, meeting
+  /// on the course of travel, the vee rounded at the bottom to its
+  /// profile_radius; its lowest point is the slot's floor.
+  std::optional<SlotSection> veeSection(const Node &feature, const Node &vee, double depth) {
+    const double deg = std::numbers::pi / 180;
+    const double angle = vee.number("profile_angle").value_or(0), tilt = vee.number("tilt_angle").value_or(0);
+    const double radius = vee.number("profile_radius").value_or(0);
+    const Vec2 d1(-std::sin(tilt * deg), std::cos(tilt * deg));
+    const Vec2 d2(std::sin((angle - tilt) * deg), std::cos((angle - tilt) * deg));
+    if (!(angle > 0 && angle < 180) || tilt < 0 || tilt > angle || d1.y() <= geom::kEps || d2.y() <= geom::kEps ||
+        radius < 0) {
+      fail("slot " + feature.symbol + ": a vee of " + formatFixed(angle, 4) + " deg tilted " + formatFixed(tilt, 4) +
+           " deg has a flank that does not rise from its bottom: a tool from above cannot cut it");
+      return std::nullopt;
+    }
+    // The flanks from the apex (origin), the rounding tangent to both.
+    const double half = angle / 2 * deg;
+    const Vec2 centre = (d1 + d2).normalized() * (radius / std::sin(half));
+    const double along = radius / std::tan(half);
+    Vec2 t1 = d1 * along, t2 = d2 * along;
+    const Vec2 shift(0, -(radius > 0 ? centre.y() - radius : 0.0));  // the lowest point to v = 0
+    const Vec2 c = centre + shift;
+    t1 += shift;
+    t2 += shift;
+    SlotSection sec;
+    sec.depth = depth;
+    if (radius > 0 && depth < std::max(t1.y(), t2.y()) - 1e-9) {
+      if (depth > std::min(t1.y(), t2.y()) + 1e-9) {
+        fail("slot " + feature.symbol + " is shallower than the rounding of its vee on one side");
+        return std::nullopt;
+      }
+      const double u = std::sqrt(std::max(0.0, radius * radius - (depth - c.y()) * (depth - c.y())));
+      sec.walls.push_back(Seg::arc(Vec2(c.x() - u, depth), Vec2(c.x() + u, depth), c, true));
+      return sec;
+    }
+    auto topOf = [&](const Vec2 &from, const Vec2 &dir) { return from + dir * ((depth - from.y()) / dir.y()); };
+    sec.walls.push_back(Seg::line(topOf(t1, d1), t1));
+    if (radius > 0)
+      sec.walls.push_back(Seg::arc(t1, t2, c, true));
+    sec.walls.push_back(Seg::line(t2, topOf(t2, d2)));
+    std::erase_if(sec.walls, [](const Seg &sg) { return (sg.b - sg.a).norm() <= geom::kEps; });
+    return sec;
   }
 
   bool fail(std::string message) {
@@ -353,6 +457,83 @@ void roundCorners(const ir::Node &feature, FeatureShape &s) {
 }
 
 } // namespace
+
+std::optional<std::pair<double, double>> SlotSection::span(double v) const {
+  if (v < -1e-9 || walls.empty())
+    return std::nullopt;
+  v = std::clamp(v, 0.0, depth);
+  double lo = 1e300, hi = -1e300;
+  auto take = [&](double u) {
+    lo = std::min(lo, u);
+    hi = std::max(hi, u);
+  };
+  for (const Seg &sg : walls) {
+    if (!sg.isArc()) {
+      const double v0 = std::min(sg.a.y(), sg.b.y()), v1 = std::max(sg.a.y(), sg.b.y());
+      if (v < v0 - 1e-12 || v > v1 + 1e-12)
+        continue;
+      if (v1 - v0 <= 1e-12) {
+        take(sg.a.x());
+        take(sg.b.x());
+      } else {
+        take(sg.a.x() + (sg.b.x() - sg.a.x()) * (v - sg.a.y()) / (sg.b.y() - sg.a.y()));
+      }
+      continue;
+    }
+    // The circle's points at height v that lie on the arc.
+    const double r = sg.radius(), dv = v - sg.c.y();
+    if (std::abs(dv) > r + 1e-12)
+      continue;
+    const double du = std::sqrt(std::max(0.0, r * r - dv * dv));
+    for (double u : {sg.c.x() - du, sg.c.x() + du}) {
+      const Vec2 p(u, v);
+      const double start = std::atan2((sg.a - sg.c).y(), (sg.a - sg.c).x());
+      double turn = std::atan2((p - sg.c).y(), (p - sg.c).x()) - start;
+      if (sg.turn < 0)
+        turn = -turn;
+      turn = std::fmod(turn + 4 * std::numbers::pi, 2 * std::numbers::pi);
+      if (turn <= std::abs(sg.sweep()) + 1e-9 || turn >= 2 * std::numbers::pi - 1e-9)
+        take(u);
+    }
+  }
+  if (lo > hi)
+    return std::nullopt;
+  return std::pair(lo, hi);
+}
+
+std::vector<double> SlotSection::breaks() const {
+  std::vector<double> out;
+  for (const Seg &sg : walls) {
+    out.push_back(sg.a.y());
+    out.push_back(sg.b.y());
+  }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end(), [](double x, double y) { return std::abs(x - y) <= 1e-9; }),
+            out.end());
+  return out;
+}
+
+FeatureShape slotBetween(const FeatureShape &slot, double lo, double hi) {
+  FeatureShape s = slot;
+  const FeatureShape::SlotPath &p = *slot.slot;
+  const Vec2 left = Vec2(-(p.to - p.from).y(), (p.to - p.from).x()).normalized();
+  // The slot path runs along the middle of the top; the course of travel is
+  // where the section puts u = 0.
+  double topMid = 0;
+  if (slot.section)
+    if (auto top = slot.section->span(slot.section->depth))
+      topMid = (top->first + top->second) / 2;
+  const double shift = (lo + hi) / 2 - topMid;
+  outlineSlot(s, p.from + left * shift, p.to + left * shift, hi - lo, p.end1, p.end2, /*united=*/false);
+  return s;
+}
+
+double cornerRadius(const ir::Node &tool) {
+  const double radius = tool.number("diameter").value_or(0) / 2;
+  if (tool.text("type") == "ball_endmill")
+    return radius;
+  return std::clamp(tool.number("corner_radius").value_or(0), 0.0, radius);
+}
 
 ShapeResult featureShape(const ir::Module &module, const ir::Node &feature) {
   const Node *workpiece = workpieceOf(module, feature);

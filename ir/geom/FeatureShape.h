@@ -38,6 +38,24 @@ struct IslandShape {
   double top = 0;
 };
 
+/// A slot's cross-section across its course of travel: its walls as one
+/// chain of lines and arcs in (u, v), u the distance left of the course
+/// (seen along it), v the height above the slot's floor. The chain runs from
+/// the top of the right wall (u < 0) down through the floor (its lowest
+/// point, v = 0) and up to the top of the left wall (v = depth). Sections
+/// are convex and no narrower higher up: the tool comes from above.
+struct SlotSection {
+  std::vector<geom::Seg> walls;
+  double depth = 0;
+
+  /// Where the walls are at height v above the floor: the lowest and highest
+  /// u between them; none below the floor. Above the top the walls go on
+  /// straight up.
+  std::optional<std::pair<double, double>> span(double v) const;
+  /// The heights of the chain's vertices (where a wall changes shape), lowest first.
+  std::vector<double> breaks() const;
+};
+
 struct FeatureShape {
   std::string symbol;
   ir::Kind kind = ir::Kind::ClosedPocket;
@@ -64,7 +82,17 @@ struct FeatureShape {
     std::string end1, end2;
   };
   std::optional<SlotPath> slot;
+  /// For slots whose walls are not vertical (vee, partial circular and
+  /// rounded-U profiles): the cross-section, which `target` and `limit`
+  /// give at the slot's top only.
+  std::optional<SlotSection> section;
 };
+
+/// The slot as if its walls were vertical, `lo` to `hi` from its course of
+/// travel (lo < hi, u as in SlotSection): its target and limit regions and
+/// its slot path (the course moved to the middle of the span). What one
+/// height of a slot with slanted walls is in the plane.
+FeatureShape slotBetween(const FeatureShape &slot, double lo, double hi);
 
 /// The frame of a node with `at`, `axis`, `ref` (features, profiles); an error
 /// message when its axis is not +z.
@@ -86,6 +114,10 @@ ShapeResult featureShape(const ir::Module &module, const ir::Node &feature);
 /// angle), the angle measured from the plane normal to the tool axis (ISO
 /// 14649-111: 0 for a flat end mill; a 140 deg carbide drill has 20 deg).
 double pointLength(const ir::Node &tool);
+
+/// The radius of the rounded edge at the tool's end: the ball's radius for
+/// a ball end mill, else its corner radius, within [0, diameter / 2].
+double cornerRadius(const ir::Node &tool);
 
 /// A workpiece's block raw piece in its coordinates: its extent in the plane
 /// and the height of its top; nullopt when it has none or another shape.

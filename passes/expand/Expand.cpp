@@ -140,6 +140,10 @@ void Expander::unsupported(const Node &ws, const std::string &reason) {
   (*stats)["workingsteps not expanded"]++;
 }
 
+void Expander::warning(const Node &ws, const std::string &message) {
+  diags->warning(ws.origin.loc, ws.kindName() + " " + ws.symbol + ": " + message).entity(ws.origin.entityId);
+}
+
 void Expander::assumed(const Node &ws, const Node &at, const std::string &message) {
   // Located at what the file gives (the approach, the strategy); a node
   // made by the pass or without an origin falls back to the step's.
@@ -152,9 +156,10 @@ namespace {
 
 class ExpandStrategiesPass final : public Pass {
 public:
-  ExpandStrategiesPass(double maxEngagement, double chordTolerance) {
+  ExpandStrategiesPass(double maxEngagement, double chordTolerance, std::optional<double> scallopHeight) {
     x_.maxEngagement = maxEngagement;
     x_.chordTolerance = chordTolerance;
+    x_.scallopHeight = scallopHeight;
   }
 
   std::string_view name() const override { return "expand-strategies"; }
@@ -339,7 +344,8 @@ private:
 
 std::unique_ptr<Pass> createExpandStrategiesPass(const PassOptions &options) {
   return std::make_unique<expand::ExpandStrategiesPass>(options.number("max-engagement").value(),
-                                                        options.number("chord-tolerance").value());
+                                                        options.number("chord-tolerance").value(),
+                                                        options.number("scallop-height"));
 }
 
 } // namespace stepnc::passes

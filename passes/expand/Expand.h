@@ -50,6 +50,9 @@ inline constexpr double kDefaultChordTolerance = 0.005;
 /// Overlap of neighbouring guide paths of a pattern strategy that gives none:
 /// a share of the width one pass of the motif cuts.
 inline constexpr double kPatternOverlap = 0.2;
+/// Largest ridge left between finishing levels on a slanted wall (mm) when
+/// neither the pass nor the workpiece gives one.
+inline constexpr double kDefaultScallopHeight = 0.01;
 /// Extra depth past the floor of a through hole, beyond the tool's point, when
 /// the operation's overcut is smaller (mm).
 inline constexpr double kBreakthrough = 1.0;
@@ -77,6 +80,9 @@ class Expander {
 public:
   double maxEngagement = kDefaultMaxEngagement;   ///< deg
   double chordTolerance = kDefaultChordTolerance; ///< mm
+  /// Largest ridge left between finishing levels on a slanted wall (mm);
+  /// absent: the workpiece's global tolerance, else kDefaultScallopHeight.
+  std::optional<double> scallopHeight;
   ir::Module *module = nullptr;
   DiagnosticEngine *diags = nullptr;
   PassStats *stats = nullptr;
@@ -91,6 +97,9 @@ public:
   void report(const Node &ws, const std::string &message) { report(ws, ws, message); }
   /// An error about workingstep `ws` located at `at` (a part of it the file gives, such as its strategy).
   void report(const Node &ws, const Node &at, const std::string &message);
+  /// A warning about workingstep `ws`, located at it: what its moves leave
+  /// undone (the moves are made).
+  void warning(const Node &ws, const std::string &message);
   /// A warning that workingstep `ws` gets no moves, and why.
   void unsupported(const Node &ws, const std::string &reason);
   /// A warning at `at` (what the file gives and stepnc does not follow, such
@@ -145,6 +154,10 @@ void expandRapidMovement(Expander &x, Node &rm, const std::string &setup);
 bool expandHoleMaking(Expander &x, const Step &step);
 /// Milling2D.cpp: levels, the strategy's paths at each, approaches and links.
 bool expandMilling2D(Expander &x, const Step &step);
+/// SlotLevels.cpp: a slot with slanted or curved walls, level by level from
+/// the top down, each level cut as a slot with vertical walls as wide as the
+/// tool fits at that height (2.5D milling hands such slots over).
+bool expandSlotLevels(Expander &x, const Step &step);
 /// PatternStrategies.cpp: trochoids along the guide strategy's paths.
 bool expandTrochoidal(Expander &x, const Step &step);
 /// PatternStrategies.cpp: plunges along the guide strategy's paths.
@@ -156,6 +169,41 @@ bool expandPlunging(Expander &x, const Step &step);
 /// to the floor plus its allowance, in equal steps no deeper than the axial
 /// depth of cut; none (after a warning) when the allowance leaves nothing.
 std::vector<double> levelsOf(Expander &x, const Node &ws, const Node &op, const ir::FeatureShape &s, const Plan &p);
+
+/// How a step's strategy cuts a level, fixed once per step, and what has
+/// been said about it (each warning once per step).
+struct LevelStrategy {
+  std::string type;  ///< the strategy's type, or the default for the feature
+  bool face = false;
+  bool sideOnly = false;  ///< one contour along the walls (side milling)
+  bool followOrientation = true;
+  bool linkAtDepth = false;
+  double stepover = 0;
+  Vec2 strokeDir = Vec2::UnitX();
+  bool saidSlotLine = false, saidSideMilling = false;
+};
+
+/// The centre area of one level and the strategy's paths in it.
+struct LevelPaths {
+  Region centres;
+  std::vector<Path2D> paths;
+};
+
+/// Milling2D.cpp: the strategy of `step` as its levels follow it: its type,
+/// the stepover, the cut direction, the stroke direction.
+LevelStrategy levelStrategy(const Step &step, const ir::FeatureShape &s, const Plan &p);
+
+/// Milling2D.cpp: the centre area of shape `s` with `islands` standing and
+/// the strategy's paths in it (along the course of travel for center
+/// milling and slots no wider than the tool); false after a diagnostic.
+bool planLevel(Expander &x, const Step &step, const ir::FeatureShape &s, const Plan &p,
+               const std::vector<Region> &islands, LevelStrategy &ls, LevelPaths &out);
+
+/// Milling2D.cpp: the paths of one level cut at height z, each reached by a
+/// link at depth or by the approach; an open path along a slot is cut from
+/// the end nearer to the tool.
+void cutLevel(Emitter &e, const Step &step, const ir::FeatureShape &s, const Plan &p, LevelPaths &level, double z,
+              const LevelStrategy &ls, int &fallbacks);
 
 /// Milling2D.cpp: where the tool centre may be at one level: away from walls
 /// and islands by the radius plus the side allowance; for faces, over the

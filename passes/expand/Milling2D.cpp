@@ -89,21 +89,15 @@ std::vector<double> levelsOf(Expander &x, const Node &ws, const Node &op, const 
   return out;
 }
 
-bool expandMilling2D(Expander &x, const Step &step) {
-  const Node &ws = step.ws, &op = step.op;
-  const ir::FeatureShape &s = *step.shape;
-  const Plan &p = step.plan;
+LevelStrategy levelStrategy(const Step &step, const ir::FeatureShape &s, const Plan &p) {
+  const Node &op = step.op;
   const Node *strategy = step.strategy;
-  std::string type = strategy ? strategy->text("type").value_or("") : "";
-  const bool face = op.is(ir::Trait::FaceOperation) || ir::hasTraits(s.kind, ir::Trait::FaceFeature);
-  if (type.empty())
-    type = face ? "bidirectional" : "contour_parallel";
-  const bool sideOnly = op.is(ir::Trait::SideOnly);
-
-  const std::vector<double> levels = levelsOf(x, ws, op, s, p);
-  if (levels.empty())
-    return false;
-
+  LevelStrategy ls;
+  ls.type = strategy ? strategy->text("type").value_or("") : "";
+  ls.face = op.is(ir::Trait::FaceOperation) || ir::hasTraits(s.kind, ir::Trait::FaceFeature);
+  if (ls.type.empty())
+    ls.type = ls.face ? "bidirectional" : "contour_parallel";
+  ls.sideOnly = op.is(ir::Trait::SideOnly);
   // The stepover: the radial depth of cut, else the overlap; never so wide
   // that a ring leaves material at the region's sharpest convex corner.
   double stepover = op.number("radial_depth").value_or(0);
@@ -114,24 +108,107 @@ bool expandMilling2D(Expander &x, const Step &step) {
     stepover = p.radius;
   const double coverLimit = ringCoverLimit(s, p.radius);
   const double limitBidir = 2 * p.radius * 0.98;
-  stepover = std::min(stepover, type == "bidirectional" || type == "unidirectional" ? limitBidir : coverLimit);
+  ls.stepover =
+      std::min(stepover, ls.type == "bidirectional" || ls.type == "unidirectional" ? limitBidir : coverLimit);
+  ls.followOrientation = counterClockwise(strategy, p.spindle);
+  ls.strokeDir = strokeDirection(*p.feature, s, strategy);
+  ls.linkAtDepth = ls.type == "contour_spiral" || ls.type == "contour_parallel" || ls.type == "bidirectional" ||
+                   ls.type == "contour_bidirectional" || ls.type == "bidirectional_contour";
+  return ls;
+}
 
-  const bool followOrientation = counterClockwise(strategy, p.spindle);
+bool planLevel(Expander &x, const Step &step, const ir::FeatureShape &s, const Plan &p,
+               const std::vector<Region> &islands, LevelStrategy &ls, LevelPaths &out) {
+  const Node &ws = step.ws, &op = step.op;
+  const Node *strategy = step.strategy;
+  const std::string &type = ls.type;
+  out.centres = centreArea(s, s.unbounded ? s.target : s.limit, islands, p);
+  out.paths.clear();
+  // Center milling, and slots exactly as wide as the tool: along the course of travel.
+  if (s.slot && (type == "center_milling" || out.centres.empty())) {
+    std::optional<Path2D> line = slotCentreline(*s.slot, p);
+    if (!line) {
+      x.report(ws, "its tool " + p.tool->symbol + " (diameter " + formatFixed(2 * p.radius, 3) +
+                       " mm) does not fit in slot " + s.symbol + " (width " + formatFixed(s.slot->width, 3) +
+                       " mm) with the side allowance");
+      return false;
+    }
+    if (strategy && type != "center_milling" && !ls.saidSlotLine) {
+      x.assumed(ws, *strategy,
+                "strategy " + type + " is not supported in slot " + s.symbol + ", no wider than tool " +
+                    p.tool->symbol + " with the side allowance: center milling along its course of travel");
+      ls.saidSlotLine = true;
+    }
+    out.centres = geom::offset(s.target, -geom::kEps);  // links stay in the slot
+    out.paths.push_back(std::move(*line));
+  } else if (type == "center_milling") {
+    x.unsupported(ws, "center milling follows the course of travel of a slot; " + s.symbol + " is a " +
+                          s.kindName());
+    return false;
+  } else if (!out.centres.empty()) {
+    auto made = strategyPaths(type, ls.face, s.unbounded, ls.sideOnly, out.centres, ls.strokeDir, ls.stepover,
+                              ls.followOrientation, p.radius);
+    if (!made) {
+      x.unsupported(ws, "strategy '" + type + "' is not expanded yet");
+      return false;
+    }
+    if (ls.sideOnly && strategy && !sideMillingFollows(type, ls.face) && !ls.saidSideMilling) {
+      x.assumed(ws, *strategy,
+                "strategy " + type + " is not supported by " + op.kindName() + ": one contour along " +
+                    (ls.face || s.unbounded ? "each island" : "the walls"));
+      ls.saidSideMilling = true;
+    }
+    out.paths = std::move(*made);
+  } else if (!(s.holeCentre && 2 * p.radius <= s.holeDiameter + 1e-6)) {
+    x.report(ws, "its tool " + p.tool->symbol + " (diameter " + formatFixed(2 * p.radius, 3) +
+                     " mm) does not fit in " + s.symbol + " with the side allowance");
+    return false;
+  }
+  return true;
+}
 
-  const Vec2 strokeDir = strokeDirection(*p.feature, s, strategy);
-  const bool linkAtDepth = type == "contour_spiral" || type == "contour_parallel" || type == "bidirectional" ||
-                           type == "contour_bidirectional" || type == "bidirectional_contour";
-  // What the file asked for and is not what the moves do: said once per step.
-  bool saidSlotLine = false, saidSideMilling = false;
+void cutLevel(Emitter &e, const Step &step, const ir::FeatureShape &s, const Plan &p, LevelPaths &level, double z,
+              const LevelStrategy &ls, int &fallbacks) {
+  if (level.centres.empty()) {
+    // A cutter as wide as the hole: straight down its axis.
+    e.travel(*s.holeCentre, p.clearanceZ);
+    e.linear(at(*s.holeCentre, z), p.plungeFeed, "plunge");
+    e.retract();
+    return;
+  }
+  if (s.slot && level.paths.size() == 1 && !geom::Chain{level.paths[0]}.closed()) {
+    // One open path per level (center milling): down at the end where the
+    // level before finished, and back along it.
+    Path2D &line = level.paths[0];
+    if (e.positioned() && (e.position().head<2>() - line.back().b).norm() <
+                              (e.position().head<2>() - line.front().a).norm()) {
+      Loop back{line};
+      back.reverse();
+      line = std::move(back.segs);
+    }
+    cutPath(e, line, z, p, step.op, level.centres, false, false, fallbacks);
+    return;
+  }
+  for (size_t k = 0; k < level.paths.size(); ++k)
+    cutPath(e, level.paths[k], z, p, step.op, level.centres, ls.linkAtDepth && k > 0, s.unbounded, fallbacks);
+}
+
+bool expandMilling2D(Expander &x, const Step &step) {
+  const ir::FeatureShape &s = *step.shape;
+  if (s.section)
+    return expandSlotLevels(x, step);
+  const Plan &p = step.plan;
+  const std::vector<double> levels = levelsOf(x, step.ws, step.op, s, p);
+  if (levels.empty())
+    return false;
+  LevelStrategy ls = levelStrategy(step, s, p);
   int fallbacks = 0;
-  Emitter e(step.moves, ws.number("secplane").value_or(0));
+  Emitter e(step.moves, step.ws.number("secplane").value_or(0));
   // The centre area and the paths depend on the level only through the
   // islands standing at it: they are made again only when that set changes.
   std::optional<std::vector<bool>> standing;
-  Region centres;
-  std::vector<Path2D> paths;
-  for (size_t i = 0; i < levels.size(); ++i) {
-    const double z = levels[i];
+  LevelPaths level;
+  for (const double z : levels) {
     std::vector<bool> here;
     for (const ir::IslandShape &isl : s.islands)
       here.push_back(isl.top > z + 1e-9);
@@ -141,69 +218,10 @@ bool expandMilling2D(Expander &x, const Step &step) {
       for (size_t k = 0; k < s.islands.size(); ++k)
         if (here[k])
           islands.push_back(geom::offset(s.islands[k].region, p.allowanceSide));
-      centres = centreArea(s, s.unbounded ? s.target : s.limit, islands, p);
-      paths.clear();
-      // Center milling, and slots exactly as wide as the tool: along the course of travel.
-      if (s.slot && (type == "center_milling" || centres.empty())) {
-        std::optional<Path2D> line = slotCentreline(*s.slot, p);
-        if (!line) {
-          x.report(ws, "its tool " + p.tool->symbol + " (diameter " + formatFixed(2 * p.radius, 3) +
-                           " mm) does not fit in slot " + s.symbol + " (width " + formatFixed(s.slot->width, 3) +
-                           " mm) with the side allowance");
-          return false;
-        }
-        if (strategy && type != "center_milling" && !saidSlotLine) {
-          x.assumed(ws, *strategy,
-                    "strategy " + type + " is not supported in slot " + s.symbol + ", no wider than tool " +
-                        p.tool->symbol + " with the side allowance: center milling along its course of travel");
-          saidSlotLine = true;
-        }
-        centres = geom::offset(s.target, -geom::kEps);  // links stay in the slot
-        paths.push_back(std::move(*line));
-      } else if (type == "center_milling") {
-        x.unsupported(ws, "center milling follows the course of travel of a slot; " + s.symbol + " is a " +
-                              s.kindName());
+      if (!planLevel(x, step, s, p, islands, ls, level))
         return false;
-      } else if (!centres.empty()) {
-        auto made = strategyPaths(type, face, s.unbounded, sideOnly, centres, strokeDir, stepover,
-                                  followOrientation, p.radius);
-        if (!made) {
-          x.unsupported(ws, "strategy '" + type + "' is not expanded yet");
-          return false;
-        }
-        if (sideOnly && strategy && !sideMillingFollows(type, face) && !saidSideMilling) {
-          x.assumed(ws, *strategy,
-                    "strategy " + type + " is not supported by " + op.kindName() + ": one contour along " +
-                        (face || s.unbounded ? "each island" : "the walls"));
-          saidSideMilling = true;
-        }
-        paths = std::move(*made);
-      } else if (!(s.holeCentre && 2 * p.radius <= s.holeDiameter + 1e-6)) {
-        x.report(ws, "its tool " + p.tool->symbol + " (diameter " + formatFixed(2 * p.radius, 3) +
-                         " mm) does not fit in " + s.symbol + " with the side allowance");
-        return false;
-      }
     }
-    if (centres.empty()) {
-      // A cutter as wide as the hole: straight down its axis.
-      e.travel(*s.holeCentre, p.clearanceZ);
-      e.linear(at(*s.holeCentre, z), p.plungeFeed, "plunge");
-      e.retract();
-      continue;
-    }
-    if (s.slot && paths.size() == 1 && !geom::Chain{paths[0]}.closed()) {
-      // One open path per level (center milling): down at the end where the
-      // level before finished, and back along it.
-      if (i > 0) {
-        Loop back{paths[0]};
-        back.reverse();
-        paths[0] = std::move(back.segs);
-      }
-      cutPath(e, paths[0], z, p, op, centres, false, false, fallbacks);
-      continue;
-    }
-    for (size_t k = 0; k < paths.size(); ++k)
-      cutPath(e, paths[k], z, p, op, centres, linkAtDepth && k > 0, s.unbounded, fallbacks);
+    cutLevel(e, step, s, p, level, z, ls, fallbacks);
   }
   e.retract();
   reportApproachFallbacks(x, step, fallbacks);

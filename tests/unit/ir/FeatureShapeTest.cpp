@@ -173,14 +173,51 @@ TEST_CASE("a general outside profile stands as an island in the raw piece", "[sh
   CHECK(r.shape->bottom == 20);
 }
 
-TEST_CASE("a vee slot is reported, not guessed", "[shape]") {
-  auto r = shapeOf("    slot %s \"S\" at=(20.0000,40.0000,30.0000)mm " + kZ +
-                       " depth=5.0000mm end_1=open end_2=open\n      path\n        line "
-                       "at=(0.0000,0.0000,0.0000)mm dir=(1.000000,0.000000,0.000000) length=50.0000mm\n"
-                       "      vee_profile profile_angle=60.0000deg tilt_angle=0.0000deg\n",
+TEST_CASE("slots with slanted or curved walls have a cross-section", "[shape]") {
+  auto slot = [&](const std::string &profile, const std::string &depth) {
+    return shapeOf("    slot %s \"S\" at=(20.0000,40.0000,30.0000)mm " + kZ + " depth=" + depth +
+                       "mm end_1=open end_2=open\n      path\n        line "
+                       "at=(0.0000,0.0000,0.0000)mm dir=(1.000000,0.000000,0.000000) length=50.0000mm\n      " +
+                       profile + "\n",
                    "%s");
-  CHECK_FALSE(r.shape);
-  CHECK(r.error.find("slanted") != std::string::npos);
+  };
+  // A sharp vee, its first flank (right of the course) vertical, the other 60 deg from it.
+  auto vee = slot("vee_profile profile_angle=60.0000deg tilt_angle=0.0000deg", "5.0000");
+  REQUIRE(vee.shape);
+  REQUIRE(vee.shape->section);
+  const ir::SlotSection &v = *vee.shape->section;
+  CHECK(v.span(0)->first == Approx(0).margin(1e-12));
+  CHECK(v.span(0)->second == Approx(0).margin(1e-12));
+  CHECK(v.span(2.5)->first == Approx(0).margin(1e-12));
+  CHECK(v.span(2.5)->second == Approx(2.5 * std::sqrt(3.0)));
+  CHECK_FALSE(v.span(-0.1));
+  CHECK(v.breaks() == std::vector<double>{0, 5});
+  // The outline at the top is the vee's width there, left of the course.
+  CHECK(vee.shape->target.area() == Approx(50 * 5 * std::sqrt(3.0)));
+  CHECK(vee.shape->target.contains({40, 41}));
+  CHECK_FALSE(vee.shape->target.contains({40, 39.9}));
+  // A vee rounded at the bottom: its lowest point is the floor.
+  auto round = slot("vee_profile profile_radius=2.0000mm profile_angle=90.0000deg tilt_angle=45.0000deg", "8.0000");
+  REQUIRE(round.shape);
+  const double apex = 2 * std::sqrt(2.0) - 2;  // below the floor, where the flanks would meet
+  CHECK(round.shape->section->span(8)->second == Approx(8 + apex));
+  CHECK(round.shape->section->span(0)->second == Approx(0).margin(1e-9));
+  CHECK(round.shape->section->span(0.5)->second == Approx(std::sqrt(4 - 1.5 * 1.5)));  // on the rounding
+  CHECK(round.shape->section->span(1)->second == Approx(1 + apex));                     // on the flank
+  // A partial circle as deep as its arc, and a rounded U deeper than its half circle.
+  auto arc = slot("partial_circular_profile radius=10.0000mm sweep_angle=120.0000deg", "5.0000");
+  REQUIRE(arc.shape);
+  CHECK(arc.shape->section->span(5)->second == Approx(10 * std::sqrt(3.0) / 2));
+  CHECK(arc.shape->section->span(1)->first == Approx(-std::sqrt(100 - 81.0)));
+  auto u = slot("rounded_u_profile width=10.0000mm", "8.0000");
+  REQUIRE(u.shape);
+  CHECK(u.shape->section->span(1)->second == Approx(3));
+  CHECK(u.shape->section->span(6)->second == Approx(5));
+  CHECK(u.shape->slot->width == Approx(10));
+  // A flank that does not rise cannot be cut from above.
+  auto bad = slot("vee_profile profile_angle=150.0000deg tilt_angle=100.0000deg", "5.0000");
+  CHECK_FALSE(bad.shape);
+  CHECK(bad.error.find("does not rise") != std::string::npos);
 }
 
 TEST_CASE("a planar face is unbounded; a step takes the nearer side of the raw piece", "[shape]") {
