@@ -363,22 +363,43 @@ InstanceId largestId(const p21::Part21File &file) {
   return largest;
 }
 
-/// `#id=NAME(first,...` with its first parameter replaced by `value`; empty
-/// when the line has no such shape (a complex instance).
-std::string withFirstParameter(std::string_view line, std::string_view value) {
-  const size_t open = line.find('(');
+/// `#id=NAME(p0,p1,...);` with its parameter `index` (0-based, at the top
+/// level of its list) replaced by `value`; empty when the line has no such
+/// parameter (a complex instance, too few parameters).
+std::string withParameter(std::string_view line, size_t index, std::string_view value) {
   const size_t eq = line.find('=');
+  const size_t open = line.find('(');
   if (open == std::string_view::npos || eq == std::string_view::npos || open == eq + 1)
     return {};
-  size_t end = open + 1;
-  if (end < line.size() && line[end] == '$')
-    ++end;
-  else if (end < line.size() && line[end] == '#')
-    for (++end; end < line.size() && std::isdigit(static_cast<unsigned char>(line[end]));)
-      ++end;
-  else
-    return {};
-  return std::string(line.substr(0, open + 1)) + std::string(value) + std::string(line.substr(end));
+  // Top-level parameter boundaries: commas outside nested lists and strings.
+  size_t begin = open + 1, current = 0;
+  int depth = 0;
+  bool inString = false;
+  for (size_t i = open + 1; i < line.size(); ++i) {
+    const char c = line[i];
+    if (inString) {
+      if (c == '\'' && i + 1 < line.size() && line[i + 1] == '\'')
+        ++i;  // a doubled quote stays in the string
+      else if (c == '\'')
+        inString = false;
+      continue;
+    }
+    if (c == '\'') {
+      inString = true;
+    } else if (c == '(') {
+      ++depth;
+    } else if ((c == ',' && depth == 0) || (c == ')' && depth == 0)) {
+      if (current == index)
+        return std::string(line.substr(0, begin)) + std::string(value) + std::string(line.substr(i));
+      if (c == ')')
+        return {};
+      ++current;
+      begin = i + 1;
+    } else if (c == ')') {
+      --depth;
+    }
+  }
+  return {};
 }
 
 /// FILE_DESCRIPTION with `lines` first, then the input's own description.
@@ -419,7 +440,11 @@ std::string writeOptimisedPart21(const p21::Part21File &input, const ir::Module 
     return {};
   Instances out(largestId(input) + 1);
   ToolpathWriter writer(out, module.sourceUnits, diags);
-  std::map<InstanceId, InstanceId> toolpathOf; // operation -> its new toolpath list
+  // Parameters to replace: instance -> (parameter index, new value). An
+  // operation gets its toolpath list (its first parameter), a workingstep
+  // whose moves travel above its file's security plane (expand-strategies
+  // raised it, said so) a plane at that height (its second).
+  std::map<InstanceId, std::vector<std::pair<size_t, std::string>>> patches;
   std::map<InstanceId, const Node *> writtenBy;
   std::vector<const Node *> steps;
   workingsteps(module.root, steps);
@@ -443,17 +468,24 @@ std::string writeOptimisedPart21(const p21::Part21File &input, const ir::Module 
       ok = false;
       continue;
     }
+    // Moves that travel above the file's security plane (expand-strategies
+    // raised it, and said so): that plane, written as the step's.
+    const Node &moves = *ws->child(ir::Kind::Moves);
+    const double travel = moves.number("secplane").value_or(0);
+    if (ws->origin.entityId != 0 && travel != ws->number("secplane").value_or(travel))
+      patches[ws->origin.entityId].emplace_back(
+          1, Instances::ref(out.add("PLANE", "'security plane (raised)'," +
+                                                 Instances::ref(out.placement(Vec3(0, 0, travel))))));
     // A step that is canned cycles keeps its operation as written: read
     // again, it expands to the same cycles, with the dwells and reduced
     // feeds a cutter-location toolpath cannot carry.
-    const Node &moves = *ws->child(ir::Kind::Moves);
     if (!moves.children.empty() && std::all_of(moves.children.begin(), moves.children.end(),
                                                [](const Node &c) { return c.kind == ir::Kind::Cycle; }))
       continue;
     const Node *tech = op->child(ir::Kind::Technology);
     const std::string reference = tech && tech->text("feed_reference") == "ccp" ? "CCP" : "TCP";
     if (auto list = writer.write(*ws, moves, *frame.frame, reference))
-      toolpathOf[op->origin.entityId] = *list;
+      patches[op->origin.entityId].emplace_back(0, Instances::ref(*list));
   }
   if (!ok || writer.failed())
     return {};
@@ -476,13 +508,14 @@ std::string writeOptimisedPart21(const p21::Part21File &input, const ir::Module 
       patched += "\n" + description;
     } else if (line.starts_with("#")) {
       const InstanceId id = std::stoull(std::string(line.substr(1, line.find('=') - 1)));
-      if (auto it = toolpathOf.find(id); it != toolpathOf.end()) {
-        patched = withFirstParameter(line, Instances::ref(it->second));
-        if (patched.empty()) {
-          diags.error({}, "operation #" + std::to_string(id) +
-                              " is a complex instance: stepnc cannot set its "
-                              "its_toolpath");
-          return {};
+      if (auto it = patches.find(id); it != patches.end()) {
+        for (const auto &[index, value] : it->second) {
+          patched = withParameter(patched, index, value);
+          if (patched.empty()) {
+            diags.error({}, "#" + std::to_string(id) + " is a complex instance: stepnc cannot set its parameter " +
+                                std::to_string(index + 1));
+            return {};
+          }
         }
       }
     }

@@ -230,13 +230,13 @@ private:
                              " has no expansion in stepnc");
       return;
     }
+    Node moves = makeMoves(ws, tool->symbol, p.spindle, coolant(*op), setup);
     // Axial approaches start the retract plane above the feature's top, never
-    // above the security plane.
+    // above the security plane the moves travel at.
     auto clearanceAbove = [&](double top) {
       return std::min(top + op->number("retract_plane").value_or(kDefaultClearance),
-                      ws.number("secplane").value_or(1e300));
+                      moves.number("secplane").value_or(1e300));
     };
-    Node moves = makeMoves(ws, tool->symbol, p.spindle, coolant(*op), setup);
     bool expanded = false;
     if (!family->needsShape) {
       // Explicit toolpaths need no shape: they are in the feature's frame.
@@ -284,8 +284,9 @@ private:
                       formatFixed(raised, 4) + " mm (the top of " +
                       (belowRaw ? "the raw piece" : s.symbol) +
                       " plus the retract plane) for this workingstep";
+    // The workingstep keeps the file's plane; its moves travel at the raised
+    // one (the STEP-NC write-back writes it as the step's security plane).
     x_.assumed(ws, ws, why);
-    ws.set("secplane", ir::Value::length(raised));
     moves.set("secplane", ir::Value::length(raised));
   }
 

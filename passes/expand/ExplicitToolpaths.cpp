@@ -69,7 +69,7 @@ bool expandExplicitToolpaths(Expander &x, const Step &step) {
   const Node &ws = step.ws, &op = step.op;
   const ir::PlaneFrame &frame = *step.frame;
   const Plan &p = step.plan;
-  Emitter e(step.moves, ws.number("secplane").value_or(0));
+  Emitter e(step.moves, step.moves.number("secplane").value_or(0));
   for (const Node *tp : op.childrenOf(ir::Kind::Toolpath)) {
     const Node *tech = tp->child(ir::Kind::Technology);
     const double feed = tech && tech->number("feed") ? *tech->number("feed") : p.feed;

@@ -179,7 +179,7 @@ bool expandHoleMaking(Expander &x, const Step &step) {
   const std::vector<Zone> zones = reducedFeedZones(x, step, s.top, bottom, p.plungeFeed);
 
   Node cycle(ir::Kind::Cycle);
-  Emitter e(cycle, ws.number("secplane").value_or(0));
+  Emitter e(cycle, step.moves.number("secplane").value_or(0));
   const Vec2 c = *s.holeCentre;
   e.travel(c, p.clearanceZ);
   std::vector<double> pecks;

@@ -203,7 +203,7 @@ bool expandMilling2D(Expander &x, const Step &step) {
     return false;
   LevelStrategy ls = levelStrategy(step, s, p);
   int fallbacks = 0;
-  Emitter e(step.moves, step.ws.number("secplane").value_or(0));
+  Emitter e(step.moves, step.moves.number("secplane").value_or(0));
   // The centre area and the paths depend on the level only through the
   // islands standing at it: they are made again only when that set changes.
   std::optional<std::vector<bool>> standing;

@@ -207,7 +207,7 @@ bool expandTrochoidal(Expander &x, const Step &step) {
   const Node *a = op.child(ir::Kind::Approach);
   const std::string entry = a ? a->text("type").value_or("plunge_helix") : "plunge_helix";
   const double angle = std::max(a ? a->number("angle").value_or(5.0) : 5.0, 0.5) * kPi / 180;
-  Emitter e(step.moves, ws.number("secplane").value_or(0));
+  Emitter e(step.moves, step.moves.number("secplane").value_or(0));
   long loops = 0;
   int fallbacks = 0;
   for (double z : g0->levels) {
@@ -280,7 +280,7 @@ bool expandPlunging(Expander &x, const Step &step) {
                  " mm does not take the tool out of the material between plunges");
     return false;
   }
-  const double secplane = ws.number("secplane").value_or(0);
+  const double secplane = step.moves.number("secplane").value_or(0);
   const double above = std::min(s.top + clearance, secplane);
   // Rounded corners stay above the material: the way down is a plunge.
   const double corner = std::min(linkRadius, above - s.top);

@@ -263,7 +263,7 @@ bool expandSlotLevels(Expander &x, const Step &step) {
   const Node *approach = op.child(ir::Kind::Approach);
   const bool alongAxis = !approach || approach->text("type").value_or("plunge_toolaxis") == "plunge_toolaxis";
   int fallbacks = 0;
-  Emitter e(step.moves, ws.number("secplane").value_or(0));
+  Emitter e(step.moves, step.moves.number("secplane").value_or(0));
   for (size_t i = 0; i < levels.size(); ++i) {
     auto [lo, hi] = *fit.centres(levels[i]);
     if (hi - lo < 1e-3)
