@@ -5,6 +5,7 @@
 #include "ir/geom/FeatureShape.h"
 #include "ir/geom/MoveWalk.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -138,14 +139,51 @@ private:
       mv.turns = m.turns;
       s.moves.push_back(std::move(mv));
     }
-    if (!s.moves.empty())
+    if (!s.moves.empty()) {
       position_ = s.moves.back().to;
+      if (!started_ || s.tool != lastTool_)
+        startClear(s);
+      started_ = true;
+      lastTool_ = s.tool;
+    }
     // A step that is one canned cycle is written as the controller's cycle
     // where the target has it; cycles among other moves are written as
     // their moves (expansion makes none yet).
     if (moves->children.size() == 1 && moves->children.front().kind == ir::Kind::Cycle)
       s.cycle = holeCycle(moves->children.front(), s.secplane);
     program_.steps.push_back(std::move(s));
+  }
+
+  /// Where a tool change left the tool, or where it is when the program
+  /// starts, is the machine's business: it may be low, beside the part.
+  /// So the step starts up along Z alone to its clearance height (the
+  /// security plane, or the first rapid's height when that is higher),
+  /// then moves across at that height, then down: the first rapid is split
+  /// when it moves both across and down. Every target writes these moves
+  /// as they are; none decides this itself.
+  static void startClear(Step &s) {
+    s.toolChange = true;
+    Move &first = s.moves.front();
+    const bool rapid = first.kind == Move::Kind::Rapid;
+    const double clearZ = clearanceHeight(s);
+    Move up;
+    up.kind = Move::Kind::Rapid;
+    up.alongZOnly = true;
+    up.role = "clearance";
+    up.node = first.node;
+    up.from = first.from;
+    up.to = Vec3(first.from.x(), first.from.y(), clearZ);
+    std::vector<Move> start{up};
+    if (rapid && first.to.z() < clearZ - kSame && (first.to.head<2>() - up.to.head<2>()).norm() > kSame) {
+      Move across = first;
+      across.from = up.to;
+      across.to = Vec3(first.to.x(), first.to.y(), clearZ);
+      start.push_back(across);
+      first.from = across.to;
+    } else {
+      first.from = up.to;
+    }
+    s.moves.insert(s.moves.begin(), start.begin(), start.end());
   }
 
   int toolIndex(const ir::Node &moves) {
@@ -183,6 +221,8 @@ private:
   Program program_;
   std::map<std::string, int> toolIndex_;
   Vec3 position_ = Vec3::Zero();
+  bool started_ = false;  ///< a step with moves was built
+  int lastTool_ = -1;     ///< that step's tool
   bool ok_ = true;
 };
 
@@ -198,6 +238,14 @@ double Move::sweep() const {
   if ((to.head<2>() - from.head<2>()).norm() <= kSame)
     angle = kTwoPi;  // over the start: a whole turn
   return angle + kTwoPi * static_cast<double>(turns);
+}
+
+double clearanceHeight(const Step &s) {
+  // The first move that is not the clearance move itself.
+  for (const Move &m : s.moves)
+    if (!m.alongZOnly)
+      return m.kind == Move::Kind::Rapid ? std::max(s.secplane, m.to.z()) : s.secplane;
+  return s.secplane;
 }
 
 std::string whyNotCycle(const TargetDescriptor &d, const HoleCycle &c) {
