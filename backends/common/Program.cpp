@@ -1,6 +1,7 @@
 #include "backends/common/Program.h"
 
 #include "ir/Kinds.h"
+#include "ir/Printer.h"
 #include "ir/Program.h"
 #include "ir/geom/FeatureShape.h"
 #include "ir/geom/MoveWalk.h"
@@ -193,6 +194,12 @@ private:
     const ir::Node *tool = ir::findTool(module_, symbol);
     if (!tool)
       return -1;  // the IR verifier reports dangling references
+    // Files that write the tool again for each workingstep give one tool
+    // several instances (and symbols): a tool the same in every value is
+    // one tool, with one number, loaded once.
+    const std::string identity = toolIdentity(*tool);
+    if (auto it = toolByIdentity_.find(identity); it != toolByIdentity_.end())
+      return toolIndex_[symbol] = it->second;
     ToolCall t;
     t.node = tool;
     t.label = tool->label.empty() ? tool->symbol : tool->label;
@@ -212,14 +219,29 @@ private:
       t.number = static_cast<int>(program_.tools.size()) + 1;
     }
     program_.tools.push_back(std::move(t));
-    return toolIndex_[symbol] = static_cast<int>(program_.tools.size()) - 1;
+    const int index = static_cast<int>(program_.tools.size()) - 1;
+    toolByIdentity_[identity] = index;
+    return toolIndex_[symbol] = index;
+  }
+
+  /// The tool as the IR prints it without its symbol, location or comment:
+  /// its id, type and every value.
+  static std::string toolIdentity(const ir::Node &tool) {
+    ir::Node copy = tool;
+    copy.symbol.clear();
+    copy.comment.clear();
+    copy.origin = {};
+    std::string text;
+    ir::printNode(copy, text, {});
+    return text;
   }
 
   const ir::Module &module_;
   const ToolTable *table_;
   DiagnosticEngine &diags_;
   Program program_;
-  std::map<std::string, int> toolIndex_;
+  std::map<std::string, int> toolIndex_;       ///< by symbol
+  std::map<std::string, int> toolByIdentity_;  ///< by toolIdentity
   Vec3 position_ = Vec3::Zero();
   bool started_ = false;  ///< a step with moves was built
   int lastTool_ = -1;     ///< that step's tool
