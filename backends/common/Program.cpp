@@ -5,10 +5,12 @@
 #include "ir/Program.h"
 #include "ir/geom/FeatureShape.h"
 #include "ir/geom/MoveWalk.h"
+#include "support/Format.h"
 
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <set>
 #include <numbers>
 
 namespace stepnc::backends {
@@ -17,6 +19,9 @@ namespace {
 
 constexpr double kTwoPi = 2 * std::numbers::pi;
 constexpr double kSame = 1e-9;
+/// How far a tool table's diameter may be from the STEP-NC tool's.
+constexpr double kDiameterTolMm = 0.001;
+constexpr double kMmPerInch = 25.4;
 
 CycleKind cycleKindOf(const ir::Node &cycle) {
   const std::string type = cycle.text("type").value_or("");
@@ -204,7 +209,10 @@ private:
     t.node = tool;
     t.label = tool->label.empty() ? tool->symbol : tool->label;
     t.diameter = tool->number("diameter").value_or(0);
-    if (table_) {
+    if (table_ && table_->format() == ToolTable::Format::LinuxCnc) {
+      if (!fromLinuxCncTable(*tool, t))
+        return -1;
+    } else if (table_) {
       const ToolTable::Entry *e = table_->find(*tool);
       if (!e) {
         diags_.error(tool->origin.loc, "tool " + tool->symbol + " (\"" + t.label + "\") is not in the tool table " +
@@ -222,6 +230,56 @@ private:
     const int index = static_cast<int>(program_.tools.size()) - 1;
     toolByIdentity_[identity] = index;
     return toolIndex_[symbol] = index;
+  }
+
+  /// A tool's number from LinuxCNC's tool table (docs/tool-table.md): the
+  /// line whose comment is the tool's STEP-NC id, else the next number in
+  /// order of first use that no such line takes. The table must list it
+  /// (LinuxCNC refuses a tool it does not list: an error) and should give
+  /// the tool's diameter (the paths are the tool centre's for the STEP-NC
+  /// diameter: a warning).
+  bool fromLinuxCncTable(const ir::Node &tool, ToolCall &t) {
+    if (!reservedNumbers_) {
+      reservedNumbers_.emplace();
+      for (const ir::Node &n : module_.root.children)
+        if (n.kind == ir::Kind::Tool)
+          if (const ToolTable::Entry *e = table_->find(n))
+            reservedNumbers_->insert(e->number);
+    }
+    const ToolTable::Entry *named = table_->find(tool);
+    if (named) {
+      t.number = named->number;
+    } else {
+      t.number = nextNumber_;
+      while (reservedNumbers_->count(t.number) || usedNumbers_.count(t.number))
+        ++t.number;
+      nextNumber_ = t.number + 1;
+    }
+    usedNumbers_.insert(t.number);
+    const ToolTable::Entry *e = named ? named : table_->findNumber(t.number);
+    const std::string subject = "tool " + tool.symbol + " (\"" + t.label + "\")";
+    if (!e) {
+      diags_.error(tool.origin.loc, subject + " is T" + std::to_string(t.number) +
+                                        " (in order of first use), which the tool table " + table_->name() +
+                                        " does not list: LinuxCNC refuses a tool its table lacks")
+          .entity(tool.origin.entityId)
+          .note("a line of the table whose comment is the tool's id (;" + t.label + ") gives it that line's number");
+      ok_ = false;
+      return false;
+    }
+    t.length = e->length;
+    if (e->diameter && t.diameter > 0 && std::abs(*e->diameter - t.diameter) > kDiameterTolMm) {
+      auto d = diags_.warning(e->diameterLoc.valid() ? e->diameterLoc : e->loc,
+                              "tool table: T" + std::to_string(t.number) + " has diameter " +
+                                  formatFixed(*e->diameter, 3) + " mm, " + subject + " " +
+                                  formatFixed(t.diameter, 3) + " mm: the program's paths are the tool centre's "
+                                  "for " + formatFixed(t.diameter, 3) + " mm");
+      d.note(tool.origin.loc, subject + " is defined here");
+      if (std::abs(*e->diameter * kMmPerInch - t.diameter) <= kDiameterTolMm)
+        d.note(formatFixed(*e->diameter, 4) + " in is " + formatFixed(t.diameter, 3) +
+               " mm: stepnc reads tool.tbl in mm, as a metric machine's table is; is this an imperial machine's?");
+    }
+    return true;
   }
 
   /// The tool as the IR prints it without its symbol, location or comment:
@@ -242,6 +300,10 @@ private:
   Program program_;
   std::map<std::string, int> toolIndex_;       ///< by symbol
   std::map<std::string, int> toolByIdentity_;  ///< by toolIdentity
+  // LinuxCNC tables: the numbers lines take by naming a tool, those given.
+  std::optional<std::set<int>> reservedNumbers_;
+  std::set<int> usedNumbers_;
+  int nextNumber_ = 1;
   Vec3 position_ = Vec3::Zero();
   bool started_ = false;  ///< a step with moves was built
   int lastTool_ = -1;     ///< that step's tool

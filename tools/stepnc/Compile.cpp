@@ -327,8 +327,9 @@ void registerCompile(CLI::App &app, std::function<void(int)> setResult) {
   cmd->add_flag("--allow-feed-increase", opts->allowFeedIncrease,
                 "Let feed adaptation raise feeds above the programmed ones where the cut allows");
   cmd->add_option("--tool-table", opts->toolTable,
-                  "Tool numbers and lengths by STEP-NC tool id (docs/tool-table.md); without one,\n"
-                  "tools are numbered in order of first use");
+                  "Tool numbers and lengths by STEP-NC tool id, or LinuxCNC's tool.tbl, whose\n"
+                  "numbers and diameters the program's tools are checked against (docs/tool-table.md);\n"
+                  "without one, tools are numbered in order of first use");
   cmd->add_flag("--no-cycles", opts->noCycles, "Write hole making as moves, not as the controller's canned cycles");
   cmd->add_option("--tolerance", opts->tolerance, "Contour tolerance for the controller's path mode, mm");
   cmd->add_option("--target-opt", opts->targetOptions,

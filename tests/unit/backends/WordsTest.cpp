@@ -160,6 +160,48 @@ TEST_CASE("tool tables: entries by id or symbol, errors at line and column", "[b
   }
 }
 
+TEST_CASE("LinuxCNC tool tables: numbers, diameters, lengths, comments", "[backends]") {
+  auto file = SourceFile::fromString("tool.tbl", "; a comment line first\n"
+                                                 "T1 P1 D10.000 Z+50.000 ;SPOT D10\n"
+                                                 "t2 p5 x0 z-1.5 d8 i0 j0 q0\r\n"
+                                                 "\n"
+                                                 "T12 P12 ;   REAMER D10  \n");
+  DiagnosticCollector collector;
+  DiagnosticEngine diags(collector);
+  auto table = ToolTable::parse(*file, diags);
+  REQUIRE(table);
+  CHECK(table->format() == ToolTable::Format::LinuxCnc);
+  REQUIRE(table->entries().size() == 3);
+  const ToolTable::Entry &t1 = table->entries()[0];
+  CHECK(t1.number == 1);
+  CHECK(*t1.diameter == 10);
+  CHECK(*t1.length == 50);
+  CHECK(t1.key == "SPOT D10");
+  CHECK(t1.loc.offset == 23);
+  CHECK(t1.diameterLoc.offset == 29);
+  CHECK(*table->entries()[1].diameter == 8);
+  CHECK(*table->entries()[1].length == -1.5);
+  CHECK(table->entries()[1].key.empty());
+  CHECK_FALSE(table->entries()[2].diameter);
+  CHECK(table->entries()[2].key == "REAMER D10");
+  // Tools are found by number, and by a comment that is their STEP-NC id.
+  CHECK(table->findNumber(2) == &table->entries()[1]);
+  CHECK(table->findNumber(3) == nullptr);
+  ir::Node reamer(ir::Kind::Tool);
+  reamer.symbol = "%reamer";
+  reamer.label = "REAMER D10";
+  CHECK(table->find(reamer) == &table->entries()[2]);
+
+  for (const char *bad : {"T0 P1\n", "T1 P1 D-3\n", "T1 P1 D\n", "T1 P1 R3\n", "T1 P1\nT1 P2\n", "T1\nP2 D3\n",
+                          "T1 T2\n"}) {
+    DiagnosticCollector badCollector;
+    DiagnosticEngine d(badCollector);
+    auto f = SourceFile::fromString("bad.tbl", bad);
+    CHECK_FALSE(ToolTable::parse(*f, d));
+    CHECK(d.errorCount() == 1);
+  }
+}
+
 namespace {
 
 /// A drilled hole's workingstep with the given moves, in IR text.
