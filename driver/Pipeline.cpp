@@ -10,6 +10,17 @@ namespace stepnc::driver {
 
 std::string toolpathPipeline(const ToolpathPipelineOptions &options) {
   std::string text = "resolve-feeds,expand-strategies,";
+  // The gate sees the cutting data as the file asks for it, before feed
+  // adaptation lowers any feed.
+  {
+    std::string check;
+    auto add = [&](const std::string &o) { check += (check.empty() ? "<" : ",") + o; };
+    if (!options.machine.empty())
+      add("machine=" + options.machine);
+    if (options.allowOutOfRange)
+      add("allow-out-of-range=true");
+    text += "check-limits" + check + (check.empty() ? "" : ">") + ",";
+  }
   if (options.adaptFeed) {
     std::string adapt;
     auto add = [&](const std::string &o) { adapt += (adapt.empty() ? "<" : ",") + o; };

@@ -21,10 +21,12 @@ struct ToolpathPipelineOptions {
   bool compensateDeflection = true;
   std::string cuttingData;  ///< a user cutting-data file, or empty
   bool allowFeedIncrease = false;
+  bool allowOutOfRange = false;  ///< check-limits reports warnings, not errors
 };
 
 /// What `compile --emit=toolpath-ir` runs: resolve-feeds, expand-strategies,
-/// adapt-feed and compensate-deflection (unless turned off), verify-toolpaths.
+/// check-limits, adapt-feed and compensate-deflection (unless turned off),
+/// verify-toolpaths.
 std::string toolpathPipeline(const ToolpathPipelineOptions &options);
 
 /// The plan-motion pass for a machine (file or shipped name) and tolerance.

@@ -48,7 +48,6 @@ std::optional<std::string> IsoEmitter::run(const Program &p) {
       // first move writes every axis and the feed again.
       for (const char *w : {"G", "X", "Y", "Z", "F"})
         modal_.forget(w);
-      afterToolChange_ = true;
     }
     if (s.spindle != 0 && s.spindle != spindle_) {
       out_.block(spindle(s.spindle));
@@ -134,7 +133,7 @@ void IsoEmitter::assumeAt(const Vec3 &p) {
 
 void IsoEmitter::positionFor(const Step &s) {
   for (const Move &m : s.moves) {
-    if (m.kind != Move::Kind::Rapid || m.role != "position")
+    if (!m.positions())
       break;
     move(m);
   }
@@ -149,13 +148,14 @@ void IsoEmitter::move(const Move &m) {
     out_.block(dwell(m.dwell));
     return;
   }
-  if (afterToolChange_ && m.kind == Move::Kind::Rapid) {
-    // From the tool change position: across at that height first, then down.
-    modal_.change("X", num(m.to.x()));
-    modal_.change("Y", num(m.to.y()));
-    out_.block((modal_.change("G", "G0") ? "G0 " : "") + word("X", num(m.to.x())) + word(" Y", num(m.to.y())));
+  if (m.alongZOnly) {
+    // Up from wherever the tool is: X and Y are not written (nor known).
+    const std::string z = num(m.to.z());
+    modal_.forget("Z");
+    modal_.change("Z", z);
+    out_.block((modal_.change("G", "G0") ? "G0 " : "") + word("Z", z));
+    return;
   }
-  afterToolChange_ = false;
   const std::string g = m.kind == Move::Kind::Rapid ? "G0" : "G1";
   // Which axes change as printed; a move that prints as no motion is left out.
   std::string words = axes(m.to);
@@ -179,7 +179,6 @@ size_t IsoEmitter::smoothRunEnd(const std::vector<Move> &moves, size_t i) const 
 }
 
 void IsoEmitter::spline(const std::vector<Move> &moves, size_t begin, size_t end) {
-  afterToolChange_ = false;
   std::vector<geom::Vec2> points{moves[begin].from.head<2>()};
   for (size_t i = begin; i < end; ++i)
     points.push_back(moves[i].to.head<2>());

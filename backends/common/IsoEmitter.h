@@ -62,8 +62,9 @@ protected:
   /// (a cycle), and that the motion word must be written again.
   void assumeAt(const Vec3 &p);
   double tolerance() const { return o_.tolerance.value_or(d_.tolerance); }
-  /// Writes the position moves of a cycle step (to the hole at the security
-  /// plane), before the cycle block.
+  /// Writes the position moves of a cycle step (up to the clearance height
+  /// after a tool change, to the hole at the security plane), before the
+  /// cycle block.
   void positionFor(const Step &s);
 
   const TargetDescriptor &d_;
@@ -83,7 +84,6 @@ private:
   /// descriptor's form.
   void spline(const std::vector<Move> &moves, size_t begin, size_t end);
   int tool_ = -1;
-  bool afterToolChange_ = false;
   double spindle_ = 0;
   std::string coolant_ = "off";
 };

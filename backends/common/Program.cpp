@@ -1,12 +1,16 @@
 #include "backends/common/Program.h"
 
 #include "ir/Kinds.h"
+#include "ir/Printer.h"
 #include "ir/Program.h"
 #include "ir/geom/FeatureShape.h"
 #include "ir/geom/MoveWalk.h"
+#include "support/Format.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
+#include <set>
 #include <numbers>
 
 namespace stepnc::backends {
@@ -15,6 +19,9 @@ namespace {
 
 constexpr double kTwoPi = 2 * std::numbers::pi;
 constexpr double kSame = 1e-9;
+/// How far a tool table's diameter may be from the STEP-NC tool's.
+constexpr double kDiameterTolMm = 0.001;
+constexpr double kMmPerInch = 25.4;
 
 CycleKind cycleKindOf(const ir::Node &cycle) {
   const std::string type = cycle.text("type").value_or("");
@@ -138,14 +145,51 @@ private:
       mv.turns = m.turns;
       s.moves.push_back(std::move(mv));
     }
-    if (!s.moves.empty())
+    if (!s.moves.empty()) {
       position_ = s.moves.back().to;
+      if (!started_ || s.tool != lastTool_)
+        startClear(s);
+      started_ = true;
+      lastTool_ = s.tool;
+    }
     // A step that is one canned cycle is written as the controller's cycle
     // where the target has it; cycles among other moves are written as
     // their moves (expansion makes none yet).
     if (moves->children.size() == 1 && moves->children.front().kind == ir::Kind::Cycle)
       s.cycle = holeCycle(moves->children.front(), s.secplane);
     program_.steps.push_back(std::move(s));
+  }
+
+  /// Where a tool change left the tool, or where it is when the program
+  /// starts, is the machine's business: it may be low, beside the part.
+  /// So the step starts up along Z alone to its clearance height (the
+  /// security plane, or the first rapid's height when that is higher),
+  /// then moves across at that height, then down: the first rapid is split
+  /// when it moves both across and down. Every target writes these moves
+  /// as they are; none decides this itself.
+  static void startClear(Step &s) {
+    s.toolChange = true;
+    Move &first = s.moves.front();
+    const bool rapid = first.kind == Move::Kind::Rapid;
+    const double clearZ = clearanceHeight(s);
+    Move up;
+    up.kind = Move::Kind::Rapid;
+    up.alongZOnly = true;
+    up.role = "clearance";
+    up.node = first.node;
+    up.from = first.from;
+    up.to = Vec3(first.from.x(), first.from.y(), clearZ);
+    std::vector<Move> start{up};
+    if (rapid && first.to.z() < clearZ - kSame && (first.to.head<2>() - up.to.head<2>()).norm() > kSame) {
+      Move across = first;
+      across.from = up.to;
+      across.to = Vec3(first.to.x(), first.to.y(), clearZ);
+      start.push_back(across);
+      first.from = across.to;
+    } else {
+      first.from = up.to;
+    }
+    s.moves.insert(s.moves.begin(), start.begin(), start.end());
   }
 
   int toolIndex(const ir::Node &moves) {
@@ -155,11 +199,20 @@ private:
     const ir::Node *tool = ir::findTool(module_, symbol);
     if (!tool)
       return -1;  // the IR verifier reports dangling references
+    // Files that write the tool again for each workingstep give one tool
+    // several instances (and symbols): a tool the same in every value is
+    // one tool, with one number, loaded once.
+    const std::string identity = toolIdentity(*tool);
+    if (auto it = toolByIdentity_.find(identity); it != toolByIdentity_.end())
+      return toolIndex_[symbol] = it->second;
     ToolCall t;
     t.node = tool;
     t.label = tool->label.empty() ? tool->symbol : tool->label;
     t.diameter = tool->number("diameter").value_or(0);
-    if (table_) {
+    if (table_ && table_->format() == ToolTable::Format::LinuxCnc) {
+      if (!fromLinuxCncTable(*tool, t))
+        return -1;
+    } else if (table_) {
       const ToolTable::Entry *e = table_->find(*tool);
       if (!e) {
         diags_.error(tool->origin.loc, "tool " + tool->symbol + " (\"" + t.label + "\") is not in the tool table " +
@@ -174,15 +227,86 @@ private:
       t.number = static_cast<int>(program_.tools.size()) + 1;
     }
     program_.tools.push_back(std::move(t));
-    return toolIndex_[symbol] = static_cast<int>(program_.tools.size()) - 1;
+    const int index = static_cast<int>(program_.tools.size()) - 1;
+    toolByIdentity_[identity] = index;
+    return toolIndex_[symbol] = index;
+  }
+
+  /// A tool's number from LinuxCNC's tool table (docs/tool-table.md): the
+  /// line whose comment is the tool's STEP-NC id, else the next number in
+  /// order of first use that no such line takes. The table must list it
+  /// (LinuxCNC refuses a tool it does not list: an error) and should give
+  /// the tool's diameter (the paths are the tool centre's for the STEP-NC
+  /// diameter: a warning).
+  bool fromLinuxCncTable(const ir::Node &tool, ToolCall &t) {
+    if (!reservedNumbers_) {
+      reservedNumbers_.emplace();
+      for (const ir::Node &n : module_.root.children)
+        if (n.kind == ir::Kind::Tool)
+          if (const ToolTable::Entry *e = table_->find(n))
+            reservedNumbers_->insert(e->number);
+    }
+    const ToolTable::Entry *named = table_->find(tool);
+    if (named) {
+      t.number = named->number;
+    } else {
+      t.number = nextNumber_;
+      while (reservedNumbers_->count(t.number) || usedNumbers_.count(t.number))
+        ++t.number;
+      nextNumber_ = t.number + 1;
+    }
+    usedNumbers_.insert(t.number);
+    const ToolTable::Entry *e = named ? named : table_->findNumber(t.number);
+    const std::string subject = "tool " + tool.symbol + " (\"" + t.label + "\")";
+    if (!e) {
+      diags_.error(tool.origin.loc, subject + " is T" + std::to_string(t.number) +
+                                        " (in order of first use), which the tool table " + table_->name() +
+                                        " does not list: LinuxCNC refuses a tool its table lacks")
+          .entity(tool.origin.entityId)
+          .note("a line of the table whose comment is the tool's id (;" + t.label + ") gives it that line's number");
+      ok_ = false;
+      return false;
+    }
+    t.length = e->length;
+    if (e->diameter && t.diameter > 0 && std::abs(*e->diameter - t.diameter) > kDiameterTolMm) {
+      auto d = diags_.warning(e->diameterLoc.valid() ? e->diameterLoc : e->loc,
+                              "tool table: T" + std::to_string(t.number) + " has diameter " +
+                                  formatFixed(*e->diameter, 3) + " mm, " + subject + " " +
+                                  formatFixed(t.diameter, 3) + " mm: the program's paths are the tool centre's "
+                                  "for " + formatFixed(t.diameter, 3) + " mm");
+      d.note(tool.origin.loc, subject + " is defined here");
+      if (std::abs(*e->diameter * kMmPerInch - t.diameter) <= kDiameterTolMm)
+        d.note(formatFixed(*e->diameter, 4) + " in is " + formatFixed(t.diameter, 3) +
+               " mm: stepnc reads tool.tbl in mm, as a metric machine's table is; is this an imperial machine's?");
+    }
+    return true;
+  }
+
+  /// The tool as the IR prints it without its symbol, location or comment:
+  /// its id, type and every value.
+  static std::string toolIdentity(const ir::Node &tool) {
+    ir::Node copy = tool;
+    copy.symbol.clear();
+    copy.comment.clear();
+    copy.origin = {};
+    std::string text;
+    ir::printNode(copy, text, {});
+    return text;
   }
 
   const ir::Module &module_;
   const ToolTable *table_;
   DiagnosticEngine &diags_;
   Program program_;
-  std::map<std::string, int> toolIndex_;
+  std::map<std::string, int> toolIndex_;       ///< by symbol
+  std::map<std::string, int> toolByIdentity_;  ///< by toolIdentity
+  // LinuxCNC tables: the numbers lines take by naming a tool, those given.
+  std::optional<std::set<int>> reservedNumbers_;
+  std::set<int> usedNumbers_;
+  int nextNumber_ = 1;
   Vec3 position_ = Vec3::Zero();
+  bool started_ = false;  ///< a step with moves was built
+  int lastTool_ = -1;     ///< that step's tool
   bool ok_ = true;
 };
 
@@ -198,6 +322,14 @@ double Move::sweep() const {
   if ((to.head<2>() - from.head<2>()).norm() <= kSame)
     angle = kTwoPi;  // over the start: a whole turn
   return angle + kTwoPi * static_cast<double>(turns);
+}
+
+double clearanceHeight(const Step &s) {
+  // The first move that is not the clearance move itself.
+  for (const Move &m : s.moves)
+    if (!m.alongZOnly)
+      return m.kind == Move::Kind::Rapid ? std::max(s.secplane, m.to.z()) : s.secplane;
+  return s.secplane;
 }
 
 std::string whyNotCycle(const TargetDescriptor &d, const HoleCycle &c) {

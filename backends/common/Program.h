@@ -38,8 +38,17 @@ struct Move {
   double feed = 0;    ///< mm/min; 0 for rapids
   bool smooth = false;  ///< a line that is a chord of a smooth curve (toolpath IR `smooth`)
   double dwell = 0;     ///< dwells: s
+  /// A rapid along Z alone, to `to.z()`: the clearance move that starts
+  /// every step after a tool change and the program (role "clearance").
+  /// Where the tool is in X and Y is then the machine's business: only the
+  /// Z word is written, and `from`/`to` carry X and Y as last planned.
+  bool alongZOnly = false;
   std::string role;
   const ir::Node *node = nullptr;
+
+  /// A rapid that takes the tool to where a step starts: the clearance
+  /// move and the moves the IR marks `position`.
+  bool positions() const { return kind == Kind::Rapid && (role == "position" || role == "clearance"); }
 
   /// The whole angle an arc sweeps (radians, > 0), full turns included; a
   /// last arc ending over its start is a whole turn.
@@ -80,6 +89,9 @@ struct Step {
   /// The operation's name, for messages ("tapping").
   std::string operationName() const { return operation ? std::string(ir::kindName(*operation)) : std::string(); }
   int tool = -1;          ///< index into Program::tools
+  /// The first step with moves, or the first after its tool changed in:
+  /// its moves start with the clearance move (Move::alongZOnly).
+  bool toolChange = false;
   double spindle = 0;     ///< rev/min, negative clockwise (M3); 0 on a rapid movement: keep
   std::string coolant;    ///< off, flood, mist, through_tool
   double secplane = 0;
@@ -95,6 +107,11 @@ struct Program {
   /// The block raw piece of the (first) workpiece, workpiece coordinates.
   std::optional<std::pair<Vec3, Vec3>> blank;
 };
+
+/// How high a step starts when where the tool is cannot be relied on (after
+/// a tool change, at the start): its security plane, or its first rapid's
+/// height when that is higher.
+double clearanceHeight(const Step &s);
 
 /// The program of `module` (toolpath IR). Errors: an executable without
 /// moves, a tool missing from the table. Returns nullopt after reporting.

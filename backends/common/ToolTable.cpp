@@ -2,8 +2,124 @@
 
 #include <cctype>
 #include <charconv>
+#include <cmath>
+#include <cstdlib>
 
 namespace stepnc::backends {
+
+namespace {
+
+bool isSpace(char c) { return std::isspace(static_cast<unsigned char>(c)) != 0; }
+
+std::string_view trim(std::string_view s) {
+  while (!s.empty() && isSpace(s.front()))
+    s.remove_prefix(1);
+  while (!s.empty() && isSpace(s.back()))
+    s.remove_suffix(1);
+  return s;
+}
+
+/// The first word of the first line that has one, outside comments of
+/// either format: `T<digits>` says the table is LinuxCNC's.
+bool looksLikeLinuxCnc(std::string_view text) {
+  size_t i = 0;
+  while (i < text.size()) {
+    if (isSpace(text[i])) {
+      ++i;
+      continue;
+    }
+    if (text[i] == '#' || text[i] == ';') {
+      i = text.find('\n', i);
+      if (i == std::string_view::npos)
+        return false;
+      continue;
+    }
+    if (text[i] != 'T' && text[i] != 't')
+      return false;
+    size_t j = i + 1;
+    while (j < text.size() && std::isdigit(static_cast<unsigned char>(text[j])))
+      ++j;
+    return j > i + 1 && (j == text.size() || isSpace(text[j]) || text[j] == ';');
+  }
+  return false;
+}
+
+} // namespace
+
+bool ToolTable::parseLinuxCncLine(const SourceFile &file, size_t lineStart, std::string_view line,
+                                  std::string_view comment, DiagnosticEngine &diags) {
+  Entry e;
+  bool hasNumber = false;
+  size_t i = 0;
+  while (i < line.size()) {
+    if (isSpace(line[i])) {
+      ++i;
+      continue;
+    }
+    const size_t start = i;
+    while (i < line.size() && !isSpace(line[i]))
+      ++i;
+    const std::string_view word = line.substr(start, i - start);
+    const SourceLoc loc{&file, lineStart + start};
+    const char letter = static_cast<char>(std::toupper(static_cast<unsigned char>(word.front())));
+    const std::string_view value = word.substr(1);
+    if (letter == 'T' || letter == 'P') {
+      long n = 0;
+      auto [p, ec] = std::from_chars(value.data(), value.data() + value.size(), n);
+      if (ec != std::errc() || p != value.data() + value.size() || n < (letter == 'T' ? 1 : 0) || n > 99999) {
+        diags.error(loc, "tool table: '" + std::string(word) + "' is not a " +
+                             (letter == 'T' ? "tool number (T1 to T99999)" : "pocket number (P0 to P99999)"));
+        return false;
+      }
+      if (letter == 'T') {
+        if (hasNumber) {
+          diags.error(loc, "tool table: a second tool number on the line");
+          return false;
+        }
+        e.number = static_cast<int>(n);
+        e.loc = loc;
+        hasNumber = true;
+      }
+      continue;
+    }
+    if (std::string_view("XYZABCUVWDIJQ").find(letter) == std::string_view::npos) {
+      diags.error(loc, "tool table: '" + std::string(word) +
+                           "' is not a word of a LinuxCNC tool table (T, P, X Y Z A B C U V W, D, I, J, Q)");
+      return false;
+    }
+    // strtod reads '+' signs, which LinuxCNC writes on its offsets.
+    const std::string number(value);
+    char *end = nullptr;
+    const double v = std::strtod(number.c_str(), &end);
+    if (number.empty() || *end != '\0' || !std::isfinite(v)) {
+      diags.error(loc, "tool table: '" + std::string(word) + "' is not a number after " + std::string(1, letter));
+      return false;
+    }
+    if (letter == 'Z')
+      e.length = v;
+    else if (letter == 'D') {
+      if (v < 0) {
+        diags.error(loc, "tool table: diameter " + std::string(word) + " is negative");
+        return false;
+      }
+      e.diameter = v;
+      e.diameterLoc = loc;
+    }
+  }
+  if (!hasNumber) {
+    diags.error(SourceLoc{&file, lineStart}, "tool table: a line without its tool number T<n>");
+    return false;
+  }
+  for (const Entry &other : entries_)
+    if (other.number == e.number) {
+      diags.error(e.loc, "tool table: T" + std::to_string(e.number) + " is listed twice")
+          .note(other.loc, "first listed here");
+      return false;
+    }
+  e.key = std::string(trim(comment));
+  entries_.push_back(std::move(e));
+  return true;
+}
 
 std::optional<ToolTable> ToolTable::parse(const SourceFile &file, DiagnosticEngine &diags) {
   ToolTable table;
@@ -11,6 +127,26 @@ std::optional<ToolTable> ToolTable::parse(const SourceFile &file, DiagnosticEngi
   const std::string_view text = file.text();
   bool ok = true;
   size_t lineStart = 0;
+  if (looksLikeLinuxCnc(text)) {
+    table.format_ = Format::LinuxCnc;
+    while (lineStart < text.size()) {
+      size_t lineEnd = text.find('\n', lineStart);
+      if (lineEnd == std::string_view::npos)
+        lineEnd = text.size();
+      std::string_view line = text.substr(lineStart, lineEnd - lineStart);
+      std::string_view comment;
+      if (const size_t semi = line.find(';'); semi != std::string_view::npos) {
+        comment = line.substr(semi + 1);
+        line = line.substr(0, semi);
+      }
+      if (!trim(line).empty())
+        ok = table.parseLinuxCncLine(file, lineStart, line, comment, diags) && ok;
+      lineStart = lineEnd + 1;
+    }
+    if (!ok)
+      return std::nullopt;
+    return table;
+  }
   while (lineStart < text.size()) {
     size_t lineEnd = text.find('\n', lineStart);
     if (lineEnd == std::string_view::npos)
@@ -105,6 +241,13 @@ std::optional<ToolTable> ToolTable::parse(const SourceFile &file, DiagnosticEngi
 const ToolTable::Entry *ToolTable::find(const ir::Node &tool) const {
   for (const Entry &e : entries_)
     if (e.bySymbol ? e.key == tool.symbol : (!tool.label.empty() && e.key == tool.label))
+      return &e;
+  return nullptr;
+}
+
+const ToolTable::Entry *ToolTable::findNumber(int number) const {
+  for (const Entry &e : entries_)
+    if (e.number == number)
       return &e;
   return nullptr;
 }

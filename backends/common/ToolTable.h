@@ -7,6 +7,13 @@
 //   %t3_endmill_d10_z4         7
 //
 // A tool is named by its STEP-NC id in double quotes or by its IR symbol.
+//
+// LinuxCNC's own tool table (tool.tbl) is read too, told apart by its first
+// word (`T<number>`): one pocket per line, words T (number), P (pocket), D
+// (diameter), X..W (offsets, Z the length) and the rest of the line after
+// ';' a comment. Its values are read in mm. It names no STEP-NC tool but by
+// its comments, so its tools are matched by number, or by a comment that is
+// the tool's STEP-NC id (docs/tool-table.md).
 #pragma once
 
 #include "ir/Node.h"
@@ -21,24 +28,39 @@ namespace stepnc::backends {
 
 class ToolTable {
 public:
+  enum class Format { Stepnc, LinuxCnc };
+
   struct Entry {
-    std::string key;  ///< the quoted id (without quotes) or the symbol (with '%')
+    std::string key;  ///< the quoted id (without quotes) or the symbol (with '%'); LinuxCNC: the comment
     bool bySymbol = false;
     int number = 0;
-    std::optional<double> length;
+    std::optional<double> length;    ///< mm (LinuxCNC: the Z offset)
+    std::optional<double> diameter;  ///< mm (LinuxCNC's D)
     SourceLoc loc;
+    SourceLoc diameterLoc;  ///< where the D word is (LinuxCNC)
   };
 
   /// Reads a table; reports each bad line (file:line:col) and returns nullopt
   /// when there was one.
   static std::optional<ToolTable> parse(const SourceFile &file, DiagnosticEngine &diags);
 
-  /// The entry for a tool node, or null.
+  /// The entry for a tool node, or null: by id or symbol; in a LinuxCNC
+  /// table, the entry whose comment is the tool's STEP-NC id.
   const Entry *find(const ir::Node &tool) const;
+  /// The entry for tool number `number`, or null.
+  const Entry *findNumber(int number) const;
   const std::string &name() const { return name_; }
+  Format format() const { return format_; }
+  const std::vector<Entry> &entries() const { return entries_; }
 
 private:
+  /// One line of a LinuxCNC table, `line` without its comment; false after
+  /// reporting an error.
+  bool parseLinuxCncLine(const SourceFile &file, size_t lineStart, std::string_view line, std::string_view comment,
+                         DiagnosticEngine &diags);
+
   std::string name_;
+  Format format_ = Format::Stepnc;
   std::vector<Entry> entries_;
 };
 

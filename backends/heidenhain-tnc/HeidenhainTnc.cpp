@@ -301,9 +301,11 @@ private:
     return "M9";
   }
 
-  /// TOOL CALL with the speed, then up to a safe height along the tool axis
-  /// starting the spindle: where the tool change left the tool is unknown,
-  /// and going straight to the security plane is safe from above or below.
+  /// TOOL CALL with the speed; the spindle starts on the next L block. After
+  /// a tool change that is the step's clearance move, up along the tool axis
+  /// (the program model puts it there, Move::alongZOnly); a TOOL CALL that
+  /// only changes the speed may move the axes as well, so it is followed by
+  /// the same move here.
   void toolCall(const ToolCall &t, const Step &s) {
     std::string text = "TOOL CALL " + std::to_string(t.number) + " Z";
     if (s.spindle != 0)
@@ -317,19 +319,20 @@ private:
     modal_.forget("F");
     modal_.forget("CC");
     cc_.reset();
-    double safeZ = s.secplane;
-    if (!s.moves.empty() && s.moves.front().kind == Move::Kind::Rapid)
-      safeZ = std::max(safeZ, s.moves.front().to.z());
-    text = "L Z" + num(safeZ) + " R0 FMAX";
-    modal_.change("Z", num(safeZ));
-    at_[2] = rounded(safeZ);
-    if (s.spindle != 0) {
-      text += s.spindle < 0 ? " M3" : " M4";
-      spindleRunning_ = true;
-    } else {
-      spindleRunning_ = false;
-    }
-    out_.block(text);
+    spindleRunning_ = s.spindle != 0;
+    if (spindleRunning_)
+      pendingM_.push_back(s.spindle < 0 ? "M3" : "M4");
+    if (!s.toolChange)
+      upAlongZ(clearanceHeight(s));
+  }
+
+  /// An FMAX block along Z alone, carrying the next M function.
+  void upAlongZ(double z) {
+    modal_.forget("Z");
+    modal_.change("Z", num(z));
+    at_[2] = rounded(z);
+    out_.block("L Z" + num(z) + " R0 FMAX" + takeM());
+    modal_.forget("F");
   }
 
   // --- Moves -------------------------------------------------------------------
@@ -343,6 +346,10 @@ private:
       // Cycle 9 waits where the tool is, from its definition on.
       out_.block("CYCL DEF 9.0 DWELL TIME");
       out_.block("CYCL DEF 9.1 DWELL " + seconds(m.dwell));
+      return;
+    }
+    if (m.alongZOnly) {
+      upAlongZ(m.to.z());
       return;
     }
     line(m.to, m.kind == Move::Kind::Rapid, m.feed);
@@ -542,7 +549,7 @@ private:
     }
     // To the hole at the security plane, as planned.
     for (const Move &m : s.moves) {
-      if (m.kind != Move::Kind::Rapid || m.role != "position")
+      if (!m.positions())
         break;
       move(m);
     }

@@ -2,6 +2,7 @@
 // operations with their technology, machine functions, strategies and
 // approach/retract, explicit toolpaths; and the tools they use (ISO 14649-111).
 #include "frontend/lowering/Lowerer.h"
+#include "ir/Plausible.h"
 #include "support/Format.h"
 
 #include <cmath>
@@ -250,19 +251,20 @@ Node technology(Lowerer &l, const Instance &tech) {
   if (auto f = tech.real("feedrate")) {
     const double feed = l.feedMmPerMin(*f);
     n.set("feed", Value::feed(feed));
-    checkPlausible(l, tech, "feedrate", feed, 1.0, 100000.0, "mm/min");
+    checkPlausible(l, tech, "feedrate", feed, ir::kPlausibleMinFeedMmPerMin, ir::kPlausibleMaxFeedMmPerMin, "mm/min");
   }
   if (auto fz = tech.real("feedrate_per_tooth"))
     n.set("feed_per_tooth", Value::length(*fz));
   if (auto vc = tech.real("cutspeed")) {
     const double speed = l.cuttingSpeedMmPerMin(*vc);
     n.set("cutting_speed", Value::feed(speed));
-    checkPlausible(l, tech, "cutspeed", speed, 1000.0, 3000000.0, "mm/min");
+    checkPlausible(l, tech, "cutspeed", speed, 1000 * ir::kPlausibleMinCuttingSpeedMPerMin,
+                   1000 * ir::kPlausibleMaxCuttingSpeedMPerMin, "mm/min");
   }
   if (auto s = tech.real("spindle")) {
     const double rpm = l.spindleRevPerMin(*s);
     n.set("spindle", Value::spindle(rpm));
-    checkPlausible(l, tech, "spindle", rpm, 1.0, 100000.0, "rev/min");
+    checkPlausible(l, tech, "spindle", rpm, ir::kPlausibleMinSpindleRpm, ir::kPlausibleMaxSpindleRpm, "rev/min");
   }
   n.set("feed_reference", Value::word(tech.enumeration("feedrate_reference").value_or("tcp")));
   copyFlag(n, "sync_spindle_feed", tech, "synchronize_spindle_with_feed");

@@ -1,6 +1,7 @@
 // Lowering of the program structure: project, workpieces, setups, workplans,
 // workingsteps and NC functions, plus the helpers every lowering file uses.
 #include "frontend/lowering/Lowerer.h"
+#include "ir/Plausible.h"
 
 #include "support/Format.h"
 
@@ -366,6 +367,8 @@ struct SpeedValue {
   std::string_view attribute;
   double value;
   double toolDiameter;  ///< mm, 0 when not known
+  double spindle = 0;   ///< the technology's spindle speed as written, 0 when none
+  int64_t flutes = 0;   ///< the tool's, 0 when not known
 };
 
 /// The reading under which every value is plausible, else the one under
@@ -399,52 +402,80 @@ void Lowerer::chooseSpeedUnits(const std::vector<Instance> &operations) {
     Instance tech = op.ref("its_technology");
     if (!tech)
       continue;
+    Instance body = op.ref("its_tool").ref("its_tool_body");
     double diameter = 0;
-    if (Instance dim = op.ref("its_tool").ref("its_tool_body").ref("dimension"))
+    if (Instance dim = body.ref("dimension"))
       diameter = dim.real("diameter").value_or(0);
+    const double spindle = tech.real("spindle").value_or(0);
+    const int64_t flutes = body.integer("number_of_teeth").value_or(0);
     for (auto [attribute, list] : {std::pair{"feedrate", &feeds}, {"cutspeed", &cutspeeds}, {"spindle", &spindles}})
       if (auto v = tech.real(attribute); v && *v != 0)
-        list->push_back({tech, attribute, *v, diameter});
+        list->push_back({tech, attribute, *v, diameter, spindle, flutes});
   }
-  // Plausible: feeds of 1 mm/min to 60 m/min; cutting speeds of 1 to 1500
-  // m/min; spindle speeds of 10 to 60000 rev/min that give such a cutting
-  // speed on the tool, when its diameter is known.
+  // Plausible: spindle speeds of 10 to 60000 rev/min that give a cutting
+  // speed of 1 to 1500 m/min on the tool, when its diameter is known;
+  // cutting speeds likewise; feeds of 1 mm/min to 60 m/min that, with the
+  // spindle speed read as chosen and the tool's flutes, load each tooth
+  // with no more than ir::kPlausibleChipLoadShare of the tool's diameter
+  // (the bound check-limits holds the program to).
+  const UnitConventions &u = options_.units;
   auto plausibleCutspeed = [](double mmPerMin) { return mmPerMin >= 1000 && mmPerMin <= 1.5e6; };
-  const size_t feed = chooseReading(kSpeedReadings, feeds, [](const SpeedValue &, double f) {
-    return std::abs(f) >= 1 && std::abs(f) <= 60000;
-  });
-  const size_t cutspeed = chooseReading(kSpeedReadings, cutspeeds,
-                                        [&](const SpeedValue &, double vc) { return plausibleCutspeed(std::abs(vc)); });
   auto plausibleSpindle = [&](const SpeedValue &v, double n) {
     n = std::abs(n);
     return n >= 10 && n <= 60000 && (v.toolDiameter <= 0 || plausibleCutspeed(std::numbers::pi * v.toolDiameter * n));
   };
   const size_t spindle = chooseReading(kSpindleReadings, spindles, plausibleSpindle);
-  const UnitConventions &u = options_.units;
+  const double revPerMin = u.rotSpeedToRevPerMin > 0 ? u.rotSpeedToRevPerMin : kSpindleReadings[spindle].factor;
+  // The feed per tooth `f` (mm/min) gives on v's tool, 0 when not known.
+  auto chipLoad = [&](const SpeedValue &v, double f) {
+    const double n = std::abs(v.spindle) * revPerMin;
+    return v.flutes > 0 && n > 0 ? std::abs(f) / (static_cast<double>(v.flutes) * n) : 0.0;
+  };
+  auto plausibleFeed = [&](const SpeedValue &v, double f) {
+    f = std::abs(f);
+    return f >= 1 && f <= 60000 && (v.toolDiameter <= 0 || chipLoad(v, f) <= ir::kPlausibleChipLoadShare * v.toolDiameter);
+  };
+  const size_t feed = chooseReading(kSpeedReadings, feeds, plausibleFeed);
+  const size_t cutspeed = chooseReading(kSpeedReadings, cutspeeds,
+                                        [&](const SpeedValue &, double vc) { return plausibleCutspeed(std::abs(vc)); });
   feedToMmPerMin_ = u.feedToMmPerMin > 0 ? u.feedToMmPerMin : kSpeedReadings[feed].factor;
   cutspeedToMmPerMin_ = u.cutspeedToMmPerMin > 0 ? u.cutspeedToMmPerMin : kSpeedReadings[cutspeed].factor;
   spindleToRevPerMin_ = u.rotSpeedToRevPerMin > 0 ? u.rotSpeedToRevPerMin : kSpindleReadings[spindle].factor;
-  // Say which reading was taken when it is not the standard's.
+  // Says which reading was taken when it is not the standard's, with a
+  // value the standard's reading makes implausible (`plausible`).
   auto report = [&](const std::vector<SpeedValue> &values, const UnitReading &chosen, const UnitReading &standard,
-                    std::string_view what, std::string_view unit) {
+                    std::string_view what, std::string_view unit, auto plausible) {
     if (chosen.factor == standard.factor || values.empty())
       return;
-    const SpeedValue &v = values.front();
+    const SpeedValue *example = &values.front();
+    for (const SpeedValue &v : values)
+      if (!plausible(v, v.value * standard.factor)) {
+        example = &v;
+        break;
+      }
+    const SpeedValue &v = *example;
+    const double asStandard = std::abs(v.value) * standard.factor;
+    std::string detail;
+    if (v.attribute == std::string_view("feedrate") && asStandard >= 1 && asStandard <= 60000)
+      if (const double fz = chipLoad(v, asStandard); fz > 0)
+        detail = " mm/min, " + formatFixed(fz, 4) + " mm per tooth on its " + formatFixed(v.toolDiameter, 4) +
+                 " mm tool";
     diags_
         .assumption(v.tech.attrLoc(v.attribute),
                     std::string(what) + " read as " + std::string(chosen.name) + ", not " + std::string(standard.name) +
                         ": as " + std::string(standard.name) + " they are not what a machine does (" +
                         std::string(v.attribute) + " " + formatFixed(v.value, 4) + " of " + hashId(v.tech.id()) +
                         ": " + formatFixed(std::abs(v.value) * chosen.factor, 1) + " " + std::string(unit) + "; as " +
-                        std::string(standard.name) + ", " + formatFixed(std::abs(v.value) * standard.factor, 1) + ")")
+                        std::string(standard.name) + ", " + formatFixed(asStandard, 1) + detail + ")")
         .entity(v.tech.id(), std::string(v.tech.entityName()));
   };
   if (u.feedToMmPerMin <= 0)
-    report(feeds, kSpeedReadings[feed], kSpeedReadings[0], "feeds", "mm/min");
+    report(feeds, kSpeedReadings[feed], kSpeedReadings[0], "feeds", "mm/min", plausibleFeed);
   if (u.cutspeedToMmPerMin <= 0)
-    report(cutspeeds, kSpeedReadings[cutspeed], kSpeedReadings[0], "cutting speeds", "mm/min");
+    report(cutspeeds, kSpeedReadings[cutspeed], kSpeedReadings[0], "cutting speeds", "mm/min",
+           [&](const SpeedValue &, double vc) { return plausibleCutspeed(std::abs(vc)); });
   if (u.rotSpeedToRevPerMin <= 0)
-    report(spindles, kSpindleReadings[spindle], kSpindleReadings[0], "spindle speeds", "rev/min");
+    report(spindles, kSpindleReadings[spindle], kSpindleReadings[0], "spindle speeds", "rev/min", plausibleSpindle);
   // A spindle speed that no reading makes plausible with the others: say
   // what it gives on its tool (feeds and cutting speeds are checked as they
   // are lowered).

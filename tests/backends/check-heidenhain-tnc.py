@@ -14,7 +14,10 @@ what the control would reject or do differently:
     from a whitelist; `TOOL CALL n Z S..`; `BLK FORM 0.1 Z` then `0.2` with
     MIN below MAX; cycle 32 and cycle 200 with all their Q parameters; cycle
     9 (`CYCL DEF 9.0 DWELL TIME`, then `CYCL DEF 9.1 DWELL t`, t > 0 s);
-  * motion: no motion before a TOOL CALL, no feed move without a feed or
+  * motion: the first after each TOOL CALL is an L block with Z alone (up
+    to the clearance height: where the tool change left the tool is the
+    machine's business, so X and Y only move once it is up); no motion
+    before a TOOL CALL, no feed move without a feed or
     with the spindle stopped; a `C` needs a `CC` and the tracked position and
     the end as far from it within --arc-tol (default 0.001 mm); `CP` has IPA
     and DR of the same sign; `M99` needs a cycle 200 and the tool at or above
@@ -118,10 +121,15 @@ class Machine:
         self.spindle = False
         self.cycle = None
         self.motions = []
+        self.up_first = None  # the TOOL CALL whose first motion is still to come
 
-    def need_tool(self, where):
+    def need_tool(self, where, z_alone=False):
         if self.tool is None:
             self.p.add(where, "motion before any TOOL CALL")
+        if self.up_first and not z_alone:
+            self.p.add(where, "the first motion after the TOOL CALL at %s is not Z alone (up to the clearance "
+                              "height before X and Y move)" % self.up_first)
+        self.up_first = None
 
     def feed_move(self, where, feed):
         if feed is not None:
@@ -145,7 +153,7 @@ class Machine:
         # An L block without coordinates ("L M30" in a program with no
         # motion) moves nothing: it needs no tool.
         if axes:
-            self.need_tool(where)
+            self.need_tool(where, z_alone=list(axes) == ["Z"] and rapid)
         if not rapid and axes:
             self.feed_move(where, feed)
         target = list(self.pos)
@@ -380,6 +388,7 @@ def check_program(text, arc_tol):
             if m.group(2) is not None:
                 unsigned(m.group(2), where, problems, "spindle speed")
             mach.tool = int(m.group(1))
+            mach.up_first = where
             mach.spindle = False
             mach.feed = None
             mach.pos = [None, None, None]

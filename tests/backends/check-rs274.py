@@ -18,6 +18,9 @@ one, within 0.001 mm:
     program, in order; its end point is the block's X Y, and the Bézier its
     I J P Q give must stay within the target's 0.01 mm of the IR's line
     (the line is a chord of the curve the spline follows).
+The first motion of the program and the first after each tool change
+must move Z alone (up to the clearance height): where the tool is then is
+the machine's business, so X and Y only move once it is up.
 Moves that go nowhere are left out on both sides. With canned cycles on,
 the cycles' own rapids are the controller's: only the feed moves must match
 (--cycles); with --no-cycles everything must.
@@ -89,6 +92,33 @@ def canon_moves(path, program):
                 out.append(move)
             at = out[-1]["to"]
     return out
+
+
+MOTION_RE = re.compile(r"(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED|NURBS_FEED)\(([^)]*)\)")
+
+
+def clearance_problems(path):
+    """Each first motion, of the program or after a CHANGE_TOOL, that moves X or Y."""
+    problems = []
+    at = (0.0, 0.0)
+    first = "the program start"
+    with open(path) as f:
+        for n, line in enumerate(f, 1):
+            if "CHANGE_TOOL(" in line:
+                first = "the tool change at canon line %d" % n
+                continue
+            m = MOTION_RE.search(line)
+            if not m:
+                continue
+            args = [a.strip() for a in m.group(2).split(",")]
+            to = (float(args[0]), float(args[1])) if m.group(1) != "NURBS_FEED" else None
+            if first and (to is None or abs(to[0] - at[0]) > TOL or abs(to[1] - at[1]) > TOL):
+                problems.append("canon line %d: the first motion after %s moves X or Y, not Z alone up to the "
+                                "clearance height: %s" % (n, first, line.strip()))
+            first = None
+            if to is not None:
+                at = to
+    return problems
 
 
 def bezier_strays(bezier, a, b):
@@ -201,6 +231,7 @@ def check(stepnc, path, cycles, extra, workdir, program=None):
     if r.returncode != 0:
         return ["rs274 rejected the program (exit %d):\n%s%s" % (r.returncode, r.stdout, r.stderr)]
     problems, n = compare(toolpath_ir.read_moves(ir_path), canon_moves(canon_path, ngc_path), cycles, 0.05 + 1e-9)
+    problems += clearance_problems(canon_path)
     if not problems:
         print("ok: %s%s: %d moves match" % (os.path.basename(path), "" if cycles else " (--no-cycles)", n))
     return problems

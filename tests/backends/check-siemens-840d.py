@@ -23,6 +23,9 @@ and reports what would be wrong there:
   * arcs, from the position tracked through the printed numbers: with I/J the
     radius at the start and at the end agree within 0.001 mm (whole circles
     too); with CR= the radius reaches across the chord; TURN= only with I/J;
+  * the first move of the program, and the first after each tool change,
+    is Z alone (up to the clearance height): where the tool is then is the
+    machine's business, so X and Y only move once it is up;
   * modal cycles: `MCALL CYCLE..` then position blocks (X/Y only, from above
     the reference plane) then a bare `MCALL`, nothing else in between;
   * cubic splines: `CSPLINE BAUTO EAUTO` (no end condition taken from the
@@ -243,6 +246,9 @@ class Checker:
         # included), radius; `line` is where it was written.
         self.made = []
         self.lacking = set()
+        # Where the first move is due to go up along Z alone: the program's
+        # start, or the line of the tool change (M6).
+        self.up_first = "the program start"
 
     def problem(self, n, text):
         self.problems.append("%s:%d: %s" % (self.name, n, text))
@@ -446,6 +452,7 @@ class Checker:
             # until written again, and the spindle is stopped.
             self.pos = {"X": None, "Y": None, "Z": None}
             self.spindle_on = False
+            self.up_first = "the tool change on line %d" % n
         elif m == 30:
             if self.mcall is not None:
                 self.problem(n, "M30 while MCALL %s is active" % self.mcall["cycle"])
@@ -479,6 +486,11 @@ class Checker:
             self.problem(n, "axis words with no motion G code (G0 G1 G2 G3)")
             return
         self.counts["moves"] += 1
+        if self.up_first:
+            if self.motion != 0 or any(a in seen for a in ("X", "Y", "I", "J", "CR", "TURN")):
+                self.problem(n, "the first move after %s is not G0 with Z alone (up to the clearance height "
+                                "before X and Y move)" % self.up_first)
+            self.up_first = None
         if self.mcall is not None:
             self.cycle_position(n, seen)
             return

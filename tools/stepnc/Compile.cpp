@@ -61,6 +61,8 @@ std::string optionsText(const CompileOptions &opts) {
     add("--tool-table " + opts.toolTable);
   if (opts.noCycles)
     add("--no-cycles");
+  if (opts.allowOutOfRange)
+    add("--allow-out-of-range");
   if (opts.tolerance)
     add("--tolerance " + formatShortest(*opts.tolerance));
   for (const std::string &o : opts.targetOptions)
@@ -167,6 +169,7 @@ int compileSource(const CompileOptions &opts, const std::string &emit, std::uniq
   toolpath.compensateDeflection = !opts.noCompensateDeflection;
   toolpath.cuttingData = opts.cuttingData;
   toolpath.allowFeedIncrease = opts.allowFeedIncrease;
+  toolpath.allowOutOfRange = opts.allowOutOfRange;
   std::string pipelineText =
       emit != "feature-ir" && opts.passes.empty() ? driver::toolpathPipeline(toolpath) : opts.passes;
   if (opts.passes.empty() && needsMotion)
@@ -302,9 +305,11 @@ void registerCompile(CLI::App &app, std::function<void(int)> setResult) {
   auto opts = std::make_shared<CompileOptions>();
   CLI::App *cmd = app.add_subcommand(
       "compile", "Compile a STEP-NC file: read it, check it against its schema, lower it to the\n"
-                 "process IR, run resolve-feeds, expand-strategies and verify-toolpaths, and write\n"
-                 "a controller program for --target (or stop early with --emit). Without --target\n"
-                 "the feature IR is written. Nothing is written when the input has errors.");
+                 "process IR, run resolve-feeds, expand-strategies, check-limits (speeds, feeds and\n"
+                 "chip loads within the machine's and the tool's range), adapt-feed,\n"
+                 "compensate-deflection and verify-toolpaths, and write a controller program for\n"
+                 "--target (or stop early with --emit). Without --target the feature IR is written.\n"
+                 "Nothing is written when the input has errors.");
   cmd->add_option("input", opts->input, "STEP-NC file (Part 21)");
   cmd->add_option("--target", opts->target, "Controller to write for: siemens-840d, heidenhain-tnc, rs274, "
                                             "native (--list-targets)");
@@ -326,11 +331,16 @@ void registerCompile(CLI::App &app, std::function<void(int)> setResult) {
                 "(docs/deflection-compensation.md)");
   cmd->add_option("--cutting-data", opts->cuttingData,
                   "Cutting data (materials, tool overhangs) on top of the shipped data (docs/cutting-data.md)");
+  cmd->add_flag("--allow-out-of-range", opts->allowOutOfRange,
+                "Write spindle speeds, feeds and extents outside the machine's range (with --machine)\n"
+                "or plausibility, and chip loads beyond the tool's, with a warning each instead of\n"
+                "refusing them (check-limits, docs/diagnostics.md)");
   cmd->add_flag("--allow-feed-increase", opts->allowFeedIncrease,
                 "Let feed adaptation raise feeds above the programmed ones where the cut allows");
   cmd->add_option("--tool-table", opts->toolTable,
-                  "Tool numbers and lengths by STEP-NC tool id (docs/tool-table.md); without one,\n"
-                  "tools are numbered in order of first use");
+                  "Tool numbers and lengths by STEP-NC tool id, or LinuxCNC's tool.tbl, whose\n"
+                  "numbers and diameters the program's tools are checked against (docs/tool-table.md);\n"
+                  "without one, tools are numbered in order of first use");
   cmd->add_flag("--no-cycles", opts->noCycles, "Write hole making as moves, not as the controller's canned cycles");
   cmd->add_option("--tolerance", opts->tolerance, "Contour tolerance for the controller's path mode, mm");
   cmd->add_option("--target-opt", opts->targetOptions,

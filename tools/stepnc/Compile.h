@@ -30,6 +30,7 @@ struct CompileOptions {
   bool noCompensateDeflection = false;
   std::string cuttingData;
   bool allowFeedIncrease = false;
+  bool allowOutOfRange = false;
   // opt only
   std::string passes;
   std::vector<std::string> printAfter;

@@ -39,6 +39,7 @@ struct SimCommandOptions {
   std::optional<double> period;
   std::string workOffset;  ///< "X,Y,Z" mm: the program origin in machine coordinates
   std::string samples;  ///< CSV of every sample
+  bool allowOutOfRange = false;
   std::string output = "-";
   driver::SchemaOptions schema;
   UnitOptions units;
@@ -131,6 +132,7 @@ int runSim(const SimCommandOptions &opts) {
     if (!hasMoves) {
       driver::ToolpathPipelineOptions toolpath;
       toolpath.machine = machineName;
+      toolpath.allowOutOfRange = opts.allowOutOfRange;
       pipeline = driver::toolpathPipeline(toolpath) + ",";
     }
     if (!hasMotion || opts.tolerance)
@@ -232,6 +234,9 @@ void registerSim(CLI::App &app, std::function<void(int)> setResult) {
                   "Where the program's origin is on the machine, X,Y,Z in mm (machine coordinates):\n"
                   "every axis position is then checked against its travel (without it, only that\n"
                   "the program's extent fits the travel)");
+  cmd->add_flag("--allow-out-of-range", opts->allowOutOfRange,
+                "STEP-NC in: play spindle speeds, feeds and extents outside the machine's range with\n"
+                "a warning each (and report them as violations) instead of refusing the file");
   cmd->add_option("--samples", opts->samples, "Write every sample (position, velocity, acceleration, jerk) as CSV");
   cmd->add_option("-o,--output", opts->output, "Report file ('-', the default, for standard output)");
   addSchemaOptions(*cmd, opts->schema);

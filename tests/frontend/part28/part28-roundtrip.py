@@ -66,7 +66,7 @@ def check(args, path, work):
         programs = []
         for source in (path, xml):
             out = stem + (".xml" if source == xml else ".p21") + ".program"
-            r = run([args.stepnc, "compile", source, "--target=" + args.target, "-o", out])
+            r = run([args.stepnc, "compile", source, "--target=" + args.target, "-o", out] + args.option)
             programs.append((r.returncode, out, r.stderr))
         (rc1, out1, err1), (rc2, out2, _) = programs
         if rc1 != rc2:
@@ -87,6 +87,8 @@ def main():
     parser.add_argument("--stepnc", required=True)
     parser.add_argument("--xsd", help="folder of the XSDs `stepnc schema --xsd` wrote")
     parser.add_argument("--target", help="also compile both and compare the programs")
+    parser.add_argument("--option", action="append", default=[],
+                        help="an option for stepnc compile (repeatable), e.g. --option=--allow-out-of-range")
     parser.add_argument("files", nargs="+")
     args = parser.parse_args()
     failed = False

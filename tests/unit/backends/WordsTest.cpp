@@ -160,6 +160,48 @@ TEST_CASE("tool tables: entries by id or symbol, errors at line and column", "[b
   }
 }
 
+TEST_CASE("LinuxCNC tool tables: numbers, diameters, lengths, comments", "[backends]") {
+  auto file = SourceFile::fromString("tool.tbl", "; a comment line first\n"
+                                                 "T1 P1 D10.000 Z+50.000 ;SPOT D10\n"
+                                                 "t2 p5 x0 z-1.5 d8 i0 j0 q0\r\n"
+                                                 "\n"
+                                                 "T12 P12 ;   REAMER D10  \n");
+  DiagnosticCollector collector;
+  DiagnosticEngine diags(collector);
+  auto table = ToolTable::parse(*file, diags);
+  REQUIRE(table);
+  CHECK(table->format() == ToolTable::Format::LinuxCnc);
+  REQUIRE(table->entries().size() == 3);
+  const ToolTable::Entry &t1 = table->entries()[0];
+  CHECK(t1.number == 1);
+  CHECK(*t1.diameter == 10);
+  CHECK(*t1.length == 50);
+  CHECK(t1.key == "SPOT D10");
+  CHECK(t1.loc.offset == 23);
+  CHECK(t1.diameterLoc.offset == 29);
+  CHECK(*table->entries()[1].diameter == 8);
+  CHECK(*table->entries()[1].length == -1.5);
+  CHECK(table->entries()[1].key.empty());
+  CHECK_FALSE(table->entries()[2].diameter);
+  CHECK(table->entries()[2].key == "REAMER D10");
+  // Tools are found by number, and by a comment that is their STEP-NC id.
+  CHECK(table->findNumber(2) == &table->entries()[1]);
+  CHECK(table->findNumber(3) == nullptr);
+  ir::Node reamer(ir::Kind::Tool);
+  reamer.symbol = "%reamer";
+  reamer.label = "REAMER D10";
+  CHECK(table->find(reamer) == &table->entries()[2]);
+
+  for (const char *bad : {"T0 P1\n", "T1 P1 D-3\n", "T1 P1 D\n", "T1 P1 R3\n", "T1 P1\nT1 P2\n", "T1\nP2 D3\n",
+                          "T1 T2\n"}) {
+    DiagnosticCollector badCollector;
+    DiagnosticEngine d(badCollector);
+    auto f = SourceFile::fromString("bad.tbl", bad);
+    CHECK_FALSE(ToolTable::parse(*f, d));
+    CHECK(d.errorCount() == 1);
+  }
+}
+
 namespace {
 
 /// A drilled hole's workingstep with the given moves, in IR text.
@@ -201,7 +243,9 @@ TEST_CASE("hole cycles come from the IR's cycle, never from the moves", "[backen
   REQUIRE(bare);
   REQUIRE(bare->steps.size() == 1);
   CHECK_FALSE(bare->steps[0].cycle);
-  CHECK(bare->steps[0].moves.size() == 4);
+  // The program's first step starts with its clearance move, then the four.
+  CHECK(bare->steps[0].moves.size() == 5);
+  CHECK(bare->steps[0].moves[0].alongZOnly);
 
   // The same moves inside a cycle: what it says, read from its attributes.
   auto drill = holeProgram("drilling", "        cycle type=drill at=(10.0000,10.0000,0.0000)mm clearance=2.0000mm "
@@ -222,8 +266,8 @@ TEST_CASE("hole cycles come from the IR's cycle, never from the moves", "[backen
   CHECK(c.dwell == 0.5);
   CHECK(c.endFeed == 50);
   CHECK(c.endDepth == 2);
-  // The cycle's moves are the step's moves all the same.
-  CHECK(drill->steps[0].moves.size() == 4);
+  // The cycle's moves are the step's moves all the same (after the clearance move).
+  CHECK(drill->steps[0].moves.size() == 5);
 
   auto peck = holeProgram("multistep_drilling",
                           "        cycle type=peck at=(10.0000,10.0000,0.0000)mm clearance=2.0000mm bottom=-12.0000mm "
@@ -243,10 +287,10 @@ TEST_CASE("hole cycles come from the IR's cycle, never from the moves", "[backen
   CHECK(peck->steps[0].cycle->reapproach == 0.5);
   CHECK(peck->steps[0].cycle->dwellStep == 0.2);
   // The dwell is a move of the step, where the tool stands.
-  REQUIRE(peck->steps[0].moves.size() == 8);
-  CHECK(peck->steps[0].moves[3].kind == Move::Kind::Dwell);
-  CHECK(peck->steps[0].moves[3].dwell == 0.2);
-  CHECK(peck->steps[0].moves[3].to == ir::Vec3(10, 10, -5));
+  REQUIRE(peck->steps[0].moves.size() == 9);
+  CHECK(peck->steps[0].moves[4].kind == Move::Kind::Dwell);
+  CHECK(peck->steps[0].moves[4].dwell == 0.2);
+  CHECK(peck->steps[0].moves[4].to == ir::Vec3(10, 10, -5));
 
   // What a target's descriptor lacks to write the cycle.
   TargetDescriptor d;
@@ -260,4 +304,66 @@ TEST_CASE("hole cycles come from the IR's cycle, never from the moves", "[backen
   CHECK(whyNotCycle(d, c) == "its drill cycle has no reduced feeds near the top or bottom");
   d.cycles = {{CycleKind::Drill, {.dwell = true, .reducedFeeds = true}}};
   CHECK(whyNotCycle(d, c).empty());
+}
+
+TEST_CASE("the program and every tool change start up along Z alone", "[backends]") {
+  // Three steps: T1, T1 again, T2; the last one's first rapid goes across
+  // and down at once (to z=5, under its security plane 20).
+  auto parsed = ir::test::parse(
+      "project \"P\"\n"
+      "  workpiece %wp \"WP\"\n"
+      "    round_hole %h \"H\" at=(10.0000,10.0000,0.0000)mm axis=(0.000000,0.000000,1.000000) "
+      "ref=(1.000000,0.000000,0.000000) depth=12.0000mm diameter=8.0000mm bottom=flat\n"
+      "  tool %a \"A\" type=twist_drill diameter=8.0000mm\n"
+      "  tool %b \"B\" type=twist_drill diameter=6.0000mm\n"
+      "  workplan @plan \"PLAN\"\n"
+      "    workingstep @ws1 \"WS1\" feature=%h secplane=20.0000mm\n"
+      "      drilling \"OP\" tool=%a\n"
+      "      moves tool=%a spindle=-1000.0rev/min coolant=off secplane=20.0000mm\n" +
+      drillMoves(8) +
+      "    workingstep @ws2 \"WS2\" feature=%h secplane=20.0000mm\n"
+      "      drilling \"OP\" tool=%a\n"
+      "      moves tool=%a spindle=-1000.0rev/min coolant=off secplane=20.0000mm\n" +
+      drillMoves(8) +
+      "    workingstep @ws3 \"WS3\" feature=%h secplane=20.0000mm\n"
+      "      drilling \"OP\" tool=%b\n"
+      "      moves tool=%b spindle=-1000.0rev/min coolant=off secplane=20.0000mm\n"
+      "        rapid to=(30.0000,10.0000,5.0000)mm role=position\n"
+      "        linear to=(30.0000,10.0000,-12.0000)mm feed=100.0mm/min role=plunge\n"
+      "        rapid to=(30.0000,10.0000,20.0000)mm role=retract\n");
+  REQUIRE(parsed.errors.empty());
+  DiagnosticCollector collector;
+  DiagnosticEngine diags(collector);
+  auto p = buildProgram(*parsed.module, nullptr, diags);
+  REQUIRE(p);
+  REQUIRE(p->steps.size() == 3);
+
+  // The start: up to the security plane, Z alone, then the planned moves.
+  const Step &first = p->steps[0];
+  CHECK(first.toolChange);
+  REQUIRE(first.moves.size() == 5);
+  CHECK(first.moves[0].alongZOnly);
+  CHECK(first.moves[0].role == "clearance");
+  CHECK(first.moves[0].kind == Move::Kind::Rapid);
+  CHECK(first.moves[0].to.z() == 20);
+  CHECK(first.moves[1].to == ir::Vec3(10, 10, 20));
+  CHECK(first.moves[1].from.z() == 20);
+
+  // The same tool again: its moves as planned.
+  CHECK_FALSE(p->steps[1].toolChange);
+  CHECK(p->steps[1].moves.size() == 4);
+  CHECK_FALSE(p->steps[1].moves[0].alongZOnly);
+
+  // A new tool: up, across at the security plane, then down.
+  const Step &third = p->steps[2];
+  CHECK(third.toolChange);
+  REQUIRE(third.moves.size() == 5);
+  CHECK(third.moves[0].alongZOnly);
+  CHECK(third.moves[0].to.z() == 20);
+  CHECK(third.moves[1].kind == Move::Kind::Rapid);
+  CHECK(third.moves[1].to == ir::Vec3(30, 10, 20));
+  CHECK(third.moves[2].kind == Move::Kind::Rapid);
+  CHECK(third.moves[2].from == ir::Vec3(30, 10, 20));
+  CHECK(third.moves[2].to == ir::Vec3(30, 10, 5));
+  CHECK(clearanceHeight(third) == 20);
 }

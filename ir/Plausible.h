@@ -1,0 +1,21 @@
+// What cutting data can be at all, whatever the machine: the bounds beyond
+// which a value read from a file is not what a machine does. Lowering reads
+// a file's speeds in the units that keep its values within them
+// (Lowerer::chooseSpeedUnits) and warns about a value still outside;
+// check-limits refuses a program that asks for one (without a machine to
+// bound it more tightly). One table, so that what lowering takes as
+// plausible check-limits does not refuse.
+#pragma once
+
+namespace stepnc::ir {
+
+inline constexpr double kPlausibleMinFeedMmPerMin = 1;
+inline constexpr double kPlausibleMaxFeedMmPerMin = 100000;
+inline constexpr double kPlausibleMinCuttingSpeedMPerMin = 1;
+inline constexpr double kPlausibleMaxCuttingSpeedMPerMin = 3000;
+inline constexpr double kPlausibleMinSpindleRpm = 1;
+inline constexpr double kPlausibleMaxSpindleRpm = 100000;
+/// Feed per tooth, at most this share of the tool's diameter.
+inline constexpr double kPlausibleChipLoadShare = 0.1;
+
+} // namespace stepnc::ir
