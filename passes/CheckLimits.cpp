@@ -116,10 +116,18 @@ private:
       else if (!machine_ && n > kPlausibleSpindleRpm)
         outOfRange(at, value + " is above " + formatTrimmed(kPlausibleSpindleRpm, 3) +
                            " rev/min, more than any spindle stepnc knows turns (without --machine)");
+      else if (!machine_ && n < ir::kPlausibleMinSpindleRpm - kSlack)
+        outOfRange(at, value + " is below " + formatTrimmed(ir::kPlausibleMinSpindleRpm, 3) +
+                           " rev/min, slower than a spindle turns to cut (the file may use another unit: "
+                           "--spindle-unit)");
     }
     if (auto feed = tech->number("feed"); feed && *feed > 0) {
       const std::string value = subject + ": feed " + formatTrimmed(*feed, 3) + " mm/min";
-      if (machine_) {
+      if (*feed < ir::kPlausibleMinFeedMmPerMin - kSlack) {
+        outOfRange(at, value + " is below " + formatTrimmed(ir::kPlausibleMinFeedMmPerMin, 3) +
+                           " mm/min, slower than any machine is programmed to feed (the file may use another "
+                           "unit: --feed-unit)");
+      } else if (machine_) {
         const double limit = machineFeed();
         if (limit > 0 && *feed > limit + kSlack)
           outOfRange(at, value + " is above the " + formatTrimmed(limit, 3) + " mm/min the machine feeds at most (" +
