@@ -36,10 +36,6 @@ namespace stepnc::passes {
 
 namespace {
 
-using ir::kPlausibleChipLoadShare;
-constexpr double kPlausibleSpindleRpm = ir::kPlausibleMaxSpindleRpm;
-constexpr double kPlausibleFeedMmPerMin = ir::kPlausibleMaxFeedMmPerMin;
-constexpr double kPlausibleCuttingSpeedMPerMin = ir::kPlausibleMaxCuttingSpeedMPerMin;
 /// Room for the printed rounding of values that sit on a limit.
 constexpr double kSlack = 1e-6;
 
@@ -113,8 +109,8 @@ private:
       else if (machine_ && n < machine_->spindleMin - kSlack)
         outOfRange(at, value + " is below the machine's minimum " + formatTrimmed(machine_->spindleMin, 3) +
                            " rev/min (" + machine_->name + ")");
-      else if (!machine_ && n > kPlausibleSpindleRpm)
-        outOfRange(at, value + " is above " + formatTrimmed(kPlausibleSpindleRpm, 3) +
+      else if (!machine_ && n > ir::kPlausibleMaxSpindleRpm)
+        outOfRange(at, value + " is above " + formatTrimmed(ir::kPlausibleMaxSpindleRpm, 3) +
                            " rev/min, more than any spindle stepnc knows turns (without --machine)");
       else if (!machine_ && n < ir::kPlausibleMinSpindleRpm - kSlack)
         outOfRange(at, value + " is below " + formatTrimmed(ir::kPlausibleMinSpindleRpm, 3) +
@@ -133,18 +129,18 @@ private:
           outOfRange(at, value + " is above the " + formatTrimmed(limit, 3) + " mm/min the machine feeds at most (" +
                              machine_->name + ", " + (machine_->maxFeed ? "its controller's max_feed" : "its fastest axis") +
                              ")");
-      } else if (*feed > kPlausibleFeedMmPerMin) {
-        outOfRange(at, value + " is above " + formatTrimmed(kPlausibleFeedMmPerMin, 3) +
+      } else if (*feed > ir::kPlausibleMaxFeedMmPerMin) {
+        outOfRange(at, value + " is above " + formatTrimmed(ir::kPlausibleMaxFeedMmPerMin, 3) +
                            " mm/min, faster than any machine stepnc knows feeds (without --machine)");
       }
     }
-    if (auto vc = tech->number("cutting_speed"); vc && *vc / 1000 > kPlausibleCuttingSpeedMPerMin)
+    if (auto vc = tech->number("cutting_speed"); vc && *vc / 1000 > ir::kPlausibleMaxCuttingSpeedMPerMin)
       outOfRange(at, subject + ": cutting speed " + formatTrimmed(*vc / 1000, 3) + " m/min is above " +
-                         formatTrimmed(kPlausibleCuttingSpeedMPerMin, 3) + " m/min, more than any tool cuts at");
+                         formatTrimmed(ir::kPlausibleMaxCuttingSpeedMPerMin, 3) + " m/min, more than any tool cuts at");
     if (auto fz = tech->number("feed_per_tooth"); fz && diameter > 0 &&
-                                                  *fz > kPlausibleChipLoadShare * diameter + kSlack)
+                                                  *fz > ir::kPlausibleChipLoadShare * diameter + kSlack)
       outOfRange(at, subject + ": feed per tooth " + formatTrimmed(*fz, 4) + " mm is above " +
-                         formatTrimmed(kPlausibleChipLoadShare * diameter, 3) + " mm, a tenth of the tool's diameter " +
+                         formatTrimmed(ir::kPlausibleChipLoadShare * diameter, 3) + " mm, a tenth of the tool's diameter " +
                          formatTrimmed(diameter, 3) + " mm (tool " + tool->symbol + ")");
   }
 
