@@ -26,8 +26,9 @@ void HeightMap::addBlock(const Vec2 &lo, const Vec2 &hi, double top) {
 
 void HeightMap::cutDisc(const Vec2 &c, double r, double z) { cutCapsule(c, c, r, z); }
 
-void HeightMap::cutCapsule(const Vec2 &a, const Vec2 &b, double r, double z) {
-  const float zf = float(z);
+/// Calls f(cell height, cell centre) for every cell whose centre lies in the
+/// area a disc of radius r sweeps from a to b.
+template <class F> void HeightMap::forCapsule(const Vec2 &a, const Vec2 &b, double r, F &&f) const {
   const Vec2 lo = a.cwiseMin(b) - Vec2(r, r), hi = a.cwiseMax(b) + Vec2(r, r);
   const int i0 = std::max(0, int(std::floor((lo.x() - box_.lo.x()) * inv_ - 0.5)));
   const int i1 = std::min(nx_ - 1, int(std::ceil((hi.x() - box_.lo.x()) * inv_ - 0.5)));
@@ -39,16 +40,38 @@ void HeightMap::cutCapsule(const Vec2 &a, const Vec2 &b, double r, double z) {
   for (int j = j0; j <= j1; ++j) {
     const double y = box_.lo.y() + (j + 0.5) * cell_;
     for (int i = i0; i <= i1; ++i) {
-      float &h = h_[size_t(j) * nx_ + i];
-      if (h <= zf)
+      const size_t k = size_t(j) * nx_ + i;
+      if (!f.wants(h_[k]))
         continue;
       const Vec2 p(box_.lo.x() + (i + 0.5) * cell_, y);
       double t = dd > 0 ? (p - a).dot(d) / dd : 0;
       t = std::clamp(t, 0.0, 1.0);
       if ((p - (a + t * d)).squaredNorm() <= r2)
-        h = zf;
+        f(k, p);
     }
   }
+}
+
+void HeightMap::cutCapsule(const Vec2 &a, const Vec2 &b, double r, double z) {
+  struct Cut {
+    HeightMap &map;
+    float z;
+    bool wants(float h) const { return h > z; }
+    void operator()(size_t k, const Vec2 &) const { map.h_[k] = z; }
+  };
+  forCapsule(a, b, r, Cut{*this, float(z)});
+}
+
+HeightMap::Peak HeightMap::highest(const Vec2 &a, const Vec2 &b, double r) const {
+  struct Highest {
+    const HeightMap &map;
+    Peak &peak;
+    bool wants(float h) const { return h > peak.height; }
+    void operator()(size_t k, const Vec2 &p) const { peak = {map.h_[k], p}; }
+  };
+  Peak peak;
+  forCapsule(a, b, r, Highest{*this, peak});
+  return peak;
 }
 
 void HeightMap::cutAlong(const geom::Seg &s, double r, double z0, double z1, double step) {

@@ -45,6 +45,14 @@ public:
     return h_[size_t(j) * nx_ + i];
   }
 
+  /// The highest material within the area a disc of radius r sweeps from a
+  /// to b (cells whose centres lie in it) and where; kAir when none.
+  struct Peak {
+    float height = kAir;
+    Vec2 at = Vec2::Zero();
+  };
+  Peak highest(const Vec2 &a, const Vec2 &b, double r) const;
+
   /// Cuts to height z the disc of radius r about c.
   void cutDisc(const Vec2 &c, double r, double z);
   /// Cuts to height z the area a disc of radius r sweeps from a to b.
@@ -55,6 +63,8 @@ public:
   void cutAlong(const geom::Seg &s, double r, double z0, double z1, double step);
 
 private:
+  template <class F> void forCapsule(const Vec2 &a, const Vec2 &b, double r, F &&f) const;
+
   geom::Box box_;
   double cell_ = 1, inv_ = 1;
   int nx_ = 1, ny_ = 1;

@@ -1,14 +1,13 @@
 // The cutting model of a program (see CuttingModel.h).
 //
-// Stock: one height field per setup, from the workpiece's block raw piece
-// (else a block to the highest feature top over the toolpath's extent),
-// cut by every feed move in program order: a milling move as the disc of
-// its cutter, a hole-making move as the disc of its tool down to where the
-// point reaches full diameter. Each horizontal milling move is measured
+// Stock: the in-process stock of passes/InProcessStock.h, cut by every feed
+// move in program order. Each horizontal milling move is measured
 // before it is cut, at samples along it, each sample on the stock as the
 // move left it up to the sample before: the material in front of a line is
 // never what the line itself removed.
 #include "passes/CuttingModel.h"
+
+#include "passes/InProcessStock.h"
 
 #include "ir/Kinds.h"
 #include "ir/geom/FeatureShape.h"
@@ -29,24 +28,6 @@ using geom::Vec2;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 bool isMill(const std::string &type) { return type.find("mill") != std::string::npos; }
-
-/// The workpiece a setup holds (its first workpiece_setup), else the only
-/// workpiece.
-const ir::Node *setupWorkpiece(const ir::Module &module, const std::string &setup) {
-  if (const ir::Node *s = ir::findResource(module, ir::Kind::Setup, setup))
-    for (const ir::Node *ws : s->childrenOf(ir::Kind::WorkpieceSetup))
-      if (auto w = ws->text("workpiece"))
-        if (const ir::Node *wp = ir::findResource(module, ir::Kind::Workpiece, *w))
-          return wp;
-  const ir::Node *only = nullptr;
-  for (const ir::Node &n : module.root.children)
-    if (n.kind == ir::Kind::Workpiece) {
-      if (only)
-        return nullptr;
-      only = &n;
-    }
-  return only;
-}
 
 /// Samples along a move's plane path: (distance from start, point, direction).
 struct PathPoint {
@@ -202,7 +183,7 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
     }
   out.cell = std::clamp(std::isfinite(smallest) ? smallest / 60 : 0.1, 0.02, 0.25);
 
-  std::map<std::string, cutting::HeightMap> stocks;
+  InProcessStock stocks(module, out.cell);
   std::map<std::string, MaterialChoice> materials;
   std::optional<ir::Vec3> position;
   for (const Pending &p : pending) {
@@ -231,50 +212,9 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
     }
     step.material = mat->second.material;
 
-    auto stock = stocks.find(p.setup);
-    if (stock == stocks.end()) {
-      // The stock's extent: the raw piece and everything this setup's moves
-      // sweep.
-      const ir::Node *wp = setupWorkpiece(module, p.setup);
-      const std::optional<ir::RawBlock> raw = ir::rawBlock(wp);
-      geom::Box box = raw ? raw->box : geom::Box{};
-      double top = raw ? raw->top : -kInf;
-      for (const Pending &q : pending) {
-        if (q.setup != p.setup)
-          continue;
-        double r = 0;
-        if (auto t = out.tools.find(q.moves->text("tool").value_or("")); t != out.tools.end())
-          r = t->second.cutter.radius;
-        for (const ir::Move &m : ir::walkMoves(*q.moves))
-          if (m.isFeed())
-            box.add(geom::Box{m.to.head<2>(), m.to.head<2>()}.grown(r + 1));
-        // No block raw piece: material up to the highest feature top.
-        if (!raw)
-          if (auto f = q.exec->text("feature"))
-            if (const ir::Node *feature = ir::findFeature(module, *f))
-              if (auto shape = ir::featureShape(module, *feature).shape)
-                top = std::max(top, shape->top);
-      }
-      if (box.empty())
-        box = geom::Box{Vec2(0, 0), Vec2(1, 1)};
-      // Keep the grid within about 25 million cells.
-      double cell = out.cell;
-      const Vec2 size = box.hi - box.lo;
-      while (size.x() / cell * size.y() / cell > 25e6)
-        cell *= 1.25;
-      cutting::HeightMap map(box.grown(2 * cell), cell);
-      if (raw) {
-        map.addBlock(raw->box.lo, raw->box.hi, raw->top);
-      } else if (std::isfinite(top)) {
-        map.addBlock(box.lo, box.hi, top);
-        out.notes.push_back("setup " + (p.setup.empty() ? std::string("(none)") : p.setup) +
-                            ": no block raw piece; material assumed up to the highest feature "
-                            "top, z=" +
-                            formatFixed(top, 3) + " mm, over the toolpath's extent");
-      }
-      stock = stocks.emplace(p.setup, std::move(map)).first;
-    }
-    cutting::HeightMap &map = stock->second;
+    const size_t notesBefore = stocks.notes().size();
+    cutting::HeightMap &map = stocks.of(p.setup);
+    out.notes.insert(out.notes.end(), stocks.notes().begin() + long(notesBefore), stocks.notes().end());
 
     const CutterSetup *tool = step.tool;
     const double radius = tool ? tool->cutter.radius : 0;
@@ -340,26 +280,11 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
           cm.samples.push_back(std::move(s));
         }
       }
-      // Cut the move into the stock.
-      const double cutStep = std::max(map.cell(), 0.05);
-      if (segs.empty()) {
-        map.cutDisc(m.to.head<2>(), radius, std::min(m.from->z(), m.to.z()) + point);
-        continue;
-      }
-      double zAt = m.from->z(), total = 0, run = 0;
-      for (const geom::Seg &seg : segs)
-        total += seg.length();
-      for (const geom::Seg &seg : segs) {
-        const double z0 = zAt;
-        run += seg.length();
-        zAt = m.from->z() + (m.to.z() - m.from->z()) * std::min(1.0, run / std::max(total, 1e-12));
-        map.cutAlong(seg, radius, z0 + point, zAt + point, cutStep);
-      }
+      InProcessStock::cut(map, m, radius, point);
     }
     out.steps.push_back(std::move(step));
   }
-  for (auto &[setup, map] : stocks)
-    out.finished.emplace(setup, std::move(map));
+  out.finished = stocks.take();
   return out;
 }
 

@@ -32,6 +32,7 @@
 #include "ir/Program.h"
 #include "ir/geom/FeatureShape.h"
 #include "ir/geom/MoveWalk.h"
+#include "passes/InProcessStock.h"
 #include "support/Format.h"
 
 #include <algorithm>
@@ -48,6 +49,7 @@ namespace {
 using geom::Region;
 using geom::Seg;
 using geom::Vec2;
+using ir::Vec3;
 
 constexpr double kDefaultTolerance = 0.01;  ///< mm, when neither the option nor the workpiece gives one
 constexpr double kLevelEps = 1e-6;          ///< heights closer than this are one depth level
@@ -282,12 +284,41 @@ public:
     for (const ir::Node &n : module_.root.children)
       if (n.kind == ir::Kind::Tool)
         tools_[n.symbol] = &n;
+    walkProgram();
     visit(module_.root);
     checkFeatures();
     return {errorsBefore_ == diags_.errorCount(), changed_};
   }
 
 private:
+  /// What the program order tells about each step: where a step starts that
+  /// goes on from where the one before left the tool below its security
+  /// plane (the file's paths joined, with the same tool), and which rapids
+  /// meet the stock that remains when they run (passes/InProcessStock.h).
+  void walkProgram() {
+    std::optional<Vec3> position;
+    double secplane = 0;
+    std::string lastTool;
+    for (const ir::Node *e : ir::programOrder(module_)) {
+      const ir::Node *moves = e->child(ir::Kind::Moves);
+      if (!moves)
+        continue;
+      const std::string tool = moves->text("tool").value_or("");
+      if (position && tool == lastTool && position->z() < secplane - kLevelEps)
+        starts_[e] = *position;
+      lastTool = tool;
+      secplane = moves->number("secplane").value_or(0);
+      for (const ir::Move &m : ir::walkMoves(*moves, position, ir::PathKind::Predicted))
+        position = m.to;
+    }
+    const double tol = tolerance_.value_or(kDefaultTolerance);
+    walkStock(module_, rapidCheckCell(module_), [&](const StockMove &sm) {
+      if (sm.move->kind == ir::MoveKind::Rapid)
+        if (std::optional<StockHit> hit = rapidMeetsStock(*sm.stock, *sm.move, sm.radius, sm.point, tol))
+          stockHits_.emplace(sm.move->node, std::pair(*hit, *sm.move->from));
+    });
+  }
+
   void visit(ir::Node &n) {
     for (ir::Node &c : n.children) {
       if (c.kind == ir::Kind::Workplan)
@@ -336,7 +367,9 @@ private:
     }
     // Where the tool is predicted to go: moves compensated for its deflection
     // are programmed off the part and reach their `nominal` ends.
-    s.moves = ir::walkMoves(movesNode, std::nullopt, ir::PathKind::Predicted);
+    const auto start = starts_.find(&exec);
+    s.moves = ir::walkMoves(movesNode, start == starts_.end() ? std::nullopt : std::optional(start->second),
+                            ir::PathKind::Predicted);
     s.figures.moves = s.moves.size();
     for (const ir::Move &m : s.moves)
       s.figures.path += m.length();
@@ -398,10 +431,11 @@ private:
           offences.push_back({m.node, "feed move with the spindle stopped (spindle=0 on its moves)"});
           break;
         }
-    // A rapid movement's rapids are the file's own explicit path: where they
-    // leave the rule they are reported as warnings, to be read, not refused.
-    const bool explicitRapids = s.exec->kind == ir::Kind::RapidMovement;
-    std::vector<Offence> rapids;
+    // The rapids of a rapid movement or of the file's explicit toolpaths are
+    // the file's own path: below the security plane they are judged on the
+    // stock alone (expand-strategies lifted those it showed in the way).
+    const bool explicitRapids = s.exec->kind == ir::Kind::RapidMovement ||
+                                (s.op && !s.op->childrenOf(ir::Kind::Toolpath).empty());
     // Bores this step has cut along the tool axis, by position: their lowest point.
     std::vector<std::pair<Vec2, double>> bores;
     for (const ir::Move &m : s.moves) {
@@ -414,16 +448,24 @@ private:
         else
           bore->second = std::min(bore->second, m.to.z());
       }
-      if (m.kind == ir::MoveKind::Rapid && m.from && !rapidSafe(s, m, bores))
-        rapids.push_back({m.node, "rapid from " + pointText(*m.from) + " to " + pointText(m.to) +
-                                      " below the security plane z=" + mm(s.secplane) +
-                                      (s.shape ? " and not along the tool axis above " + s.shape->symbol
-                                               : " and not along the tool axis")});
-    }
-    if (explicitRapids) {
-      report(s, rapids, "explicit rapids below the security plane", /*warning=*/true);
-    } else {
-      offences.insert(offences.end(), rapids.begin(), rapids.end());
+      if (m.kind != ir::MoveKind::Rapid)
+        continue;
+      // Where the step does not know the rapid's start, the program's walk did.
+      const auto hit = stockHits_.find(m.node);
+      const bool safe = !m.from || rapidSafe(s, m, bores);
+      if (!safe && !explicitRapids) {
+        offences.push_back({m.node, "rapid from " + pointText(*m.from) + " to " + pointText(m.to) +
+                                        " below the security plane z=" + mm(s.secplane) +
+                                        (s.shape ? " and not along the tool axis above " + s.shape->symbol
+                                                 : " and not along the tool axis")});
+      } else if (hit != stockHits_.end()) {
+        const StockHit &at = hit->second.first;
+        offences.push_back({m.node, "rapid from " + pointText(hit->second.second) + " to " + pointText(m.to) +
+                                        " meets the stock that remains (up to z=" + mm(at.height) + " at (" +
+                                        formatFixed(at.at.x(), 4) + ", " + formatFixed(at.at.y(), 4) + "))"});
+      } else if (!safe) {
+        ++stats_["explicit rapids below the security plane, clear of the stock"];
+      }
     }
     report(s, offences, "safety errors");
   }
@@ -1026,6 +1068,9 @@ private:
   const unsigned errorsBefore_ = diags_.errorCount();
   bool changed_ = false;
   std::map<std::string, const ir::Node *, std::less<>> tools_;
+  std::map<const ir::Node *, Vec3> starts_;         ///< steps that go on from the step before
+  /// Rapids that meet the stock, by move: where, and where the rapid starts.
+  std::map<const ir::Node *, std::pair<StockHit, Vec3>> stockHits_;
   std::map<std::string, ir::ShapeResult> shapes_;
   std::map<std::string, std::vector<Floor>> floors_;
   RegionCache cache_;

@@ -16,6 +16,7 @@
 #include "ir/Kinds.h"
 #include "ir/Program.h"
 #include "ir/geom/FeatureShape.h"
+#include "ir/geom/MoveWalk.h"
 
 #include <algorithm>
 #include <array>
@@ -160,7 +161,7 @@ public:
   /// (after an error) when a move cannot be written, or (silently) when the
   /// moves are a single positioning.
   std::optional<InstanceId> write(const Node &ws, const Node &moves, const ir::PlaneFrame &frame,
-                                  const std::string &feedReference) {
+                                  const std::string &feedReference, std::optional<Vec3> start) {
     ws_ = &ws;
     frame_ = &frame;
     spindle_ = moves.number("spindle").value_or(0);
@@ -180,13 +181,20 @@ public:
       smooth = smooth || m.flag("smooth").value_or(false);
       if (!at) {
         // The first move takes the tool to the first point of the first
-        // toolpath: lowering makes it again, from wherever the tool is.
-        if (m.kind != ir::Kind::Rapid || role != "position" || to.z() != moves.number("secplane").value_or(0)) {
+        // toolpath: lowering makes it again, from wherever the tool is. A
+        // step that goes on from where the one before left the tool (the
+        // file's paths joined) starts its toolpath there.
+        const bool positions =
+            m.kind == ir::Kind::Rapid && role == "position" && to.z() == moves.number("secplane").value_or(0);
+        if (positions) {
+          at = to;
+          continue;
+        }
+        if (!start) {
           fail(m, "the first move is not a rapid to the security plane");
           return std::nullopt;
         }
-        at = to;
-        continue;
+        at = start;
       }
       const bool rapid = m.kind == ir::Kind::Rapid;
       const double feed = rapid ? 0 : m.number("feed").value_or(0);
@@ -448,6 +456,16 @@ std::string writeOptimisedPart21(const p21::Part21File &input, const ir::Module 
   std::map<InstanceId, const Node *> writtenBy;
   std::vector<const Node *> steps;
   workingsteps(module.root, steps);
+  // Where each executable starts: where the one before it left the tool.
+  std::map<const Node *, Vec3> starts;
+  std::optional<Vec3> position;
+  for (const Node *e : ir::programOrder(module))
+    if (const Node *moves = e->child(ir::Kind::Moves)) {
+      if (position)
+        starts[e] = *position;
+      for (const ir::Move &m : ir::walkMoves(*moves, position))
+        position = m.to;
+    }
   for (const Node *ws : steps) {
     const Node *op = ir::operationOf(*ws);
     const Node *feature = ir::findFeature(module, ws->text("feature").value_or(""));
@@ -484,7 +502,9 @@ std::string writeOptimisedPart21(const p21::Part21File &input, const ir::Module 
       continue;
     const Node *tech = op->child(ir::Kind::Technology);
     const std::string reference = tech && tech->text("feed_reference") == "ccp" ? "CCP" : "TCP";
-    if (auto list = writer.write(*ws, moves, *frame.frame, reference))
+    const auto start = starts.find(ws);
+    if (auto list = writer.write(*ws, moves, *frame.frame, reference,
+                                 start == starts.end() ? std::nullopt : std::optional(start->second)))
       patches[op->origin.entityId].emplace_back(0, Instances::ref(*list));
   }
   if (!ok || writer.failed())

@@ -125,12 +125,15 @@ void Expander::attach(Node &ws, Node moves) {
   (*stats)["workingsteps expanded"]++;
   (*stats)["moves"] += static_cast<long long>(moves.children.size());
   lastTool = moves.text("tool").value_or("");
+  lastSpindle = moves.number("spindle").value_or(0);
+  lastCoolant = moves.text("coolant").value_or("off");
   ws.add(std::move(moves));
   result.changed = true;
 }
 
 void Expander::report(const Node &ws, const Node &at, const std::string &message) {
-  diags->error(at.origin.loc, ws.kindName() + " " + ws.symbol + ": " + message).entity(at.origin.entityId);
+  const Node &where = at.origin.loc.valid() ? at : ws;
+  diags->error(where.origin.loc, ws.kindName() + " " + ws.symbol + ": " + message).entity(where.origin.entityId);
   result.ok = false;
 }
 
@@ -169,12 +172,17 @@ public:
     x_.diags = &diags;
     x_.stats = &stats;
     x_.result = {};
+    x_.explicitRuns.clear();
     // Workingsteps in the branches of control flow too: each branch is a
     // program of its own, which a target with control flow writes as such.
     ir::forEachMachiningStep(module, [&](Node &e, const std::string &setup) {
       if (!e.child(ir::Kind::Moves))
         executable(e, setup);
     });
+    if (x_.result.ok) {
+      linkExplicitPaths(x_);
+      settleExplicitRapids(x_);
+    }
     return x_.result;
   }
 

@@ -19,6 +19,7 @@
 #include "passes/Pass.h"
 #include "passes/expand/Emitter.h"
 
+#include <map>
 #include <numbers>
 #include <optional>
 #include <span>
@@ -76,6 +77,28 @@ struct Plan {
 
 /// The state of one run of the pass, and the ways it reports: every family
 /// reads its options and module and reports through it.
+/// What expanding a path the file gives (an operation's explicit toolpaths,
+/// a rapid movement) left on its moves, for linking consecutive paths and
+/// settling their rapids on the in-process stock (linkExplicitPaths,
+/// settleExplicitRapids). Indices are into the executable's `moves`.
+struct ExplicitRun {
+  Node *exec = nullptr;
+  size_t leadIn = 0;                 ///< moves made to reach the path's start
+  bool retract = false;              ///< the last move is the retract made after the path
+  ir::Vec3 start = ir::Vec3::Zero(); ///< the path's first point
+  ir::Vec3 end = ir::Vec3::Zero();   ///< and its last
+  /// The file's own moves that the stock decides: rapids it asks for
+  /// (`connect` false), and lines of `connect` toolpaths that give no speed,
+  /// each with the place of its toolpath in the file (for messages: the
+  /// toolpath node itself may move as the step gets its moves).
+  struct Decided {
+    size_t index;
+    bool connect;
+    ir::Origin toolpath;
+  };
+  std::vector<Decided> decided;
+};
+
 class Expander {
 public:
   double maxEngagement = kDefaultMaxEngagement;   ///< deg
@@ -87,8 +110,13 @@ public:
   DiagnosticEngine *diags = nullptr;
   PassStats *stats = nullptr;
   PassResult result;
-  /// The tool of the last step expanded: a rapid movement keeps it.
+  /// The tool of the last step expanded, its spindle and coolant: a rapid
+  /// movement keeps them.
   std::string lastTool;
+  double lastSpindle = 0;
+  std::string lastCoolant = "off";
+  /// The paths the file gives, by executable.
+  std::map<const Node *, ExplicitRun> explicitRuns;
 
   /// Gives executable `ws` its moves and counts them.
   void attach(Node &ws, Node moves);
@@ -109,6 +137,21 @@ public:
   /// the warning only says so (--strict makes it an error).
   void assumed(const Node &ws, const Node &at, const std::string &message);
 };
+
+/// Joins consecutive paths the file gives (same tool, setup, spindle and
+/// coolant) where one starts where the one before ends: no retract and no
+/// approach between them; over the same point in the plane, straight along
+/// the axis. (Where the next starts elsewhere, the tool retracts to the
+/// security plane and travels, as before.)
+void linkExplicitPaths(Expander &x);
+
+/// Reads the rapids the file's paths ask for below the security plane on
+/// the in-process stock: kept where their path is clear, lifted (up to the
+/// security plane, across, down) with a warning where it is not; a rapid
+/// whose end lies in the stock is an error. Lines of `connect` toolpaths
+/// that give no speed are moved at rapid where their path is clear (as
+/// NIST's ISO 14649 interpreter reads them), at feed where it is not.
+void settleExplicitRapids(Expander &x);
 
 /// An empty `moves` for the executable `exec`, with the state in force.
 Node makeMoves(const Node &exec, const std::string &tool, double spindle, const std::string &coolant,

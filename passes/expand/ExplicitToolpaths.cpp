@@ -5,10 +5,21 @@
 // curves segment by segment. A toolpath typed by what it does gives its
 // moves that role; the speed name `rapid` makes them rapids. Rapid
 // movements (a workingstep of their own) become rapids through their points
-// with the tool of the step before.
+// with the tool, spindle and coolant of the step before.
+//
+// Once every step has its moves, consecutive paths are joined where one
+// starts where the one before ends, and the rapids the file asks for below
+// the security plane are read on the in-process stock (linkExplicitPaths,
+// settleExplicitRapids): the program then runs the file's path as NIST's
+// ISO 14649 interpreter does, wherever that is safe.
 #include "passes/expand/Expand.h"
 
+#include "passes/InProcessStock.h"
+#include "support/Format.h"
+
 #include <algorithm>
+#include <cmath>
+#include <set>
 
 namespace stepnc::passes::expand {
 
@@ -21,6 +32,10 @@ namespace {
 struct ExplicitKind {
   bool rapid = false;
   const char *role = "cut";
+  /// A `connect` toolpath that gives no speed (nor a technology with a
+  /// feed): its lines are moved at rapid where the stock shows them clear
+  /// (settleExplicitRapids).
+  bool connectNoSpeed = false;
 };
 
 ExplicitKind explicitKind(const Node &tp) {
@@ -32,19 +47,23 @@ ExplicitKind explicitKind(const Node &tp) {
   static constexpr Row kRoles[] = {{"non_contact", "position", "position"}, {"approach", "approach", "plunge"},
                                    {"contact", "cut", "cut"},               {"connect", "link", "link"},
                                    {"lift", "retract", "retract"},          {"trajectory_path", "position", "cut"}};
+  // A toolpath with a technology of its own asks for its feed.
+  const bool noSpeed = !tp.has("rapid") && !tp.has("speed_ratio") && !tp.child(ir::Kind::Technology);
   for (const Row &r : kRoles)
     if (type == r.type)
-      return {rapid, rapid ? r.rapidRole : r.feedRole};
+      return {rapid, rapid ? r.rapidRole : r.feedRole, !rapid && noSpeed && type == "connect"};
   // The IR allows only the words above; a new one would cut, at feed.
   return {rapid, rapid ? "position" : "cut"};
 }
 
-/// One piece of an explicit toolpath, mapped from the feature's frame.
+/// One piece of an explicit toolpath, mapped from the feature's frame; the
+/// path's run records where it starts and which moves the stock decides.
 void explicitPiece(const ir::PlaneFrame &f, const ir::CurvePiece &c, const ExplicitKind &kind, double feed,
-                   double clearanceZ, Emitter &e) {
+                   double clearanceZ, Emitter &e, const Node &toolpath, ExplicitRun &run, const Node &moves) {
   const Vec3 from = at(f.map(c.from.head<2>()), f.z + c.from.z());
   const Vec3 to = at(f.map(c.to.head<2>()), f.z + c.to.z());
-  if (!e.positioned() || (e.position() - from).norm() > 1e-6) {
+  const bool first = !e.positioned();
+  if (first || (e.position() - from).norm() > 1e-6) {
     // Reach the start: over it at the security plane, down in free space to
     // the clearance height at most, then at feed. A start at or above the
     // security plane, or of rapids, is reached by rapids alone.
@@ -55,12 +74,19 @@ void explicitPiece(const ir::PlaneFrame &f, const ir::CurvePiece &c, const Expli
       e.linear(from, feed, "plunge");
     }
   }
+  if (first) {
+    run.leadIn = moves.children.size();
+    run.start = from;
+  }
+  const size_t before = moves.children.size();
   if (kind.rapid)
     e.rapid(to, kind.role);
   else if (!c.arc)
     e.linear(to, feed, kind.role);
   else
     e.arc(to, f.map(c.center.head<2>()), c.ccw != f.mirrored(), c.turns, feed, kind.role);
+  if (moves.children.size() > before && (kind.rapid || (kind.connectNoSpeed && !c.arc)))
+    run.decided.push_back({before, !kind.rapid, toolpath.origin});
 }
 
 } // namespace
@@ -70,6 +96,8 @@ bool expandExplicitToolpaths(Expander &x, const Step &step) {
   const ir::PlaneFrame &frame = *step.frame;
   const Plan &p = step.plan;
   Emitter e(step.moves, step.moves.number("secplane").value_or(0));
+  ExplicitRun run;
+  run.exec = const_cast<Node *>(&ws);  // the pass's own module: the step is its to change
   for (const Node *tp : op.childrenOf(ir::Kind::Toolpath)) {
     const Node *tech = tp->child(ir::Kind::Technology);
     const double feed = tech && tech->number("feed") ? *tech->number("feed") : p.feed;
@@ -93,10 +121,15 @@ bool expandExplicitToolpaths(Expander &x, const Step &step) {
         }
       }
       for (const ir::CurvePiece &c : cr.pieces)
-        explicitPiece(frame, c, kind, feed, p.clearanceZ, e);
+        explicitPiece(frame, c, kind, feed, p.clearanceZ, e, *tp, run, step.moves);
     }
   }
+  run.end = e.position();
+  const size_t before = step.moves.children.size();
   e.retract();
+  run.retract = step.moves.children.size() > before;
+  if (e.positioned())
+    x.explicitRuns[&ws] = run;
   return true;
 }
 
@@ -109,8 +142,10 @@ void expandRapidMovement(Expander &x, Node &rm, const std::string &setup) {
         .entity(rm.origin.entityId);
     return;
   }
-  Node moves = makeMoves(rm, x.lastTool, 0, "off", setup);
+  Node moves = makeMoves(rm, x.lastTool, x.lastSpindle, x.lastCoolant, setup);
   Emitter e(moves, rm.number("secplane").value_or(0));
+  ExplicitRun run;
+  run.exec = &rm;
   for (const Node *tp : rm.childrenOf(ir::Kind::Toolpath))
     for (const Node &curve : tp->children)
       if (curve.category() == ir::Category::Curve) {
@@ -120,12 +155,300 @@ void expandRapidMovement(Expander &x, Node &rm, const std::string &setup) {
           return;
         }
         for (const ir::CurvePiece &c : cr.pieces) {
-          if (!e.positioned())
+          if (!e.positioned()) {
             e.travel(c.from.head<2>(), c.from.z());
+            run.leadIn = moves.children.size();
+            run.start = c.from;
+          }
+          const size_t before = moves.children.size();
           e.rapid(c.to);
+          if (moves.children.size() > before)
+            run.decided.push_back({before, false, tp->origin});
         }
       }
+  run.end = e.position();
+  if (e.positioned())
+    x.explicitRuns[&rm] = run;
   x.attach(rm, std::move(moves));
+}
+
+namespace {
+
+constexpr double kSamePoint = 1e-4;  ///< mm: points this close are one (the file's joins)
+constexpr double kStockTolerance = 0.01; ///< mm a rapid may skim the stock's top
+
+Node *movesOf(Node &exec) {
+  for (Node &c : exec.children)
+    if (c.kind == ir::Kind::Moves)
+      return &c;
+  return nullptr;
+}
+
+/// Whether the tool may go on from one path to the next without leaving the
+/// work: the same tool and setup, turning the same way at the same speed,
+/// with the same coolant.
+bool sameState(const Node &a, const Node &b) {
+  return a.text("tool") == b.text("tool") && a.text("setup") == b.text("setup") &&
+         a.number("spindle") == b.number("spindle") && a.text("coolant") == b.text("coolant");
+}
+
+/// Drops the first `n` moves of a run's moves, keeping its indices true.
+void dropLeadIn(ExplicitRun &run, Node &moves) {
+  moves.children.erase(moves.children.begin(), moves.children.begin() + long(run.leadIn));
+  for (ExplicitRun::Decided &d : run.decided)
+    d.index -= run.leadIn;
+}
+
+/// A node that only says where in the file something is, for messages (an
+/// unknown place falls back to the step's).
+Node placeOf(const ir::Origin &origin) {
+  Node n;
+  n.origin = origin;
+  return n;
+}
+
+Node rapidTo(const Vec3 &to, const char *role) {
+  Node m(ir::Kind::Rapid);
+  m.set("to", ir::Value::point(to));
+  m.set("role", ir::Value::word(role));
+  return m;
+}
+
+} // namespace
+
+void linkExplicitPaths(Expander &x) {
+  ExplicitRun *before = nullptr;
+  for (const Node *e : ir::programOrder(*x.module)) {
+    auto it = x.explicitRuns.find(e);
+    ExplicitRun *run = it == x.explicitRuns.end() ? nullptr : &it->second;
+    Node *movesA = before ? movesOf(*before->exec) : nullptr;
+    Node *movesB = run ? movesOf(*run->exec) : nullptr;
+    if (movesA && movesB && sameState(*movesA, *movesB)) {
+      const Vec3 p = before->end, q = run->start;
+      const bool samePoint = (p - q).norm() <= kSamePoint;
+      const bool sameXY = (p.head<2>() - q.head<2>()).norm() <= kSamePoint;
+      if (samePoint || sameXY) {
+        if (before->retract) {
+          movesA->children.pop_back();
+          before->retract = false;
+        }
+        // Straight along the axis over the same point: up at rapid, down at
+        // the feed the approach plunged at (a rapid down is the file's path
+        // the stock decides).
+        std::optional<Node> joint;
+        if (!samePoint) {
+          const Node *plunge = nullptr;
+          for (size_t k = 0; k < run->leadIn; ++k)
+            if (movesB->children[k].kind == ir::Kind::Linear)
+              plunge = &movesB->children[k];
+          if (q.z() < p.z() && plunge) {
+            joint = *plunge;
+            joint->set("to", ir::Value::point(q));
+          } else {
+            joint = rapidTo(q, q.z() > p.z() ? "retract" : "approach");
+          }
+        }
+        dropLeadIn(*run, *movesB);
+        if (joint) {
+          const bool rapidDown = joint->kind == ir::Kind::Rapid && q.z() < p.z();
+          movesB->children.insert(movesB->children.begin(), std::move(*joint));
+          for (ExplicitRun::Decided &d : run->decided)
+            ++d.index;
+          if (rapidDown)
+            run->decided.insert(run->decided.begin(), {0, false, ir::Origin{}});
+        }
+        (*x.stats)["explicit paths joined"]++;
+      }
+    }
+    // Only executables that move break or continue a chain: a message does not.
+    if (e->kind == ir::Kind::DisplayMessage)
+      continue;
+    before = run && movesB ? run : nullptr;
+  }
+}
+
+void settleExplicitRapids(Expander &x) {
+  // The moves the stock decides, by node.
+  struct Pending {
+    ExplicitRun *run;
+    ExplicitRun::Decided decided;
+  };
+  std::map<const Node *, Pending> pending;
+  for (auto &[exec, run] : x.explicitRuns)
+    if (Node *moves = movesOf(*run.exec))
+      for (const ExplicitRun::Decided &d : run.decided)
+        pending.emplace(&moves->children[d.index], Pending{&run, d});
+
+  struct Lift {
+    size_t index;
+    Vec3 from;
+    StockHit hit;
+  };
+  std::set<const Node *> clearConnects;
+  std::map<Node *, std::vector<Lift>> lifts;  // by executable
+  struct ShortApproach {
+    size_t index;
+    double z;      ///< where the rapid stops, above the stock
+    double stock;  ///< the stock's top under the tool there
+  };
+  std::map<const Node *, std::vector<ShortApproach>> shortened;  // by executable
+  struct RaisedCycle {
+    const Node *exec;
+    double z;      ///< the cycle's clearance plane, above the stock
+    double stock;  ///< the stock's top under the tool there
+  };
+  std::map<const Node *, RaisedCycle> raisedCycles;  // by cycle: its first hit
+  walkStock(*x.module, rapidCheckCell(*x.module), [&](const StockMove &sm) {
+    const ir::Move &m = *sm.move;
+    auto it = pending.find(m.node);
+    if (it == pending.end()) {
+      // A rapid made here down the tool's axis whose way the stock blocks
+      // (a feature below the raw piece's top there): it stops the clearance
+      // above the stock and the tool goes on at feed.
+      if (m.kind != ir::MoveKind::Rapid || m.to.z() >= m.from->z() ||
+          (m.to.head<2>() - m.from->head<2>()).norm() > 1e-9)
+        return;
+      if (auto hit = rapidMeetsStock(*sm.stock, m, sm.radius, sm.point, kStockTolerance)) {
+        const double z = std::min(m.from->z(), hit->height + kDefaultClearance);
+        if (m.cycle) {
+          raisedCycles.emplace(m.cycle, RaisedCycle{sm.executable, z, hit->height});
+          return;
+        }
+        const Node *moves = sm.executable->child(ir::Kind::Moves);
+        const size_t index = size_t(m.node - moves->children.data());
+        if (index < moves->children.size() && &moves->children[index] == m.node)
+          shortened[sm.executable].push_back({index, z, hit->height});
+      }
+      return;
+    }
+    const Pending &p = it->second;
+    const double secplane = movesOf(*p.run->exec)->number("secplane").value_or(0);
+    ir::Move asRapid = m;
+    asRapid.kind = ir::MoveKind::Rapid;
+    const std::optional<StockHit> hit = rapidMeetsStock(*sm.stock, asRapid, sm.radius, sm.point, kStockTolerance);
+    if (p.decided.connect) {
+      if (!hit)
+        clearConnects.insert(m.node);
+      return;
+    }
+    if (!hit || std::min(m.from->z(), m.to.z()) >= secplane - kStockTolerance)
+      return;
+    // Lifted: is the way down at the end clear?
+    const cutting::HeightMap::Peak below =
+        sm.stock->highest(m.to.head<2>(), m.to.head<2>(), std::max(0.0, sm.radius - sm.stock->cell()));
+    if (below.height > m.to.z() + sm.point + kStockTolerance) {
+      x.report(*p.run->exec, placeOf(p.decided.toolpath),
+               "its rapid to (" + formatFixed(m.to.x(), 4) + ", " + formatFixed(m.to.y(), 4) + ", " +
+                   formatFixed(m.to.z(), 4) + ") ends in the stock that remains there (up to z=" +
+                   formatFixed(below.height, 4) + " mm): no rapid reaches it safely");
+      return;
+    }
+    lifts[p.run->exec].push_back({size_t(m.node - movesOf(*p.run->exec)->children.data()), *m.from, *hit});
+  });
+
+  for (auto &[exec, run] : x.explicitRuns) {
+    Node *moves = movesOf(*run.exec);
+    if (!moves)
+      continue;
+    const double secplane = moves->number("secplane").value_or(0);
+    std::set<std::pair<const SourceFile *, uint64_t>> toolpathsSaid;
+    for (const ExplicitRun::Decided &d : run.decided) {
+      Node &m = moves->children[d.index];
+      if (!d.connect || !clearConnects.count(&m))
+        continue;
+      Node r = rapidTo(*m.vec("to"), "link");
+      r.origin = m.origin;
+      m = std::move(r);
+      (*x.stats)["connect moves at rapid"]++;
+      if (toolpathsSaid.insert({d.toolpath.loc.file, d.toolpath.loc.offset}).second)
+        x.assumed(*run.exec, placeOf(d.toolpath),
+                  "its connect toolpath gives no speed or feed: moved at rapid where its path is clear of the stock "
+                  "that remains (as NIST's ISO 14649 interpreter moves it), at feed where it is not");
+    }
+    auto lifted = lifts.find(run.exec);
+    if (lifted == lifts.end())
+      continue;
+    // Back to front: each lift replaces one move by up to three.
+    for (auto l = lifted->second.rbegin(); l != lifted->second.rend(); ++l) {
+      const Vec3 to = *moves->children[l->index].vec("to");
+      const double high = std::max({secplane, l->from.z(), to.z()});
+      ir::Origin toolpath;
+      for (const ExplicitRun::Decided &d : run.decided)
+        if (d.index == l->index)
+          toolpath = d.toolpath;
+      const Node where = placeOf(toolpath);
+      x.assumed(*run.exec, where,
+                "its rapid from (" + formatFixed(l->from.x(), 4) + ", " + formatFixed(l->from.y(), 4) + ", " +
+                    formatFixed(l->from.z(), 4) + ") to (" + formatFixed(to.x(), 4) + ", " + formatFixed(to.y(), 4) +
+                    ", " + formatFixed(to.z(), 4) + ") meets the stock that remains (up to z=" +
+                    formatFixed(l->hit.height, 4) + " mm at (" + formatFixed(l->hit.at.x(), 4) + ", " +
+                    formatFixed(l->hit.at.y(), 4) + ")): lifted: up to the security plane z=" + formatFixed(high, 4) +
+                    " mm, across, and down");
+      std::vector<Node> path;
+      if (l->from.z() < high)
+        path.push_back(rapidTo(Vec3(l->from.x(), l->from.y(), high), "retract"));
+      path.push_back(rapidTo(Vec3(to.x(), to.y(), high), "position"));
+      path.push_back(rapidTo(to, "approach"));
+      const auto at = moves->children.begin() + long(l->index);
+      for (Node &n : path)
+        n.origin = at->origin;
+      moves->children.erase(at);
+      moves->children.insert(moves->children.begin() + long(l->index), path.begin(), path.end());
+      (*x.stats)["explicit rapids lifted"]++;
+    }
+  }
+
+  // A canned cycle's clearance plane (its R plane) within the stock: raised
+  // above it, where the cycle's rapids to the plane then end.
+  for (auto &[constCycle, raise] : raisedCycles) {
+    Node &cycle = *const_cast<Node *>(constCycle);  // the pass's own module
+    const double old = cycle.number("clearance").value_or(raise.z);
+    if (raise.z <= old)
+      continue;
+    for (Node &c : cycle.children)
+      if (c.kind == ir::Kind::Rapid)
+        if (const Vec3 to = *c.vec("to"); std::abs(to.z() - old) < 1e-9)
+          c.set("to", ir::Value::point(Vec3(to.x(), to.y(), raise.z)));
+    cycle.set("clearance", ir::Value::length(raise.z));
+    const Vec3 at = *cycle.vec("at");
+    x.warning(*raise.exec, "its cycle at (" + formatFixed(at.x(), 4) + ", " + formatFixed(at.y(), 4) +
+                               ") starts in the stock that remains (up to z=" + formatFixed(raise.stock, 4) +
+                               " mm, above the feature): its clearance plane is raised from z=" + formatFixed(old, 4) +
+                               " to z=" + formatFixed(raise.z, 4) + " mm");
+    (*x.stats)["approaches stopped above the stock"]++;
+  }
+
+  for (auto &[constExec, list] : shortened) {
+    // The pass's own module: the step is its to change.
+    Node &exec = *const_cast<Node *>(constExec);
+    Node &moves = *movesOf(exec);
+    for (auto a = list.rbegin(); a != list.rend(); ++a) {
+      Node &rapid = moves.children[a->index];
+      const Vec3 to = *rapid.vec("to");
+      // The feed the tool goes on at: that of the first move after it that has one.
+      std::optional<double> feed;
+      for (size_t k = a->index + 1; k < moves.children.size() && !feed; ++k)
+        feed = moves.children[k].number("feed");
+      if (!feed) {
+        x.report(exec, "its approach down to z=" + formatFixed(to.z(), 4) + " mm at (" + formatFixed(to.x(), 4) +
+                           ", " + formatFixed(to.y(), 4) + ") meets the stock that remains (up to z=" +
+                           formatFixed(a->stock, 4) + " mm), and no feed follows to go on at");
+        continue;
+      }
+      x.warning(exec, "its approach at (" + formatFixed(to.x(), 4) + ", " + formatFixed(to.y(), 4) +
+                          ") meets the stock that remains (up to z=" + formatFixed(a->stock, 4) +
+                          " mm, above the feature): rapid down to z=" + formatFixed(a->z, 4) +
+                          " mm, then at feed down to z=" + formatFixed(to.z(), 4) + " mm");
+      rapid.set("to", ir::Value::point(Vec3(to.x(), to.y(), a->z)));
+      Node plunge(ir::Kind::Linear);
+      plunge.set("to", ir::Value::point(to));
+      plunge.set("feed", ir::Value::feed(*feed));
+      plunge.set("role", ir::Value::word("plunge"));
+      plunge.origin = rapid.origin;
+      moves.children.insert(moves.children.begin() + long(a->index) + 1, std::move(plunge));
+      (*x.stats)["approaches stopped above the stock"]++;
+    }
+  }
 }
 
 } // namespace stepnc::passes::expand
