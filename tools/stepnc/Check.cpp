@@ -1,9 +1,14 @@
 // `stepnc check FILE...`: reads each file, reports its diagnostics and prints a
 // one-line summary per file (and an entity histogram with --stats). Files are
 // read against their schema as compile reads them (driver::bindOptions):
-// drift whose meaning is clear is a warning, an error with --strict.
+// drift whose meaning is clear is a warning, an error with --strict. A
+// STEP-NC file of a schema stepnc compiles is then lowered to the process IR
+// as compile lowers it, so that the two report the same diagnostics of the
+// file; compile goes on to the toolpaths, whose diagnostics are its own.
 #include "driver/LoadModule.h"
 #include "frontend/binding/Binder.h"
+#include "frontend/express/Builtin.h"
+#include "frontend/lowering/Lowering.h"
 #include "frontend/part21/Part21File.h"
 #include "support/VerifyDiagnostics.h"
 #include "tools/stepnc/CommandLine.h"
@@ -24,6 +29,7 @@ struct CheckOptions {
   bool verify = false;
   driver::SchemaOptions schema;
   DiagnosticOptions diag;
+  UnitOptions units;
 };
 
 void printStats(const p21::Part21File &file) {
@@ -42,18 +48,23 @@ void printStats(const p21::Part21File &file) {
   }
 }
 
-/// Reads and checks one file: Part 21 syntax and references, then the schema.
-/// Returns the schema checked against (null if none).
+/// Reads and checks one file: Part 21 syntax and references, then the schema,
+/// then (a STEP-NC file of a schema stepnc compiles, without errors so far)
+/// its lowering. Returns the schema checked against (null if none).
 const express::Schema *checkFile(const p21::Part21File &file, const driver::SchemaSelection &schemas,
-                                 DiagnosticEngine &diags) {
+                                 const CheckOptions &opts, DiagnosticEngine &diags) {
   if (diags.limitReached())
     return nullptr;
   const express::Model *model = nullptr;
   const express::Schema *schema = schemas.select(file, diags, model);
-  if (schema)
-    binding::bind(file, *model, *schema, diags, driver::bindOptions(diags));  // includes the Part 21 reference check
-  else
+  if (!schema) {
     p21::checkInstances(file, diags);
+    return schema;
+  }
+  // The bind includes the Part 21 reference check.
+  auto bound = binding::bind(file, *model, *schema, diags, driver::bindOptions(diags));
+  if (bound && !diags.hasErrors() && schema == express::builtinSchemaFor(file.schemaNames()))
+    lowering::lowerToFeatureIR(*bound, diags, lowering::LowerOptions{opts.units.conventions()});
   return schema;
 }
 
@@ -77,7 +88,7 @@ int verifyFiles(const CheckOptions &opts) {
     DiagnosticEngine diags(collector);
     diags.setStrict(opts.diag.strict);
     auto file = p21::readPart21(*source, diags);
-    checkFile(*file, schemas, diags);
+    checkFile(*file, schemas, opts, diags);
     if (!verifyDiagnostics(*source, collector.diags, std::cerr) && status == kExitOk)
       status = kExitDiagnostics;
   }
@@ -107,7 +118,7 @@ int runCheckFiles(const CheckOptions &opts) {
       continue;
     }
     auto file = p21::readPart21(*source, diags);
-    const express::Schema *checked = checkFile(*file, schemas, diags);
+    const express::Schema *checked = checkFile(*file, schemas, opts, diags);
     std::string names;
     for (const std::string &s : file->schemaNames())
       names += (names.empty() ? "" : ", ") + s;
@@ -130,7 +141,8 @@ int runCheckFiles(const CheckOptions &opts) {
 void registerCheck(CLI::App &app, std::function<void(int)> setResult) {
   auto opts = std::make_shared<CheckOptions>();
   CLI::App *cmd = app.add_subcommand(
-      "check", "Read STEP-NC files, report their diagnostics and print a summary of each.\n"
+      "check", "Read STEP-NC files, check them against their schema and lower them to the process IR as compile\n"
+               "does (the same diagnostics of the file), report their diagnostics and print a summary of each.\n"
                "Exit status: 0 no errors (warnings allowed), 1 errors found, 2 usage or I/O error.");
   cmd->add_option("files", opts->files, "Part 21 files to check")->required();
   cmd->add_flag("--stats", opts->stats, "Also print a histogram of entity types");
@@ -138,6 +150,7 @@ void registerCheck(CLI::App &app, std::function<void(int)> setResult) {
                 "Check diagnostics against 'expected-error@+1 {{text}}' annotations in the "
                 "files' comments instead of printing them (exit 0 when all match)");
   addSchemaOptions(*cmd, opts->schema);
+  addUnitOptions(*cmd, opts->units);
   addDiagnosticOptions(*cmd, opts->diag);
   addStrictOption(*cmd, opts->diag);
   cmd->callback([opts, setResult] { setResult(runCheckFiles(*opts)); });
