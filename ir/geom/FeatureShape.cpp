@@ -74,7 +74,7 @@ void outlineSlot(FeatureShape &s, const Vec2 &a, const Vec2 &b, double width, co
     return outer(l);
   };
   s.target = outline(a, b, false);
-  s.slot = FeatureShape::SlotPath{a, b, width, end1, end2};
+  s.slot = FeatureShape::SlotPath{a, b, width, end1, end2, {Seg::line(a, b)}};
   if (!united) {
     s.limit = outline(a, b, true);
     return;
@@ -275,6 +275,11 @@ public:
   }
 
   bool slot(const Node &feature, FeatureShape &s) {
+    if (const Node *path = feature.child(ir::Kind::Path); path && !path->children.empty()) {
+      CurveResult cr = curvePieces(path->children.front());
+      if (cr.error.empty() && (cr.pieces.size() > 1 || (cr.pieces.size() == 1 && cr.pieces[0].arc)))
+        return curvedSlot(feature, s, cr.pieces);
+    }
     const auto path = straightPath(feature, s, "course of travel");
     if (!path)
       return false;
@@ -308,6 +313,67 @@ public:
     const double mid = (lo + hi) / 2;
     outlineSlot(s, a + left * mid, b + left * mid, hi - lo, std::string(*feature.text("end_1")),
                 std::string(*feature.text("end_2")));
+    return true;
+  }
+
+  /// A slot along a course of lines and arcs (a general path), its walls
+  /// vertical (a square U profile) `width` apart about the course: the area
+  /// within width / 2 of it, its ends radiused (half discs), flat (cut square
+  /// across the course's end) or open (flat, the width continued into the
+  /// air past the end in the limit).
+  bool curvedSlot(const Node &feature, FeatureShape &s, const std::vector<CurvePiece> &pieces) {
+    const Node *profile = feature.child(ir::Kind::SquareUProfile);
+    if (!profile)
+      return fail("slot " + feature.symbol + " runs along a curved or polyline course: stepnc makes such slots with "
+                  "vertical walls (a square U profile) only");
+    for (const char *end : {"end_1", "end_2"})
+      if (auto w = feature.text(end); w == "woodruff" || w == "loop")
+        return fail("slot " + feature.symbol + ": " + *w + " slot ends are not supported yet");
+    const double width = profile->number("width").value_or(0);
+    if (!(width > geom::kEps))
+      return fail("slot " + feature.symbol + " has no width at its top");
+    std::vector<Seg> course;
+    for (const CurvePiece &c : pieces) {
+      if (c.turns > 0)
+        return fail("slot " + feature.symbol + ": its course of travel turns full circles");
+      const Vec2 a = s.frame.map(c.from.head<2>()), b = s.frame.map(c.to.head<2>());
+      if ((b - a).norm() <= geom::kEps && !c.arc)
+        continue;
+      course.push_back(c.arc ? Seg::arc(a, b, s.frame.map(c.center.head<2>()), c.ccw != s.frame.mirrored())
+                             : Seg::line(a, b));
+    }
+    if (course.empty())
+      return fail("slot " + feature.symbol + ": its course of travel has no length");
+    for (size_t i = 1; i < course.size(); ++i)
+      if ((course[i].a - course[i - 1].b).norm() > 1e-6)
+        return fail("slot " + feature.symbol + ": its course of travel is not one connected path");
+    const std::string end1(*feature.text("end_1")), end2(*feature.text("end_2"));
+    const double half = width / 2;
+    // Past each end, along the course's tangent there: the square cut off a
+    // flat or open end (a little wider than the slot), and the strip an open
+    // end continues into.
+    auto beyond = [&](const Vec2 &p, const Vec2 &out, double length, double across) {
+      const Vec2 n(-out.y() * across, out.x() * across);
+      return outer(geom::polygon({p - n, p - n + out * length, p + n + out * length, p + n}));
+    };
+    const Vec2 start = course.front().a, finish = course.back().b;
+    const Vec2 out1 = -course.front().tangent(0), out2 = course.back().tangent(1);
+    Region target = geom::sweptDisc(course, half);
+    std::vector<Region> caps, strips;
+    for (const auto &[end, p, out] : {std::tuple(end1, start, out1), std::tuple(end2, finish, out2)}) {
+      if (end != "radiused")
+        caps.push_back(beyond(p, out, half * 1.5, half * 1.5));
+      if (end == "open")
+        strips.push_back(beyond(p, out, kOpenReach, half));
+    }
+    for (const Region &cap : caps)
+      target = geom::subtract(target, cap);
+    Region limit = target;
+    for (const Region &strip : strips)
+      limit = geom::unite(limit, strip);
+    s.target = std::move(target);
+    s.limit = std::move(limit);
+    s.slot = FeatureShape::SlotPath{start, finish, width, end1, end2, std::move(course)};
     return true;
   }
 

@@ -80,6 +80,10 @@ struct FeatureShape {
     geom::Vec2 from = geom::Vec2::Zero(), to = geom::Vec2::Zero();
     double width = 0;
     std::string end1, end2;
+    /// The course from `from` to `to`: one line for a straight slot; lines
+    /// and arcs for a slot along a general path (vertical walls only).
+    std::vector<geom::Seg> course;
+    bool straight() const { return course.size() == 1 && !course.front().isArc(); }
   };
   std::optional<SlotPath> slot;
   /// For slots whose walls are not vertical (vee, partial circular and

@@ -239,14 +239,53 @@ std::optional<Path2D> slotCentreline(const ir::FeatureShape::SlotPath &slot, con
       return std::max(0.0, reach - slot.width / 2);
     return reach;
   };
-  const Vec2 along = (slot.to - slot.from).normalized();
-  const double length = (slot.to - slot.from).norm();
   const double in1 = inset(slot.end1), in2 = inset(slot.end2);
-  if (length - in1 - in2 < -1e-9)
+  if (slot.straight()) {
+    const Vec2 along = (slot.to - slot.from).normalized();
+    const double length = (slot.to - slot.from).norm();
+    if (length - in1 - in2 < -1e-9)
+      return std::nullopt;
+    const Vec2 a = slot.from + along * in1;
+    const Vec2 b = slot.from + along * std::max(in1, length - in2);
+    return Path2D{Seg::line(a, b)};
+  }
+  // A course of lines and arcs: cut back along its length until the tool's
+  // edge is `inset` from the end (square across the course there: on an end
+  // arc of radius R the angle asin(inset / R) back), or continued along its
+  // end tangents past open ends.
+  auto back = [](double inset, const Seg &end) {
+    if (inset <= 0 || !end.isArc())
+      return std::max(inset, 0.0);
+    const double r = end.radius();
+    return r * std::asin(std::min(1.0, inset / r));
+  };
+  double length = 0;
+  for (const Seg &sg : slot.course)
+    length += sg.length();
+  const double from = back(in1, slot.course.front()), to = length - back(in2, slot.course.back());
+  if (to - from < -1e-9)
     return std::nullopt;
-  const Vec2 a = slot.from + along * in1;
-  const Vec2 b = slot.from + along * std::max(in1, length - in2);
-  return Path2D{Seg::line(a, b)};
+  Path2D path;
+  if (in1 < 0) {
+    const Vec2 a = slot.course.front().a;
+    path.push_back(Seg::line(a + slot.course.front().tangent(0) * in1, a));
+  }
+  double run = 0;
+  for (const Seg &sg : slot.course) {
+    const double len = sg.length(), lo = std::max(from, run), hi = std::min(to, run + len);
+    if (hi - lo > geom::kEps) {
+      const Vec2 a = sg.at((lo - run) / len), b = sg.at((hi - run) / len);
+      path.push_back(sg.isArc() ? Seg::arc(a, b, sg.c, sg.turn > 0) : Seg::line(a, b));
+    }
+    run += len;
+  }
+  if (in2 < 0) {
+    const Vec2 b = slot.course.back().b;
+    path.push_back(Seg::line(b, b - slot.course.back().tangent(1) * in2));
+  }
+  if (path.empty())
+    return std::nullopt;
+  return path;
 }
 
 std::optional<std::vector<Path2D>> strategyPaths(const std::string &type, bool face, bool unbounded, bool sideOnly,

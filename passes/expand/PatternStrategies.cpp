@@ -292,6 +292,7 @@ bool expandPlunging(Expander &x, const Step &step) {
     auto paths = guidePaths(x, ws, op, guide, s, p, z, pitch, 0, area);
     if (!paths)
       return false;
+    const geom::SegIndex areaEdges = geom::SegIndex::of(area);
     for (Path2D path : *paths) {
       const bool closed = path.size() > 1 && (path.front().a - path.back().b).norm() < 1e-7;
       if (closed && e.positioned())
@@ -306,12 +307,20 @@ bool expandPlunging(Expander &x, const Step &step) {
         e.linear(at(c, z), p.plungeFeed, "plunge");
         ++plunges;
         // Away from the wall just cut, into the hole of the plunge before,
-        // then straight up.
+        // then straight up. Where the guide turns round a corner of the
+        // material, the chord to the plunge before passes closer to it than
+        // the tool may go: there the tool goes straight up.
         Vec2 out = c;
         if (k > 0 && backOff > 0) {
           const Vec2 back = centres[k - 1] - c;
-          out = c + back * std::min(1.0, backOff / back.norm());
-          e.linear(at(out, z), p.feed, "retract");
+          const Vec2 to = c + back * std::min(1.0, backOff / back.norm());
+          auto allowed = [&](const Vec2 &q) {
+            return area.contains(q) || areaEdges.distance(q) <= 1e-6;
+          };
+          if (allowed(to) && allowed((c + to) / 2)) {
+            out = to;
+            e.linear(at(out, z), p.feed, "retract");
+          }
         }
         e.rapid(at(out, k + 1 < centres.size() ? above - corner : secplane), "retract");
       }
