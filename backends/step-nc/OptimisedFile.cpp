@@ -371,14 +371,14 @@ InstanceId largestId(const p21::Part21File &file) {
   return largest;
 }
 
-/// `#id=NAME(p0,p1,...);` with its parameter `index` (0-based, at the top
-/// level of its list) replaced by `value`; empty when the line has no such
-/// parameter (a complex instance, too few parameters).
-std::string withParameter(std::string_view line, size_t index, std::string_view value) {
+/// Where parameter `index` (0-based, at the top level of its list) of
+/// `#id=NAME(p0,p1,...);` lies in the line: [begin, end); none when the line
+/// has no such parameter (a complex instance, too few parameters).
+std::optional<std::pair<size_t, size_t>> parameterSpan(std::string_view line, size_t index) {
   const size_t eq = line.find('=');
   const size_t open = line.find('(');
   if (open == std::string_view::npos || eq == std::string_view::npos || open == eq + 1)
-    return {};
+    return std::nullopt;
   // Top-level parameter boundaries: commas outside nested lists and strings.
   size_t begin = open + 1, current = 0;
   int depth = 0;
@@ -398,16 +398,39 @@ std::string withParameter(std::string_view line, size_t index, std::string_view 
       ++depth;
     } else if ((c == ',' && depth == 0) || (c == ')' && depth == 0)) {
       if (current == index)
-        return std::string(line.substr(0, begin)) + std::string(value) + std::string(line.substr(i));
+        return std::pair(begin, i);
       if (c == ')')
-        return {};
+        return std::nullopt;
       ++current;
       begin = i + 1;
     } else if (c == ')') {
       --depth;
     }
   }
-  return {};
+  return std::nullopt;
+}
+
+/// The line with its parameter `index` replaced by `value`; empty when the
+/// line has no such parameter.
+std::string withParameter(std::string_view line, size_t index, std::string_view value) {
+  const auto span = parameterSpan(line, index);
+  if (!span)
+    return {};
+  return std::string(line.substr(0, span->first)) + std::string(value) + std::string(line.substr(span->second));
+}
+
+/// Whether parameter `index` of the line gives no value: `$`, or a number
+/// that is 0 (what generators write for a feed or speed they leave out).
+bool givesNothing(std::string_view line, size_t index) {
+  const auto span = parameterSpan(line, index);
+  if (!span)
+    return false;
+  const std::string text(line.substr(span->first, span->second - span->first));
+  if (text == "$")
+    return true;
+  char *end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  return end != text.c_str() && *end == '\0' && v == 0;
 }
 
 /// FILE_DESCRIPTION with `lines` first, then the input's own description.
@@ -440,6 +463,76 @@ std::string fileDescription(const p21::Part21File &input, const std::vector<std:
 
 } // namespace
 
+/// A feed or spindle speed the operation's technology leaves out (`$` or 0,
+/// and nothing it follows from: resolve-feeds assumed it from the tool and
+/// the material, and said so), written into it in the file's own
+/// units, so that the optimised file needs no assumption there; an operation
+/// with no technology gets one. A technology shared by operations whose
+/// values differ gets a copy per operation.
+using Patches = std::map<InstanceId, std::vector<std::pair<size_t, std::string>>>;
+void writeResolvedTechnology(const Node &op, const std::map<InstanceId, std::string_view> &lines,
+                             const ir::SourceUnits &units, Instances &out, Patches &patches) {
+  constexpr size_t kItsTechnology = 6;  // machining_operation's 7th attribute
+  const Node *tech = op.child(ir::Kind::Technology);
+  if (!tech || op.origin.entityId == 0)
+    return;
+  const double feed = tech->number("feed").value_or(0), spindle = tech->number("spindle").value_or(0);
+  // The values that read back as the ones used, in the file's units.
+  const std::string feedText = Instances::real(
+      preimage(feed, feed / units.feedToMmPerMin, [&](double v) { return v * units.feedToMmPerMin; }));
+  const std::string spindleText = Instances::real(preimage(
+      spindle, spindle / units.spindleToRevPerMin, [&](double v) { return v * units.spindleToRevPerMin; }));
+  // The technology the file gives: the operation's its_technology.
+  InstanceId id = 0;
+  if (const auto op_ = lines.find(op.origin.entityId); op_ != lines.end())
+    if (const auto span = parameterSpan(op_->second, kItsTechnology)) {
+      const std::string_view ref = op_->second.substr(span->first, span->second - span->first);
+      if (ref.size() > 1 && ref[0] == '#')
+        id = std::strtoull(std::string(ref.substr(1)).c_str(), nullptr, 10);
+    }
+  const auto line = lines.find(id);
+  if (id == 0 || line == lines.end()) {
+    // No technology in the file: one with what was assumed.
+    if (feed <= 0 || spindle == 0)
+      return;
+    const std::string reference = tech->text("feed_reference") == "ccp" ? "CCP" : "TCP";
+    const InstanceId made = out.add("MILLING_TECHNOLOGY", feedText + ",." + reference + ".,$," + spindleText +
+                                                              ",$,.F.,.F.,.F.,$");
+    patches[op.origin.entityId].emplace_back(kItsTechnology, Instances::ref(made));
+    return;
+  }
+  if (line->second.find("=MILLING_TECHNOLOGY(") == std::string_view::npos)
+    return;
+  // MILLING_TECHNOLOGY(feedrate, feedrate_reference, cutspeed, spindle,
+  // feedrate_per_tooth, ...): a feed derived from the feed per tooth, a
+  // spindle speed from the cutting speed, follow from what the file gives.
+  std::vector<std::pair<size_t, std::string>> mine;
+  if (feed > 0 && givesNothing(line->second, 0) && givesNothing(line->second, 4))
+    mine.emplace_back(0, feedText);
+  if (spindle != 0 && givesNothing(line->second, 3) && givesNothing(line->second, 2))
+    mine.emplace_back(3, spindleText);
+  if (mine.empty())
+    return;
+  std::vector<std::pair<size_t, std::string>> &given = patches[id];
+  const bool conflicts = std::any_of(mine.begin(), mine.end(), [&](const auto &m) {
+    return std::any_of(given.begin(), given.end(),
+                       [&](const auto &g) { return g.first == m.first && g.second != m.second; });
+  });
+  if (!conflicts) {
+    for (auto &m : mine)
+      if (std::find(given.begin(), given.end(), m) == given.end())
+        given.push_back(std::move(m));
+    return;
+  }
+  // Shared with an operation that resolved other values: this one's own copy.
+  std::string copy(line->second);
+  for (const auto &[index, value] : mine)
+    copy = withParameter(copy, index, value);
+  const size_t open = copy.find('('), close = copy.rfind(')');
+  const InstanceId made = out.add("MILLING_TECHNOLOGY", copy.substr(open + 1, close - open - 1));
+  patches[op.origin.entityId].emplace_back(kItsTechnology, Instances::ref(made));
+}
+
 std::string writeOptimisedPart21(const p21::Part21File &input, const ir::Module &module,
                                  const OptimisedFileOptions &options, DiagnosticEngine &diags) {
   bool ok = true;
@@ -452,7 +545,7 @@ std::string writeOptimisedPart21(const p21::Part21File &input, const ir::Module 
   // operation gets its toolpath list (its first parameter), a workingstep
   // whose moves travel above its file's security plane (expand-strategies
   // raised it, said so) a plane at that height (its second).
-  std::map<InstanceId, std::vector<std::pair<size_t, std::string>>> patches;
+  Patches patches;
   std::map<InstanceId, const Node *> writtenBy;
   std::vector<const Node *> steps;
   workingsteps(module.root, steps);
@@ -466,6 +559,14 @@ std::string writeOptimisedPart21(const p21::Part21File &input, const ir::Module 
       for (const ir::Move &m : ir::walkMoves(*moves, position))
         position = m.to;
     }
+  // The canonical line of every instance, to read what the file gives.
+  std::map<InstanceId, std::string_view> lines;
+  for (size_t pos = 0, eol; pos < canonical.size(); pos = eol + 1) {
+    eol = canonical.find('\n', pos);
+    const std::string_view line(canonical.data() + pos, eol - pos);
+    if (line.starts_with("#"))
+      lines.emplace(std::stoull(std::string(line.substr(1, line.find('=') - 1))), line);
+  }
   for (const Node *ws : steps) {
     const Node *op = ir::operationOf(*ws);
     const Node *feature = ir::findFeature(module, ws->text("feature").value_or(""));
@@ -494,6 +595,7 @@ std::string writeOptimisedPart21(const p21::Part21File &input, const ir::Module 
       patches[ws->origin.entityId].emplace_back(
           1, Instances::ref(out.add("PLANE", "'security plane (raised)'," +
                                                  Instances::ref(out.placement(Vec3(0, 0, travel))))));
+    writeResolvedTechnology(*op, lines, module.sourceUnits, out, patches);
     // A step that is canned cycles keeps its operation as written: read
     // again, it expands to the same cycles, with the dwells and reduced
     // feeds a cutter-location toolpath cannot carry.
