@@ -297,7 +297,9 @@ void settleExplicitRapids(Expander &x) {
     double z;      ///< the cycle's clearance plane, above the stock
     double stock;  ///< the stock's top under the tool there
   };
-  std::map<const Node *, RaisedCycle> raisedCycles;  // by cycle: its first hit
+  // By cycle, in the order the walk meets them: its first hit.
+  std::vector<std::pair<const Node *, RaisedCycle>> raisedCycles;
+  std::set<const Node *> cyclesMet;
   walkStock(*x.module, rapidCheckCell(*x.module), [&](const StockMove &sm) {
     const ir::Move &m = *sm.move;
     auto it = pending.find(m.node);
@@ -311,7 +313,8 @@ void settleExplicitRapids(Expander &x) {
       if (auto hit = rapidMeetsStock(*sm.stock, m, sm.radius, sm.point, kStockTolerance)) {
         const double z = std::min(m.from->z(), hit->height + kDefaultClearance);
         if (m.cycle) {
-          raisedCycles.emplace(m.cycle, RaisedCycle{sm.executable, z, hit->height});
+          if (cyclesMet.insert(m.cycle).second)
+            raisedCycles.emplace_back(m.cycle, RaisedCycle{sm.executable, z, hit->height});
           return;
         }
         const Node *moves = sm.executable->child(ir::Kind::Moves);
@@ -346,55 +349,103 @@ void settleExplicitRapids(Expander &x) {
     lifts[p.run->exec].push_back({size_t(m.node - movesOf(*p.run->exec)->children.data()), *m.from, *hit});
   });
 
-  for (auto &[exec, run] : x.explicitRuns) {
-    Node *moves = movesOf(*run.exec);
+  // A lifted rapid becomes up to three; a stopped approach gains a plunge:
+  // each executable's edits are made back to front, so that each changes
+  // only what follows it. Executables in program order, so that the
+  // warnings come in the order of the program.
+  auto lift = [&](Node &exec, Node &moves, const ExplicitRun &run, const Lift &l) {
+    const double secplane = moves.number("secplane").value_or(0);
+    const Vec3 to = *moves.children[l.index].vec("to");
+    const double high = std::max({secplane, l.from.z(), to.z()});
+    ir::Origin toolpath;
+    for (const ExplicitRun::Decided &d : run.decided)
+      if (d.index == l.index)
+        toolpath = d.toolpath;
+    x.assumed(exec, placeOf(toolpath),
+              "its rapid from (" + formatFixed(l.from.x(), 4) + ", " + formatFixed(l.from.y(), 4) + ", " +
+                  formatFixed(l.from.z(), 4) + ") to (" + formatFixed(to.x(), 4) + ", " + formatFixed(to.y(), 4) +
+                  ", " + formatFixed(to.z(), 4) + ") meets the stock that remains (up to z=" +
+                  formatFixed(l.hit.height, 4) + " mm at (" + formatFixed(l.hit.at.x(), 4) + ", " +
+                  formatFixed(l.hit.at.y(), 4) + ")): lifted: up to the security plane z=" + formatFixed(high, 4) +
+                  " mm, across, and down");
+    std::vector<Node> path;
+    if (l.from.z() < high)
+      path.push_back(rapidTo(Vec3(l.from.x(), l.from.y(), high), "retract"));
+    path.push_back(rapidTo(Vec3(to.x(), to.y(), high), "position"));
+    path.push_back(rapidTo(to, "approach"));
+    const auto at = moves.children.begin() + long(l.index);
+    for (Node &n : path)
+      n.origin = at->origin;
+    moves.children.erase(at);
+    moves.children.insert(moves.children.begin() + long(l.index), path.begin(), path.end());
+    (*x.stats)["explicit rapids lifted"]++;
+  };
+  auto stopAbove = [&](Node &exec, Node &moves, const ShortApproach &a) {
+    Node &rapid = moves.children[a.index];
+    const Vec3 to = *rapid.vec("to");
+    // The feed the tool goes on at: that of the first move after it that has one.
+    std::optional<double> feed;
+    for (size_t k = a.index + 1; k < moves.children.size() && !feed; ++k)
+      feed = moves.children[k].number("feed");
+    if (!feed) {
+      x.report(exec, "its approach down to z=" + formatFixed(to.z(), 4) + " mm at (" + formatFixed(to.x(), 4) + ", " +
+                         formatFixed(to.y(), 4) + ") meets the stock that remains (up to z=" +
+                         formatFixed(a.stock, 4) + " mm), and no feed follows to go on at");
+      return;
+    }
+    x.warning(exec, "its approach at (" + formatFixed(to.x(), 4) + ", " + formatFixed(to.y(), 4) +
+                        ") meets the stock that remains (up to z=" + formatFixed(a.stock, 4) +
+                        " mm, above the feature): rapid down to z=" + formatFixed(a.z, 4) +
+                        " mm, then at feed down to z=" + formatFixed(to.z(), 4) + " mm");
+    rapid.set("to", ir::Value::point(Vec3(to.x(), to.y(), a.z)));
+    Node plunge(ir::Kind::Linear);
+    plunge.set("to", ir::Value::point(to));
+    plunge.set("feed", ir::Value::feed(*feed));
+    plunge.set("role", ir::Value::word("plunge"));
+    plunge.origin = rapid.origin;
+    moves.children.insert(moves.children.begin() + long(a.index) + 1, std::move(plunge));
+    (*x.stats)["approaches stopped above the stock"]++;
+  };
+  for (const Node *constExec : ir::programOrder(*x.module)) {
+    Node &exec = *const_cast<Node *>(constExec);  // the pass's own module
+    Node *moves = movesOf(exec);
     if (!moves)
       continue;
-    const double secplane = moves->number("secplane").value_or(0);
-    std::set<std::pair<const SourceFile *, uint64_t>> toolpathsSaid;
-    for (const ExplicitRun::Decided &d : run.decided) {
-      Node &m = moves->children[d.index];
-      if (!d.connect || !clearConnects.count(&m))
-        continue;
-      Node r = rapidTo(*m.vec("to"), "link");
-      r.origin = m.origin;
-      m = std::move(r);
-      (*x.stats)["connect moves at rapid"]++;
-      if (toolpathsSaid.insert({d.toolpath.loc.file, d.toolpath.loc.offset}).second)
-        x.assumed(*run.exec, placeOf(d.toolpath),
-                  "its connect toolpath gives no speed or feed: moved at rapid where its path is clear of the stock "
-                  "that remains (as NIST's ISO 14649 interpreter moves it), at feed where it is not");
+    const auto run = x.explicitRuns.find(constExec);
+    if (run != x.explicitRuns.end()) {
+      std::set<std::pair<const SourceFile *, uint64_t>> toolpathsSaid;
+      for (const ExplicitRun::Decided &d : run->second.decided) {
+        Node &m = moves->children[d.index];
+        if (!d.connect || !clearConnects.count(&m))
+          continue;
+        Node r = rapidTo(*m.vec("to"), "link");
+        r.origin = m.origin;
+        m = std::move(r);
+        (*x.stats)["connect moves at rapid"]++;
+        if (toolpathsSaid.insert({d.toolpath.loc.file, d.toolpath.loc.offset}).second)
+          x.assumed(exec, placeOf(d.toolpath),
+                    "its connect toolpath gives no speed or feed: moved at rapid where its path is clear of the "
+                    "stock that remains (as NIST's ISO 14649 interpreter moves it), at feed where it is not");
+      }
     }
-    auto lifted = lifts.find(run.exec);
-    if (lifted == lifts.end())
-      continue;
-    // Back to front: each lift replaces one move by up to three.
-    for (auto l = lifted->second.rbegin(); l != lifted->second.rend(); ++l) {
-      const Vec3 to = *moves->children[l->index].vec("to");
-      const double high = std::max({secplane, l->from.z(), to.z()});
-      ir::Origin toolpath;
-      for (const ExplicitRun::Decided &d : run.decided)
-        if (d.index == l->index)
-          toolpath = d.toolpath;
-      const Node where = placeOf(toolpath);
-      x.assumed(*run.exec, where,
-                "its rapid from (" + formatFixed(l->from.x(), 4) + ", " + formatFixed(l->from.y(), 4) + ", " +
-                    formatFixed(l->from.z(), 4) + ") to (" + formatFixed(to.x(), 4) + ", " + formatFixed(to.y(), 4) +
-                    ", " + formatFixed(to.z(), 4) + ") meets the stock that remains (up to z=" +
-                    formatFixed(l->hit.height, 4) + " mm at (" + formatFixed(l->hit.at.x(), 4) + ", " +
-                    formatFixed(l->hit.at.y(), 4) + ")): lifted: up to the security plane z=" + formatFixed(high, 4) +
-                    " mm, across, and down");
-      std::vector<Node> path;
-      if (l->from.z() < high)
-        path.push_back(rapidTo(Vec3(l->from.x(), l->from.y(), high), "retract"));
-      path.push_back(rapidTo(Vec3(to.x(), to.y(), high), "position"));
-      path.push_back(rapidTo(to, "approach"));
-      const auto at = moves->children.begin() + long(l->index);
-      for (Node &n : path)
-        n.origin = at->origin;
-      moves->children.erase(at);
-      moves->children.insert(moves->children.begin() + long(l->index), path.begin(), path.end());
-      (*x.stats)["explicit rapids lifted"]++;
+    struct Edit {
+      size_t index;
+      const Lift *lift;
+      const ShortApproach *approach;
+    };
+    std::vector<Edit> edits;
+    if (auto l = lifts.find(&exec); l != lifts.end() && run != x.explicitRuns.end())
+      for (const Lift &one : l->second)
+        edits.push_back({one.index, &one, nullptr});
+    if (auto s = shortened.find(constExec); s != shortened.end())
+      for (const ShortApproach &one : s->second)
+        edits.push_back({one.index, nullptr, &one});
+    std::stable_sort(edits.begin(), edits.end(), [](const Edit &a, const Edit &b) { return a.index > b.index; });
+    for (const Edit &e : edits) {
+      if (e.lift)
+        lift(exec, *moves, run->second, *e.lift);
+      else
+        stopAbove(exec, *moves, *e.approach);
     }
   }
 
@@ -416,38 +467,6 @@ void settleExplicitRapids(Expander &x) {
                                " mm, above the feature): its clearance plane is raised from z=" + formatFixed(old, 4) +
                                " to z=" + formatFixed(raise.z, 4) + " mm");
     (*x.stats)["approaches stopped above the stock"]++;
-  }
-
-  for (auto &[constExec, list] : shortened) {
-    // The pass's own module: the step is its to change.
-    Node &exec = *const_cast<Node *>(constExec);
-    Node &moves = *movesOf(exec);
-    for (auto a = list.rbegin(); a != list.rend(); ++a) {
-      Node &rapid = moves.children[a->index];
-      const Vec3 to = *rapid.vec("to");
-      // The feed the tool goes on at: that of the first move after it that has one.
-      std::optional<double> feed;
-      for (size_t k = a->index + 1; k < moves.children.size() && !feed; ++k)
-        feed = moves.children[k].number("feed");
-      if (!feed) {
-        x.report(exec, "its approach down to z=" + formatFixed(to.z(), 4) + " mm at (" + formatFixed(to.x(), 4) +
-                           ", " + formatFixed(to.y(), 4) + ") meets the stock that remains (up to z=" +
-                           formatFixed(a->stock, 4) + " mm), and no feed follows to go on at");
-        continue;
-      }
-      x.warning(exec, "its approach at (" + formatFixed(to.x(), 4) + ", " + formatFixed(to.y(), 4) +
-                          ") meets the stock that remains (up to z=" + formatFixed(a->stock, 4) +
-                          " mm, above the feature): rapid down to z=" + formatFixed(a->z, 4) +
-                          " mm, then at feed down to z=" + formatFixed(to.z(), 4) + " mm");
-      rapid.set("to", ir::Value::point(Vec3(to.x(), to.y(), a->z)));
-      Node plunge(ir::Kind::Linear);
-      plunge.set("to", ir::Value::point(to));
-      plunge.set("feed", ir::Value::feed(*feed));
-      plunge.set("role", ir::Value::word("plunge"));
-      plunge.origin = rapid.origin;
-      moves.children.insert(moves.children.begin() + long(a->index) + 1, std::move(plunge));
-      (*x.stats)["approaches stopped above the stock"]++;
-    }
   }
 }
 
