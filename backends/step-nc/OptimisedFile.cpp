@@ -371,6 +371,9 @@ InstanceId largestId(const p21::Part21File &file) {
   return largest;
 }
 
+/// The id of a canonical instance line `#id=...`.
+InstanceId instanceIdOf(std::string_view line) { return std::stoull(std::string(line.substr(1, line.find('=') - 1))); }
+
 /// Where parameter `index` (0-based, at the top level of its list) of
 /// `#id=NAME(p0,p1,...);` lies in the line: [begin, end); none when the line
 /// has no such parameter (a complex instance, too few parameters).
@@ -565,7 +568,7 @@ std::string writeOptimisedPart21(const p21::Part21File &input, const ir::Module 
     eol = canonical.find('\n', pos);
     const std::string_view line(canonical.data() + pos, eol - pos);
     if (line.starts_with("#"))
-      lines.emplace(std::stoull(std::string(line.substr(1, line.find('=') - 1))), line);
+      lines.emplace(instanceIdOf(line), line);
   }
   for (const Node *ws : steps) {
     const Node *op = ir::operationOf(*ws);
@@ -629,7 +632,7 @@ std::string writeOptimisedPart21(const p21::Part21File &input, const ir::Module 
     } else if (line == "HEADER;" && !hasDescription) {
       patched += "\n" + description;
     } else if (line.starts_with("#")) {
-      const InstanceId id = std::stoull(std::string(line.substr(1, line.find('=') - 1)));
+      const InstanceId id = instanceIdOf(line);
       if (auto it = patches.find(id); it != patches.end()) {
         for (const auto &[index, value] : it->second) {
           patched = withParameter(patched, index, value);

@@ -14,12 +14,25 @@ namespace {
 Vec3 at(const geom::Vec2 &p, double z) { return {p.x(), p.y(), z}; }
 } // namespace
 
+Node Emitter::rapidNode(const Vec3 &to, const char *role) {
+  Node m(ir::Kind::Rapid);
+  m.set("to", Value::point(to));
+  m.set("role", Value::word(role));
+  return m;
+}
+
+Node Emitter::linearNode(const Vec3 &to, double feed, const char *role) {
+  Node m(ir::Kind::Linear);
+  m.set("to", Value::point(to));
+  m.set("feed", Value::feed(feed));
+  m.set("role", Value::word(role));
+  return m;
+}
+
 void Emitter::rapid(const Vec3 &to, const char *role) {
   if (positioned_ && (to - pos_).norm() <= geom::kEps)
     return;
-  Node &m = moves_.add(Node(ir::Kind::Rapid));
-  m.set("to", Value::point(to));
-  m.set("role", Value::word(role));
+  moves_.add(rapidNode(to, role));
   pos_ = to;
   positioned_ = true;
 }
@@ -27,10 +40,7 @@ void Emitter::rapid(const Vec3 &to, const char *role) {
 void Emitter::linear(const Vec3 &to, double feed, const char *role, bool smooth) {
   if ((to - pos_).norm() <= geom::kEps)
     return;
-  Node &m = moves_.add(Node(ir::Kind::Linear));
-  m.set("to", Value::point(to));
-  m.set("feed", Value::feed(feed));
-  m.set("role", Value::word(role));
+  Node &m = moves_.add(linearNode(to, feed, role));
   if (smooth)
     m.set("smooth", Value::boolean(true));
   pos_ = to;

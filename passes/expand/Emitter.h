@@ -23,6 +23,11 @@ public:
   /// The security plane, a height in workpiece coordinates.
   double secplane() const { return secplane_; }
 
+  /// The node of a rapid to `to`, and of a line at feed: what rapid() and
+  /// linear() write, for passes that edit moves already written.
+  static ir::Node rapidNode(const ir::Vec3 &to, const char *role);
+  static ir::Node linearNode(const ir::Vec3 &to, double feed, const char *role);
+
   /// A rapid to `to`; none when the tool is already there.
   void rapid(const ir::Vec3 &to, const char *role = "position");
 

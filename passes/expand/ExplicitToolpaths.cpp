@@ -192,7 +192,7 @@ bool sameState(const Node &a, const Node &b) {
          a.number("spindle") == b.number("spindle") && a.text("coolant") == b.text("coolant");
 }
 
-/// Drops the first `n` moves of a run's moves, keeping its indices true.
+/// Drops the moves a run made to reach its path's start, keeping its indices true.
 void dropLeadIn(ExplicitRun &run, Node &moves) {
   moves.children.erase(moves.children.begin(), moves.children.begin() + long(run.leadIn));
   for (ExplicitRun::Decided &d : run.decided)
@@ -207,13 +207,6 @@ Node placeOf(const ir::Origin &origin) {
   return n;
 }
 
-Node rapidTo(const Vec3 &to, const char *role) {
-  Node m(ir::Kind::Rapid);
-  m.set("to", ir::Value::point(to));
-  m.set("role", ir::Value::word(role));
-  return m;
-}
-
 } // namespace
 
 void linkExplicitPaths(Expander &x) {
@@ -226,8 +219,8 @@ void linkExplicitPaths(Expander &x) {
     if (movesA && movesB && sameState(*movesA, *movesB)) {
       const Vec3 p = before->end, q = run->start;
       const bool samePoint = (p - q).norm() <= kSamePoint;
-      const bool sameXY = (p.head<2>() - q.head<2>()).norm() <= kSamePoint;
-      if (samePoint || sameXY) {
+      // Over the same point in the plane (the same point itself included).
+      if ((p.head<2>() - q.head<2>()).norm() <= kSamePoint) {
         if (before->retract) {
           movesA->children.pop_back();
           before->retract = false;
@@ -245,7 +238,7 @@ void linkExplicitPaths(Expander &x) {
             joint = *plunge;
             joint->set("to", ir::Value::point(q));
           } else {
-            joint = rapidTo(q, q.z() > p.z() ? "retract" : "approach");
+            joint = Emitter::rapidNode(q, q.z() > p.z() ? "retract" : "approach");
           }
         }
         dropLeadIn(*run, *movesB);
@@ -370,9 +363,9 @@ void settleExplicitRapids(Expander &x) {
                   " mm, across, and down");
     std::vector<Node> path;
     if (l.from.z() < high)
-      path.push_back(rapidTo(Vec3(l.from.x(), l.from.y(), high), "retract"));
-    path.push_back(rapidTo(Vec3(to.x(), to.y(), high), "position"));
-    path.push_back(rapidTo(to, "approach"));
+      path.push_back(Emitter::rapidNode(Vec3(l.from.x(), l.from.y(), high), "retract"));
+    path.push_back(Emitter::rapidNode(Vec3(to.x(), to.y(), high), "position"));
+    path.push_back(Emitter::rapidNode(to, "approach"));
     const auto at = moves.children.begin() + long(l.index);
     for (Node &n : path)
       n.origin = at->origin;
@@ -398,10 +391,7 @@ void settleExplicitRapids(Expander &x) {
                         " mm, above the feature): rapid down to z=" + formatFixed(a.z, 4) +
                         " mm, then at feed down to z=" + formatFixed(to.z(), 4) + " mm");
     rapid.set("to", ir::Value::point(Vec3(to.x(), to.y(), a.z)));
-    Node plunge(ir::Kind::Linear);
-    plunge.set("to", ir::Value::point(to));
-    plunge.set("feed", ir::Value::feed(*feed));
-    plunge.set("role", ir::Value::word("plunge"));
+    Node plunge = Emitter::linearNode(to, *feed, "plunge");
     plunge.origin = rapid.origin;
     moves.children.insert(moves.children.begin() + long(a.index) + 1, std::move(plunge));
     (*x.stats)["approaches stopped above the stock"]++;
@@ -418,7 +408,7 @@ void settleExplicitRapids(Expander &x) {
         Node &m = moves->children[d.index];
         if (!d.connect || !clearConnects.count(&m))
           continue;
-        Node r = rapidTo(*m.vec("to"), "link");
+        Node r = Emitter::rapidNode(*m.vec("to"), "link");
         r.origin = m.origin;
         m = std::move(r);
         (*x.stats)["connect moves at rapid"]++;

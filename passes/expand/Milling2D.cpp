@@ -253,11 +253,11 @@ std::optional<Path2D> slotCentreline(const ir::FeatureShape::SlotPath &slot, con
   // edge is `inset` from the end (square across the course there: on an end
   // arc of radius R the angle asin(inset / R) back), or continued along its
   // end tangents past open ends.
-  auto back = [](double inset, const Seg &end) {
-    if (inset <= 0 || !end.isArc())
-      return std::max(inset, 0.0);
+  auto back = [](double by, const Seg &end) {
+    if (by <= 0 || !end.isArc())
+      return std::max(by, 0.0);
     const double r = end.radius();
-    return r * std::asin(std::min(1.0, inset / r));
+    return r * std::asin(std::min(1.0, by / r));
   };
   double length = 0;
   for (const Seg &sg : slot.course)
