@@ -94,7 +94,7 @@ void visitSteps(Node &n, const std::string &setup,
                 const std::function<void(Node &, const std::string &)> &visit) {
   for (Node &c : n.children) {
     if (c.kind == Kind::Workingstep || c.kind == Kind::RapidMovement)
-      visit(c, setup);
+      visit(c, c.text("setup").value_or(setup));  // a step on another face has a setup of its own
     else if (c.kind == Kind::Workplan)
       visitSteps(c, c.text("setup").value_or(setup), visit);
     else if (c.is(Trait::ControlFlow) || c.category() == Category::Branch)

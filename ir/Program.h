@@ -35,8 +35,9 @@ bool hasMachiningSteps(const Module &module);
 /// executables that get moves) under the module's workplans, in the order
 /// written: into nested workplans, and into the bodies and branches of
 /// control flow (then, else, branch, a while's body), each of which is a
-/// program of its own. `setup` is the setup in force: the symbol the nearest
-/// enclosing workplan names. A straight program is visited in program order.
+/// program of its own. `setup` is the setup in force: the step's own (a
+/// feature on another face), else the symbol the nearest enclosing workplan
+/// names. A straight program is visited in program order.
 void forEachMachiningStep(Module &module, const std::function<void(Node &step, const std::string &setup)> &visit);
 
 /// A workingstep's operation (its child of category operation), or null.

@@ -40,6 +40,7 @@ const RefRule kRefRules[] = {
     {Kind::Workingstep, "feature", Category::Feature},
     {Kind::WorkpieceSetup, "workpiece", Kind::Workpiece},
     {Kind::Workplan, "setup", Kind::Setup},
+    {Kind::Workingstep, "setup", Kind::Setup},
     {Kind::Island, "feature", Kind::Boss},
     {Kind::Moves, "tool", Kind::Tool},
     {Kind::Moves, "setup", Kind::Setup},

@@ -3,6 +3,7 @@
 #include "geom/Spline.h"
 #include "support/Format.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -14,6 +15,13 @@ std::vector<std::string> headerLines(const Program &p, const EmitOptions &o, con
   lines.push_back("target " + d.name + (o.optionsText.empty() ? "" : ", options " + o.optionsText));
   lines.push_back("units mm, feeds mm/min, spindle rev/min; coordinates are the workpiece's: set the work "
                   "offset to its origin");
+  if (!p.clampings.empty()) {
+    const auto stops = std::count_if(p.steps.begin(), p.steps.end(), [](const Step &s) { return s.reclamp; });
+    lines.push_back("the program re-clamps the workpiece " + std::to_string(stops) +
+                    " times, stopping for each; one work offset per clamping:");
+    for (const auto &clamping : p.clampings)
+      lines.push_back(clamping.second);
+  }
   if (p.toolsFromTable)
     lines.push_back("tool numbers and lengths from the tool table");
   else
@@ -34,12 +42,25 @@ std::optional<std::string> IsoEmitter::run(const Program &p) {
       continue;
     case Step::Kind::Stop:
     case Step::Kind::OptionalStop:
+      if (s.reclamp)
+        beforeReclamp();
       stop(s.kind == Step::Kind::OptionalStop);
       continue;
     case Step::Kind::Moves:
       break;
     }
     out_.block(comment(s.label));
+    if (s.workOffset > 0) {
+      const std::string w = workOffsetWord(s.workOffset);
+      if (w.empty())
+        diags_.error(s.exec->origin.loc, d_.name + " has no work offset " + std::to_string(s.workOffset) +
+                                             " for workingstep " + s.exec->symbol + "'s setup");
+      else
+        out_.block(w);
+      // Where the axes are in the new offset is not where they were.
+      for (const char *w : {"G", "X", "Y", "Z"})
+        modal_.forget(w);
+    }
     if (s.tool >= 0 && s.tool != tool_) {
       toolChange(p.tools[static_cast<size_t>(s.tool)]);
       tool_ = s.tool;
@@ -102,6 +123,12 @@ std::string IsoEmitter::coolant(const std::string &mode) const {
 std::string IsoEmitter::radiusWord(double signedRadius) const { return word("R", num(signedRadius)); }
 
 void IsoEmitter::stop(bool optional) { out_.block(optional ? "M1" : "M0"); }
+
+void IsoEmitter::beforeReclamp() {
+  out_.block("M5 M9");
+  spindle_ = 0;
+  coolant_ = "off";
+}
 
 std::string IsoEmitter::axes(const Vec3 &to, bool forceXY) {
   std::string words;

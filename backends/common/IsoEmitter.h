@@ -51,6 +51,11 @@ protected:
   virtual bool cycle(const Step &s, const HoleCycle &c) = 0;
   virtual void message(const std::string &text) = 0;
   virtual void stop(bool optional);
+  /// Before a re-clamp stop: the spindle and coolant off.
+  virtual void beforeReclamp();
+  /// The word that selects work offset `n` (1: the program's first); "" and
+  /// an error when the controller has no such offset.
+  virtual std::string workOffsetWord(int n) const = 0;
 
   // --- Shared machinery ------------------------------------------------------------
   void move(const Move &m);

@@ -63,9 +63,15 @@ public:
   std::optional<Program> build() {
     program_.name = module_.root.label.empty() ? module_.root.symbol : module_.root.label;
     program_.toolsFromTable = table_ != nullptr;
-    for (const ir::Node &n : module_.root.children)
+    for (const ir::Node &n : module_.root.children) {
       if (n.kind == ir::Kind::Workpiece && !program_.blank)
         blank(n);
+      if (n.kind == ir::Kind::Setup && n.has("work_offset"))
+        program_.clampings.emplace_back(static_cast<int>(*n.count("work_offset")), n.text("instruction").value_or(""));
+    }
+    reclamps_ = !program_.clampings.empty();
+    if (reclamps_)
+      program_.clampings.insert(program_.clampings.begin(), {1, "work offset 1: the workpiece as clamped first, its top up"});
     for (const ir::Node *e : ir::programOrder(module_))
       executable(*e);
     if (!ok_)
@@ -103,6 +109,8 @@ private:
       Step s;
       s.kind = e.kind == ir::Kind::ProgramStop ? Step::Kind::Stop : Step::Kind::OptionalStop;
       s.exec = &e;
+      s.reclamp = e.flag("reclamp").value_or(false);
+      reclamped_ = reclamped_ || s.reclamp;
       program_.steps.push_back(std::move(s));
       return;
     }
@@ -145,11 +153,23 @@ private:
       mv.turns = m.turns;
       s.moves.push_back(std::move(mv));
     }
+    // A program that re-clamps selects each setup's work offset.
+    if (reclamps_) {
+      const std::string setup = moves->text("setup").value_or("");
+      if (!started_ || setup != lastSetup_) {
+        const ir::Node *node = ir::findResource(module_, ir::Kind::Setup, setup);
+        s.workOffset = node ? static_cast<int>(node->count("work_offset").value_or(1)) : 1;
+      }
+      lastSetup_ = setup;
+    }
     if (!s.moves.empty()) {
       position_ = s.moves.back().to;
-      if (!started_ || s.tool != lastTool_)
+      // After a re-clamp where the tool is over the workpiece is unknown:
+      // the step starts as after a tool change.
+      if (!started_ || s.tool != lastTool_ || reclamped_)
         startClear(s);
       started_ = true;
+      reclamped_ = false;
       lastTool_ = s.tool;
     }
     // A step that is one canned cycle is written as the controller's cycle
@@ -307,6 +327,9 @@ private:
   Vec3 position_ = Vec3::Zero();
   bool started_ = false;  ///< a step with moves was built
   int lastTool_ = -1;     ///< that step's tool
+  bool reclamps_ = false;  ///< the program has setups on other faces (work offsets)
+  bool reclamped_ = false; ///< a re-clamp stop since the last step with moves
+  std::string lastSetup_;  ///< the setup of the last step with moves
   bool ok_ = true;
 };
 

@@ -92,6 +92,12 @@ struct Step {
   /// The first step with moves, or the first after its tool changed in:
   /// its moves start with the clearance move (Move::alongZOnly).
   bool toolChange = false;
+  /// A stop for the operator to re-clamp the workpiece (docs/setups.md):
+  /// the spindle and coolant stop first.
+  bool reclamp = false;
+  /// In a program that re-clamps, the work offset (1: the program's first)
+  /// its first step and the first step after each re-clamp select.
+  int workOffset = 0;
   double spindle = 0;     ///< rev/min, negative clockwise (M3); 0 on a rapid movement: keep
   std::string coolant;    ///< off, flood, mist, through_tool
   double secplane = 0;
@@ -106,6 +112,10 @@ struct Program {
   std::vector<Step> steps;
   /// The block raw piece of the (first) workpiece, workpiece coordinates.
   std::optional<std::pair<Vec3, Vec3>> blank;
+  /// A program that re-clamps the workpiece (docs/setups.md): each setup's
+  /// work offset and what the operator does ("work offset 2: ..."), the
+  /// first clamping's first.
+  std::vector<std::pair<int, std::string>> clampings;
 };
 
 /// How high a step starts when where the tool is cannot be relied on (after

@@ -129,6 +129,15 @@ public:
         continue;
       case Step::Kind::Stop:
       case Step::Kind::OptionalStop:
+        if (s.reclamp) {
+          // The spindle and coolant stop before the operator re-clamps,
+          // whatever the control does at M0.
+          flushM();
+          if (spindleRunning_)
+            mBlock("M5");
+          if (coolantCode_ != "M9")
+            mBlock("M9");
+        }
         stop(s.kind == Step::Kind::OptionalStop);
         continue;
       case Step::Kind::Moves:
@@ -259,6 +268,13 @@ private:
 
   void step(const Program &p, const Step &s) {
     out_.block(trimmed("* - " + commentText(s.label)));
+    if (s.workOffset > 0) {
+      // The setup's datum: a line of the preset table, activated by cycle 247.
+      flushM();
+      out_.block("CYCL DEF 247 DATUM SETTING ~");
+      out_.raw("  Q339=+" + std::to_string(s.workOffset) + " ;DATUM NUMBER");
+      forgetPosition();
+    }
     if (s.taps()) {
       // Plain moves would feed the tap out with the spindle still turning
       // forward: it would break. Cycle 207 is left out until its facts are

@@ -2,6 +2,7 @@
 // wrote) in the native motion format of runtime/NativeFormat.h, for open
 // controllers that play time-parameterised segments themselves.
 #include "backends/Backend.h"
+#include "ir/Program.h"
 #include "ir/motion/MotionIR.h"
 #include "runtime/NativeFormat.h"
 
@@ -23,6 +24,16 @@ public:
 
   std::optional<std::string> emit(const ir::Module &module, const EmitOptions &options,
                                   DiagnosticEngine &diags) override {
+    // A re-clamp is an operator's work between two motions; the native
+    // format carries motion only.
+    for (const ir::Node *e : ir::programOrder(module))
+      if (e->kind == ir::Kind::ProgramStop && e->flag("reclamp").value_or(false)) {
+        diags.error(e->origin.loc, "the program re-clamps the workpiece here, to reach features on another face "
+                                   "(docs/setups.md); the native motion format has no stop for the operator: "
+                                   "write a G-code target")
+            .entity(e->origin.entityId);
+        return std::nullopt;
+      }
     auto trajectory = ir::readMotion(module, diags);
     if (!trajectory)
       return std::nullopt;

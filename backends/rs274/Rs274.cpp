@@ -77,6 +77,15 @@ private:
 
   void message(const std::string &text) override { out_.block(comment("MSG," + text)); }
 
+  /// G54..G59, G59.1..G59.3: the nine coordinate systems of LinuxCNC.
+  std::string workOffsetWord(int n) const override {
+    if (n >= 1 && n <= 6)
+      return "G" + std::to_string(53 + n);
+    if (n >= 7 && n <= 9)
+      return "G59." + std::to_string(n - 6);
+    return "";
+  }
+
   bool cycle(const Step &s, const HoleCycle &c) override {
     // G98: back to the height before the cycle, the security plane.
     std::string words;

@@ -254,6 +254,16 @@ private:
 
   void message(const std::string &text) override { out_.block("MSG(\"" + printable(text, kMaxMessage) + "\")"); }
 
+  /// G54..G57, then the user frames G505..G599 (as many as the machine
+  /// data MD28080 sets up).
+  std::string workOffsetWord(int n) const override {
+    if (n >= 1 && n <= 4)
+      return "G" + std::to_string(53 + n);
+    if (n >= 5 && n <= 99)
+      return "G" + std::to_string(500 + n);
+    return "";
+  }
+
   bool cycle(const Step &s, const HoleCycle &c) override {
     const CycleCall call = cycleCall(*program_, s, c, d_);
     if (call.text.empty())

@@ -575,6 +575,26 @@ std::string writeOptimisedPart21(const p21::Part21File &input, const ir::Module 
     const Node *feature = ir::findFeature(module, ws->text("feature").value_or(""));
     if (!op || !feature || op->origin.entityId == 0)
       continue;
+    const Node &moves = *ws->child(ir::Kind::Moves);
+    // Moves that travel above the file's security plane (expand-strategies
+    // raised it, and said so): that plane, written as the step's.
+    const double travel = moves.number("secplane").value_or(0);
+    // (Not for a step on another face: its plane is the file's, turned, and
+    // read again it is raised again.)
+    if (ws->origin.entityId != 0 && !ws->has("setup") && travel != ws->number("secplane").value_or(travel))
+      patches[ws->origin.entityId].emplace_back(
+          1, Instances::ref(out.add("PLANE", "'security plane (raised)'," +
+                                                 Instances::ref(out.placement(Vec3(0, 0, travel))))));
+    // A step that is canned cycles keeps its operation as written: read
+    // again, it expands to the same cycles, with the dwells and reduced
+    // feeds a cutter-location toolpath cannot carry. Steps that share such
+    // an operation share its technology too.
+    if (!moves.children.empty() && std::all_of(moves.children.begin(), moves.children.end(),
+                                               [](const Node &c) { return c.kind == ir::Kind::Cycle; })) {
+      if (writtenBy.emplace(op->origin.entityId, ws).second)
+        writeResolvedTechnology(*op, lines, module.sourceUnits, out, patches);
+      continue;
+    }
     if (auto [it, fresh] = writtenBy.emplace(op->origin.entityId, ws); !fresh) {
       diags
           .error(ws->origin.loc, "workingstep " + ws->symbol + " shares its operation #" +
@@ -590,21 +610,7 @@ std::string writeOptimisedPart21(const p21::Part21File &input, const ir::Module 
       ok = false;
       continue;
     }
-    // Moves that travel above the file's security plane (expand-strategies
-    // raised it, and said so): that plane, written as the step's.
-    const Node &moves = *ws->child(ir::Kind::Moves);
-    const double travel = moves.number("secplane").value_or(0);
-    if (ws->origin.entityId != 0 && travel != ws->number("secplane").value_or(travel))
-      patches[ws->origin.entityId].emplace_back(
-          1, Instances::ref(out.add("PLANE", "'security plane (raised)'," +
-                                                 Instances::ref(out.placement(Vec3(0, 0, travel))))));
     writeResolvedTechnology(*op, lines, module.sourceUnits, out, patches);
-    // A step that is canned cycles keeps its operation as written: read
-    // again, it expands to the same cycles, with the dwells and reduced
-    // feeds a cutter-location toolpath cannot carry.
-    if (!moves.children.empty() && std::all_of(moves.children.begin(), moves.children.end(),
-                                               [](const Node &c) { return c.kind == ir::Kind::Cycle; }))
-      continue;
     const Node *tech = op->child(ir::Kind::Technology);
     const std::string reference = tech && tech->text("feed_reference") == "ccp" ? "CCP" : "TCP";
     const auto start = starts.find(ws);

@@ -14,7 +14,7 @@ namespace {
 
 // `depth` is a plane in the feature's frame: the feature goes down to it.
 void setDepth(Lowerer &l, Node &n, const Instance &f) {
-  std::optional<double> z = l.planeHeight(f, "depth", "feature depth");
+  std::optional<double> z = l.planeHeight(f, "depth", "feature depth", n.vec("axis"));
   if (!z)
     return;
   if (*z > 1e-9) {
@@ -117,7 +117,12 @@ void Lowerer::placeProfileOnce(const Instance &profileInstance, Node &profile, c
     return q.x() >= raw->min.x() - 1e-6 && q.x() <= raw->max.x() + 1e-6 && q.y() >= raw->min.y() - 1e-6 &&
            q.y() <= raw->max.y() + 1e-6;
   };
-  if (insideXY(composed) || !insideXY(*at))
+  // The feature's own placement written again (its origin and axis) is
+  // the same mistake, whether or not the composed origin leaves the block.
+  const std::optional<Vec3> axis = profile.vec("axis");
+  const bool featureAgain = (*at - frame.at).norm() < 1e-6 && axis && (*axis - frame.axis).norm() < 1e-6;
+  const bool outsideComposed = !insideXY(composed) && insideXY(*at);
+  if (!featureAgain && !outsideComposed)
     return;
   // Read in workpiece coordinates, the profile's placement relative to the feature is:
   const Vec3 relative = r.transpose() * (*at - frame.at);
@@ -126,6 +131,13 @@ void Lowerer::placeProfileOnce(const Instance &profileInstance, Node &profile, c
     profile.set("axis", Value::direction(r.transpose() * *axis));
   if (auto ref = profile.vec("ref"))
     profile.set("ref", Value::direction(r.transpose() * *ref));
+  if (!outsideComposed) {
+    assumed(profileInstance, "placement",
+            "origin " + formatTuple({at->x(), at->y(), at->z()}, 4) + " mm and axis " +
+                formatTuple({axis->x(), axis->y(), axis->z()}, 4) + " are the feature's own placement, in "
+                "workpiece coordinates; read as the feature's frame (ISO 14649 places a profile in it)");
+    return;
+  }
   assumed(profileInstance, "placement",
           "origin " + formatTuple({at->x(), at->y(), at->z()}, 4) +
               " mm, placed in the feature's frame as ISO 14649 has it, lies at " +

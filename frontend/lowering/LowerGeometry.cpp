@@ -120,7 +120,8 @@ void Lowerer::setPlacement(Node &node, const Placement &p) {
   node.set("ref", Value::direction(p.ref));
 }
 
-std::optional<double> Lowerer::planeHeight(const Instance &owner, std::string_view attribute, std::string_view role) {
+std::optional<double> Lowerer::planeHeight(const Instance &owner, std::string_view attribute, std::string_view role,
+                                           const std::optional<Vec3> &featureAxis) {
   Instance plane = owner.ref(attribute);
   if (!plane) {
     missing(owner, attribute);
@@ -144,6 +145,17 @@ std::optional<double> Lowerer::planeHeight(const Instance &owner, std::string_vi
             "(" + formatFixed(p->axis.x(), 4) + ", " + formatFixed(p->axis.y(), 4) + ", " +
                 formatFixed(p->axis.z(), 4) + ") makes " + std::string(role) + " " + hashId(plane.id()) +
                 " vertical; its ref_direction is along z: read with the two swapped, the plane normal to z");
+  } else if (featureAxis && std::abs(featureAxis->z()) < 1 - 1e-9 &&
+             std::abs(std::abs(p->axis.dot(*featureAxis)) - 1.0) < 1e-6) {
+    // A plane in the feature's frame whose normal is written as the
+    // feature's axis in workpiece coordinates (a feature on a side face):
+    // the plane is normal to the feature's axis either way.
+    std::string what = formatTuple({p->axis.x(), p->axis.y(), p->axis.z()}, 4);
+    what += " is the feature's axis in workpiece coordinates; ";
+    what += role;
+    what += " " + hashId(plane.id()) + " read as normal to the feature's axis, " + formatFixed(p->at.z(), 4) +
+            " mm along it in the feature's frame";
+    assumed(plane.ref("position"), "axis", what);
   } else if (std::abs(std::abs(p->axis.z()) - 1.0) > 1e-9) {
     char normal[96];
     std::snprintf(normal, sizeof normal, "(%g, %g, %g)", p->axis.x(), p->axis.y(), p->axis.z());

@@ -101,6 +101,15 @@ Node *Lowerer::findResource(const std::string &symbol) {
   return nullptr;
 }
 
+Node *Lowerer::findFeatureNode(const std::string &symbol) {
+  for (Node &w : module_->root.children)
+    if (w.kind == ir::Kind::Workpiece)
+      for (Node &c : w.children)
+        if (c.symbol == symbol)
+          return &c;
+  return nullptr;
+}
+
 // --- resources ---------------------------------------------------------------
 
 std::optional<std::string> Lowerer::workpiece(const Instance &wp) {
@@ -212,12 +221,16 @@ std::optional<Node> Lowerer::workingstep(const Instance &ws) {
   Node node(ir::Kind::Workingstep);
   stamp(node, ws);
   node.symbol = symbolFor('@', ws.string("its_id"), "ws");
-  if (auto f = feature(ws.ref("its_feature")))
+  const std::optional<std::string> f = feature(ws.ref("its_feature"));
+  if (f)
     node.set("feature", Value::ref(*f));
   else
     missing(ws, "its_feature");
-  if (auto h = planeHeight(ws, "its_secplane", "security plane"))
-    node.set("secplane", Value::length(*h));
+  const Node *featureNode = f ? findFeatureNode(*f) : nullptr;
+  const bool onTop = !featureNode || (featureNode->vec("axis").value_or(Vec3::UnitZ()) - Vec3::UnitZ()).norm() < 1e-9;
+  if (onTop)
+    if (auto h = planeHeight(ws, "its_secplane", "security plane"))
+      node.set("secplane", Value::length(*h));
   if (Instance op = ws.ref("its_operation")) {
     use_ = {op, ws.ref("its_feature")};
     std::optional<Node> lowered = operation(op);
@@ -227,6 +240,8 @@ std::optional<Node> Lowerer::workingstep(const Instance &ws) {
   } else {
     missing(ws, "its_operation");
   }
+  if (!onTop && !placeOnFace(ws, node))
+    return std::nullopt;
   return node;
 }
 
@@ -238,19 +253,28 @@ std::optional<Node> Lowerer::workplan(const Instance &wp) {
   Node node(ir::Kind::Workplan);
   stamp(node, wp);
   node.symbol = symbolFor('@', wp.string("its_id"), "workplan");
+  const Instance outerSetup = setupInForce_;
+  const std::string outerSymbol = setupSymbolInForce_;
   if (Instance s = wp.ref("its_setup"))
-    if (auto sym = setup(s))
+    if (auto sym = setup(s)) {
       node.set("setup", Value::ref(*sym));
+      setupInForce_ = s;
+      setupSymbolInForce_ = *sym;
+    }
   for (const Instance &exe : wp.refs("its_elements"))
     executable(exe, node);
+  setupInForce_ = outerSetup;
+  setupSymbolInForce_ = outerSymbol;
   workplansOnStack_.erase(wp.index());
   return node;
 }
 
 bool Lowerer::executable(const Instance &exe, Node &parent) {
   if (exe.isA("machining_workingstep")) {
-    if (auto ws = workingstep(exe))
+    if (auto ws = workingstep(exe)) {
+      reclampBefore(*ws, parent);
       parent.add(std::move(*ws));
+    }
     return true;
   }
   if (exe.isA("workplan")) {
@@ -269,6 +293,13 @@ bool Lowerer::executable(const Instance &exe, Node &parent) {
     Node n(ir::Kind::RapidMovement);
     stamp(n, exe);
     n.symbol = symbolFor('@', exe.string("its_id"), "rapid");
+    if (const Node *c = clamping_.empty() ? nullptr : findResource(clamping_); c && c->has("face_up")) {
+      diags_.error(exe.loc(), "rapid movement " + hashId(exe.id()) + " follows workingsteps machined with the " +
+                                  "workpiece re-clamped " + *c->text("face_up") + " face up; its toolpath, in " +
+                                  "workpiece coordinates, is not turned with it yet (docs/setups.md)")
+          .entity(exe.id(), std::string(exe.entityName()));
+      return true;
+    }
     if (auto h = planeHeight(exe, "its_secplane", "security plane"))
       n.set("secplane", Value::length(*h));
     if (Instance list = exe.ref("its_toolpath"))

@@ -26,6 +26,19 @@ struct Placement {
   Vec3 ref = Vec3::UnitX();
 };
 
+/// How a 3-axis machine reaches a feature that faces another way than +z
+/// (docs/setups.md): the workpiece is turned so that face is up, a rotation
+/// by multiples of 90 deg, and shifted so that the box around its raw piece
+/// keeps its lowest corner where it was. Workpiece coordinates p become
+/// rotation p + shift.
+struct Turn {
+  std::string face;  ///< the face that is up: "+x", "-x", "+y", "-y", "-z"
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Vec3 shift = Vec3::Zero();
+  Vec3 point(const Vec3 &p) const { return rotation * p + shift; }
+  Vec3 direction(const Vec3 &d) const { return rotation * d; }
+};
+
 /// A raw piece's extent in its workpiece's coordinates: the box around its
 /// BLOCK (exact when the block's axes are the workpiece's), for the values
 /// lowering assumes from it.
@@ -104,8 +117,11 @@ public:
   void setPlacement(Node &node, const Placement &p);
   /// The offset along z of the plane (elementary_surface) that attribute
   /// `attribute` of `owner` refers to: its location's z. Reports an absent or
-  /// unusable plane itself (callers do not report again).
-  std::optional<double> planeHeight(const Instance &owner, std::string_view attribute, std::string_view role);
+  /// unusable plane itself (callers do not report again). A feature's plane
+  /// may give its normal as `featureAxis`, the feature's axis in workpiece
+  /// coordinates (reported).
+  std::optional<double> planeHeight(const Instance &owner, std::string_view attribute, std::string_view role,
+                                    const std::optional<Vec3> &featureAxis = std::nullopt);
   /// A toleranced_length_measure (or a plain length) as mm.
   std::optional<double> toleranced(const Instance &owner, std::string_view attribute);
   /// A profile (closed or open) as a profile node; null node kind on failure.
@@ -145,6 +161,20 @@ public:
   /// The feature's symbol, lowering it under its workpiece the first time.
   std::optional<std::string> feature(const Instance &feature);
 
+  // --- features on other faces (LowerClampings.cpp) -------------------------
+  /// The turn that brings a feature whose axis is `axis` (workpiece
+  /// coordinates, not +z) up on a 3-axis machine: nullopt when the axis is
+  /// along no face of a box (that needs an indexed 5-axis machine).
+  static std::optional<Turn> turnFor(const Vec3 &axis, const std::optional<RawExtent> &raw);
+  /// Workingstep `ws` (lowered into `step`) machines a feature facing
+  /// another way than +z: the step gets the feature, its workpiece and a
+  /// setup turned that face up, its security plane read in that setup, its
+  /// explicit toolpaths turned with it. False after an error.
+  bool placeOnFace(const Instance &ws, Node &step);
+  /// The stop, with a message to the operator, before `step` when it is
+  /// machined in another clamping than the step before it.
+  void reclampBefore(const Node &step, Node &parent);
+
   // --- operations (LowerOperations.cpp) --------------------------------------
   std::optional<Node> operation(const Instance &op);
   std::optional<std::string> tool(const Instance &tool);
@@ -168,6 +198,16 @@ private:
   std::optional<Node> workingstep(const Instance &ws);
   std::optional<Node> workplan(const Instance &wp);
   Node *findResource(const std::string &symbol);
+  /// A feature node by symbol, in any workpiece.
+  Node *findFeatureNode(const std::string &symbol);
+  /// The copies placeOnFace makes, each once per face (LowerClampings.cpp).
+  std::string turnedWorkpiece(const std::string &workpiece, const Turn &turn);
+  std::string turnedFeature(const std::string &feature, const Turn &turn, const std::string &workpiece);
+  std::string turnedSetup(const std::string &workpiece, const Turn &turn, const std::optional<RawExtent> &raw,
+                          const Instance &stepInstance);
+  /// The security plane of `owner` (attribute its_secplane) as a height in
+  /// the turned setup; reports what it assumes.
+  std::optional<double> turnedSecplane(const Instance &owner, const Turn &turn, const std::optional<RawExtent> &raw);
   /// Decides how the file's angles are read (options_.units.angles), from
   /// the instances that have angles.
   void chooseAngleUnit(const std::vector<Instance> &withAngles);
@@ -183,6 +223,13 @@ private:
   std::map<size_t, std::string> lowered_;  ///< instance index -> symbol of its resource node
   std::set<size_t> reported_;              ///< instances already reported unsupported
   std::set<size_t> workplansOnStack_;      ///< cycle guard for nested workplans
+  /// The file's setup in force (the nearest enclosing workplan's), and the
+  /// setup the last machined step was in (reclampBefore).
+  Instance setupInForce_;
+  std::string setupSymbolInForce_, clamping_;
+  std::map<std::string, std::string> turned_;  ///< symbol + " " + face -> the turned copy's symbol
+  std::set<std::pair<size_t, std::string>> secplanesAssumed_;  ///< (plane, face) reported once
+  int64_t workOffsets_ = 1;                  ///< work offsets used: the file's own is 1
   std::vector<Instance> projectWorkpieces_;  ///< the project's its_workpieces
   double angleToDeg_ = 1.0;                  ///< plane_angle_measure to deg
   bool swapAxisAndRef_ = false;              ///< choosePlacementReading

@@ -175,10 +175,13 @@ public:
     x_.explicitRuns.clear();
     // Workingsteps in the branches of control flow too: each branch is a
     // program of its own, which a target with control flow writes as such.
+    leftOut_.clear();
     ir::forEachMachiningStep(module, [&](Node &e, const std::string &setup) {
       if (!e.child(ir::Kind::Moves))
         executable(e, setup);
     });
+    if (!leftOut_.empty())
+      leaveOut(module.root);
     if (x_.result.ok) {
       linkExplicitPaths(x_);
       settleExplicitRapids(x_);
@@ -264,6 +267,16 @@ private:
       const ir::FeatureShape &s = *shape.shape;
       const double secplane = ws.number("secplane").value_or(0);
       const std::optional<ir::RawBlock> raw = ir::rawBlock(ir::workpieceOf(*x_.module, *feature));
+      if (raw && s.top <= raw->bottom + 1e-6 && !s.unbounded) {
+        // Below the raw piece is what the workpiece stands on: a table, a
+        // vise, a fixture. The step is left out, never machined into it.
+        x_.assumed(ws, ws, s.symbol + " lies wholly below the raw piece (its top z=" + formatFixed(s.top, 4) +
+                               " mm, the raw piece's bottom z=" + formatFixed(raw->bottom, 4) +
+                               " mm): machining it would cut into what the workpiece stands on; the "
+                               "workingstep is left out of the program");
+        leftOut_.insert(&ws);
+        return;
+      }
       if (raw)
         reportOutsideRaw(ws, s, *raw);
       if (secplane < s.top || (raw && secplane < raw->top))
@@ -332,6 +345,17 @@ private:
   }
 
   std::set<std::string> outsideReported_;
+  std::set<const Node *> leftOut_;  ///< workingsteps not to machine (said why)
+
+  /// Removes the leftOut_ steps from the program: top down, so a step is
+  /// compared where it was when it was recorded.
+  void leaveOut(Node &n) {
+    std::erase_if(n.children, [&](const Node &c) { return leftOut_.count(&c) > 0; });
+    for (Node &c : n.children)
+      if (c.category() == ir::Category::Executable || c.is(ir::Trait::ControlFlow) ||
+          c.category() == ir::Category::Branch)
+        leaveOut(c);
+  }
 
   /// Runs the family on the step; when it made moves without an error,
   /// says where they do not follow the operation's approach or retract.
