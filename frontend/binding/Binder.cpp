@@ -144,6 +144,22 @@ private:
   Tally unsetAggregate_, unsetString_;
   void reportTally(const Tally &t, const std::string &what);
   std::map<std::string, std::string> suggestions_;  ///< unknown name -> closest entity
+  /// An instance of an entity no schema of the model has, with no close
+  /// name (a writer's own entity, not a typo): where it is referred to.
+  /// With the lenient reading it is left out when only optional attributes
+  /// refer to it (a warning); else it is an error.
+  struct Unknown {
+    std::string name;
+    uint64_t at = 0;
+    std::vector<std::string> optionalUses;  ///< "'its_machining_strategy' of #31"
+    bool needed = false;
+  };
+  std::map<size_t, Unknown> unknown_;
+  /// A reference from `ctx` to instance `target`, whose entity is unknown.
+  void referToUnknown(size_t target, const Context &ctx);
+  /// The closest entity name of the schema to unknown `name` ("" if none is
+  /// close), and the other schema of the model that declares it ("" if none).
+  std::pair<std::string, std::string> nearest(std::string_view name);
 };
 
 Binder::Drift Binder::driftOf(TypeId type) const {
@@ -185,11 +201,11 @@ EntityId Binder::lookup(std::string_view upperName, uint64_t offset) {
   return kNone;
 }
 
-void Binder::reportUnknown(size_t index, std::string_view name, uint64_t at) {
+std::pair<std::string, std::string> Binder::nearest(std::string_view name) {
   // One suggestion per distinct unknown name.
   auto [it, fresh] = suggestions_.try_emplace(std::string(name));
+  const std::string lowered = express::lower(name);
   if (fresh) {
-    const std::string lowered = express::lower(name);
     size_t bestDist = 4;
     for (const auto &[candidate, ref] : schema_.scope) {
       if (!ref.first)
@@ -201,23 +217,38 @@ void Binder::reportUnknown(size_t index, std::string_view name, uint64_t at) {
       }
     }
   }
-  const std::string &best = it->second;
+  for (const express::Schema &other : model_.schemas())
+    if (&other != &schema_)
+      if (auto found = other.scope.find(lowered); found != other.scope.end() && found->second.first)
+        return {it->second, other.name};
+  return {it->second, ""};
+}
+
+void Binder::reportUnknown(size_t index, std::string_view name, uint64_t at) {
+  const auto [best, declaredIn] = nearest(name);
   auto d = diags_.error(file_.loc(at), "unknown entity '" + std::string(name) + "' in schema '" + schema_.name + "'");
   d.entity(entry(index).id, std::string(name));
   // A name another schema of the model declares: the file forgot to list it.
-  const std::string lowered = express::lower(name);
-  for (const express::Schema &other : model_.schemas())
-    if (&other != &schema_)
-      if (auto found = other.scope.find(lowered); found != other.scope.end() && found->second.first) {
-        std::string listed = other.name;
-        for (char &c : listed)
-          c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-        d.note("'" + lowered + "' is declared in schema '" + other.name + "': list '" + listed +
-               "' in the file's FILE_SCHEMA");
-        return;
-      }
+  if (!declaredIn.empty()) {
+    std::string listed = declaredIn;
+    for (char &c : listed)
+      c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    d.note("'" + express::lower(name) + "' is declared in schema '" + declaredIn + "': list '" + listed +
+           "' in the file's FILE_SCHEMA");
+    return;
+  }
   if (!best.empty())
     d.note("did you mean '" + best + "'?");
+}
+
+void Binder::referToUnknown(size_t target, const Context &ctx) {
+  auto it = unknown_.find(target);
+  if (it == unknown_.end())
+    return;
+  if (ctx.slot && ctx.slot->optional && ctx.path.empty())
+    it->second.optionalUses.push_back("'" + ctx.slot->name + "' of #" + std::to_string(entry(ctx.entry).id));
+  else
+    it->second.needed = true;
 }
 
 std::string Binder::entityName(size_t index) const { return file_.describe(entry(index)); }
@@ -320,6 +351,10 @@ bool Binder::checkSelect(const Value &v, DeclTypeId decl, const Context &ctx) {
     int64_t i = file_.indexOf(v.ref);
     if (i < 0)
       return true;  // dangling: reported by the Part 21 check
+    if (out_.entity(static_cast<size_t>(i)) == kNone) {
+      referToUnknown(static_cast<size_t>(i), ctx);
+      return true;  // the target's own entity is unknown: reported there
+    }
     for (EntityId e : c.entities)
       if (out_.isA(static_cast<size_t>(i), e))
         return true;
@@ -376,8 +411,10 @@ bool Binder::checkNamed(const Value &v, const TypeExpr &t, const Context &ctx) {
     int64_t i = file_.indexOf(v.ref);
     if (i < 0)
       return true;  // dangling: reported by the Part 21 check
-    if (out_.entity(static_cast<size_t>(i)) == kNone)
+    if (out_.entity(static_cast<size_t>(i)) == kNone) {
+      referToUnknown(static_cast<size_t>(i), ctx);
       return true;  // the target's own entity is unknown: reported there
+    }
     if (!out_.isA(static_cast<size_t>(i), t.entity)) {
       error(ctx, v, "expected a reference to " + t.name + ", found " + describe(v) + ", which is not " + article(t.name));
       return false;
@@ -685,8 +722,13 @@ void Binder::run() {
       } else if (isAlias[nameId]) {
         ++aliasUses_[std::string(name)].count;
       }
-      if (slot == kNone)
-        reportUnknown(i, name, en.begin());
+      if (slot == kNone) {
+        // Decided once its references are known (after pass 2).
+        if (const auto [best, declaredIn] = nearest(name); best.empty() && declaredIn.empty())
+          unknown_.emplace(i, Unknown{std::string(name), en.begin(), {}, false});
+        else
+          reportUnknown(i, name, en.begin());
+      }
       continue;
     }
     if (!file_.decodeInstance(i, scratch_, nullptr))
@@ -722,6 +764,25 @@ void Binder::run() {
       checkInstance(i, values);
   });
 
+  // A writer's own entity that only optional attributes refer to: left
+  // out, what refers to it read as `$` (lowering reads the attribute as
+  // absent, and says what it assumes for it).
+  for (const auto &[i, u] : unknown_) {
+    if (u.needed || !options_.lenient) {
+      reportUnknown(i, u.name, u.at);
+      continue;
+    }
+    std::string uses;
+    for (size_t k = 0; k < u.optionalUses.size(); ++k)
+      uses += (k == 0 ? "" : k + 1 == u.optionalUses.size() ? " and " : ", ") + u.optionalUses[k];
+    diags_.assumption(file_.loc(u.at), "'" + u.name + "' is an entity of no schema stepnc knows (the writer's own, "
+                                           "it seems): #" + std::to_string(entry(i).id) + " is left out" +
+                                           (uses.empty() ? std::string(", and nothing refers to it")
+                                                         : "; " + uses + ", which refer" +
+                                                               (u.optionalUses.size() == 1 ? "s" : "") +
+                                                               " to it, read as absent ($)"))
+        .entity(entry(i).id, u.name);
+  }
   // An alias: one diagnostic per name, at its first use; an error with
   // --strict, where only the schema's own names are read.
   for (const auto &[alias, use] : aliasUses_) {

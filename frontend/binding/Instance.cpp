@@ -123,7 +123,11 @@ Instance Instance::follow(const Value &v) const {
   if (!bound_ || u.kind != ValueKind::Reference)
     return {};
   const int64_t i = bound_->file().indexOf(u.ref);
-  return i < 0 ? Instance() : Instance(*bound_, static_cast<size_t>(i));
+  // An instance of an entity the schema does not have reads as absent: the
+  // binder reported it (left out, or an error).
+  if (i < 0 || bound_->entity(static_cast<size_t>(i)) == express::kNone)
+    return Instance();
+  return Instance(*bound_, static_cast<size_t>(i));
 }
 
 Instance Instance::ref(std::string_view name) const {

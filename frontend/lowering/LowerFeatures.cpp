@@ -127,7 +127,7 @@ void Lowerer::placeProfileOnce(const Instance &profileInstance, Node &profile, c
   // Read in workpiece coordinates, the profile's placement relative to the feature is:
   const Vec3 relative = r.transpose() * (*at - frame.at);
   profile.set("at", Value::point(relative));
-  if (auto axis = profile.vec("axis"))
+  if (axis)
     profile.set("axis", Value::direction(r.transpose() * *axis));
   if (auto ref = profile.vec("ref"))
     profile.set("ref", Value::direction(r.transpose() * *ref));
