@@ -131,12 +131,25 @@ struct SourceUnits {
   double spindleToRevPerMin = 60;     ///< its spindle (rev/s)
 };
 
+/// A value the reading of the source file assumed, as the Part 21 text that
+/// says it explicitly: parameter `parameter` (0-based) of instance
+/// `entityId`, or with `parameter` -1 its entity name (an alias read as the
+/// schema's entity). The machine-optimised STEP-NC writes them, so that the
+/// file it writes needs none of these assumptions.
+struct SourceFix {
+  uint64_t entityId = 0;
+  int parameter = 0;
+  std::string text;
+};
+
 struct Module {
   Node root{Kind::Project};
   std::string sourceName;
   /// Set by lowering; not part of the IR text (IR read from text has the
   /// standard's units).
   SourceUnits sourceUnits;
+  /// Set by binding and lowering, in the order met; not part of the IR text.
+  std::vector<SourceFix> sourceFixes;
 };
 
 /// Structural equality (kinds, symbols, labels, attributes, children; not origins).

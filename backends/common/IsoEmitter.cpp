@@ -51,12 +51,12 @@ std::optional<std::string> IsoEmitter::run(const Program &p) {
     }
     out_.block(comment(s.label));
     if (s.workOffset > 0) {
-      const std::string w = workOffsetWord(s.workOffset);
-      if (w.empty())
+      const std::string offset = workOffsetWord(s.workOffset);
+      if (offset.empty())
         diags_.error(s.exec->origin.loc, d_.name + " has no work offset " + std::to_string(s.workOffset) +
                                              " for workingstep " + s.exec->symbol + "'s setup");
       else
-        out_.block(w);
+        out_.block(offset);
       // Where the axes are in the new offset is not where they were.
       for (const char *w : {"G", "X", "Y", "Z"})
         modal_.forget(w);

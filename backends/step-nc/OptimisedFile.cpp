@@ -620,6 +620,15 @@ std::string writeOptimisedPart21(const p21::Part21File &input, const ir::Module 
   }
   if (!ok || writer.failed())
     return {};
+  // What reading the file assumed, said explicitly: read again, it needs no
+  // assumption (ir::SourceFix).
+  std::map<InstanceId, std::string> renames;
+  for (const ir::SourceFix &f : module.sourceFixes) {
+    if (f.parameter < 0)
+      renames[f.entityId] = f.text;
+    else
+      patches[f.entityId].emplace_back(static_cast<size_t>(f.parameter), f.text);
+  }
 
   // Patch the canonical text: one header entity or instance per line.
   const std::string description = fileDescription(input, options.description);
@@ -639,6 +648,10 @@ std::string writeOptimisedPart21(const p21::Part21File &input, const ir::Module 
       patched += "\n" + description;
     } else if (line.starts_with("#")) {
       const InstanceId id = instanceIdOf(line);
+      if (auto it = renames.find(id); it != renames.end())
+        if (const size_t eq = patched.find('='), open = patched.find('(');
+            eq != std::string::npos && open != std::string::npos && eq < open)
+          patched = patched.substr(0, eq + 1) + it->second + patched.substr(open);
       if (auto it = patches.find(id); it != patches.end()) {
         for (const auto &[index, value] : it->second) {
           patched = withParameter(patched, index, value);

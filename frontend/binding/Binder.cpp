@@ -466,6 +466,9 @@ bool Binder::checkValue(const Value &v, TypeId type, const Context &ctx, bool op
       Tally &t = drift == Drift::EmptyAggregate ? unsetAggregate_ : unsetString_;
       if (t.count++ == 0)
         t.first = entry(ctx.entry).begin() + v.offset;
+      if (entry(ctx.entry).name() != p21::kComplexInstance)
+        out_.fixes_.push_back({entry(ctx.entry).id, static_cast<int>(ctx.position) - 1,
+                               drift == Drift::EmptyAggregate ? "()" : "''"});
       return true;
     }
     if (options_.lenient && ctx.path.empty()) {
@@ -721,6 +724,12 @@ void Binder::run() {
         isAlias[nameId] = aliasUses_.size() != aliasesBefore;
       } else if (isAlias[nameId]) {
         ++aliasUses_[std::string(name)].count;
+      }
+      if (isAlias[nameId]) {
+        std::string target = aliasUses_[std::string(name)].target;
+        for (char &c : target)
+          c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+        out_.fixes_.push_back({en.id, -1, std::move(target)});
       }
       if (slot == kNone) {
         // Decided once its references are known (after pass 2).

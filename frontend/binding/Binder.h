@@ -41,6 +41,17 @@ public:
   /// True if the instance is `of` or a subtype of it.
   bool isA(size_t index, express::EntityId of) const;
 
+  /// What the lenient reading assumed, as Part 21 text that says it (for
+  /// simple instances): a `$` in a mandatory aggregate is `()`, in a
+  /// mandatory string `''`; an alias is the schema's entity name
+  /// (parameter -1). The machine-optimised STEP-NC writes them.
+  struct Fix {
+    uint64_t id = 0;
+    int parameter = 0;
+    std::string text;
+  };
+  const std::vector<Fix> &fixes() const { return fixes_; }
+
 private:
   friend class Binder;
   struct Complex {
@@ -52,6 +63,7 @@ private:
   const express::Schema &schema_;
   std::vector<express::EntityId> byName_;  ///< NameId -> entity (kNone: unknown)
   std::unordered_map<uint32_t, Complex> complex_;  ///< entry index -> its records' entities
+  std::vector<Fix> fixes_;
 };
 
 struct BindOptions {

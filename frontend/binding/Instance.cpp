@@ -59,6 +59,16 @@ const Value *Instance::find(std::string_view name) const {
 
 const Value *Instance::attr(std::string_view name) const { return find(name); }
 
+int Instance::parameterIndex(std::string_view name) const {
+  if (!valid() || bound_->file().entries()[index_].name() == p21::kComplexInstance)
+    return -1;
+  const Value *v = find(name);
+  if (!v)
+    return -1;
+  const auto params = arena_.params(arena_.records()[0]);
+  return static_cast<int>(v - params.data());
+}
+
 SourceLoc Instance::attrLoc(std::string_view name) const {
   const Value *v = find(name);
   return v ? bound_->file().loc(bound_->file().entries()[index_].begin() + v->offset) : loc();

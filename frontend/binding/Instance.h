@@ -55,6 +55,10 @@ public:
   std::optional<bool> boolean(std::string_view name) const;
   /// The instance a reference attribute points to (invalid if none).
   Instance ref(std::string_view name) const;
+  /// The 0-based position of attribute `name` in a simple instance's
+  /// parameters (what a writer patches); -1 for a complex instance or an
+  /// attribute the entity does not have.
+  int parameterIndex(std::string_view name) const;
   /// The instances an aggregate of references points to, in order.
   std::vector<Instance> refs(std::string_view name) const;
   /// The reals of an aggregate (e.g. coordinates).

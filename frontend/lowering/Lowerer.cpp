@@ -56,6 +56,11 @@ void Lowerer::assumed(const Instance &inst, std::string_view attribute, std::str
   diags_.assumption(inst.attrLoc(attribute), std::move(message)).entity(inst.id(), std::string(inst.entityName()));
 }
 
+void Lowerer::fix(const Instance &inst, std::string_view attribute, std::string text) {
+  if (const int i = inst.parameterIndex(attribute); i >= 0)
+    (module_ ? module_->sourceFixes : pendingFixes_).push_back({inst.id(), i, std::move(text)});
+}
+
 std::string Lowerer::symbolFor(char sigil, const std::optional<std::string> &label, std::string_view fallback) {
   std::string base;
   if (label) {
@@ -133,11 +138,13 @@ std::optional<std::string> Lowerer::workpiece(const Instance &wp) {
     constexpr double kMaxTolerance = 1.0;  // mm
     if (*tol > 0 && *tol <= kMaxTolerance)
       node.set("global_tolerance", Value::length(*tol));
-    else
+    else {
       assumed(wp, "global_tolerance",
               formatFixed(*tol, 4) + " mm is no machining tolerance (it must be above 0 and at most " +
                   formatFixed(kMaxTolerance, 1) + " mm); not used: toolpaths are verified to 0.01 mm "
                   "(verify-toolpaths<tolerance=...> sets another)");
+      fix(wp, "global_tolerance", "$");  // OPTIONAL: what is not used is not given
+    }
   }
   if (Instance bounding = rawBounding(wp)) {
     if (bounding.isA("block")) {
@@ -550,6 +557,13 @@ void Lowerer::choosePlacementReading(const std::vector<Instance> &placements) {
   if (swapped < 2)
     return;
   swapAxisAndRef_ = true;
+  for (const Instance &a : placements) {
+    const Instance axis = a.ref("axis"), ref = a.ref("ref_direction");
+    if (axis && ref) {
+      fix(a, "axis", hashId(ref.id()));
+      fix(a, "ref_direction", hashId(axis.id()));
+    }
+  }
   diags_
       .assumption(first.loc(),
                   "every AXIS2_PLACEMENT_3D of the file that gives both directions (" + std::to_string(swapped) +
@@ -593,6 +607,9 @@ std::unique_ptr<ir::Module> Lowerer::run() {
   module_ = std::make_unique<ir::Module>();
   module_->sourceName = std::string(bound_.file().source().name());
   module_->sourceUnits = {feedToMmPerMin_, cutspeedToMmPerMin_, spindleToRevPerMin_};
+  for (const binding::BoundFile::Fix &f : bound_.fixes())
+    module_->sourceFixes.push_back({f.id, f.parameter, f.text});
+  module_->sourceFixes.insert(module_->sourceFixes.end(), pendingFixes_.begin(), pendingFixes_.end());
   Instance main;
   if (projects.empty()) {
     // No PROJECT names the main workplan: a workplan that is no other

@@ -92,6 +92,10 @@ public:
   /// (an error with --strict). `what` says what the file has, the value
   /// assumed and why: "absent; assumed 20 mm: ...".
   void assumed(const Instance &inst, std::string_view attribute, std::string_view what);
+  /// Records the Part 21 text that says what was assumed for attribute
+  /// `attribute` of `inst`, for the machine-optimised STEP-NC to write
+  /// (ir::SourceFix); nothing for a complex instance.
+  void fix(const Instance &inst, std::string_view attribute, std::string text);
   /// A fresh symbol with `sigil`, from a STEP-NC id string or a fallback.
   std::string symbolFor(char sigil, const std::optional<std::string> &label, std::string_view fallback);
   /// Sets origin and label from an instance.
@@ -230,6 +234,7 @@ private:
   std::map<std::string, std::string> turned_;  ///< symbol + " " + face -> the turned copy's symbol
   std::set<std::pair<size_t, std::string>> secplanesAssumed_;  ///< (plane, face) reported once
   int64_t workOffsets_ = 1;                  ///< work offsets used: the file's own is 1
+  std::vector<ir::SourceFix> pendingFixes_;  ///< fix() before the module exists
   std::vector<Instance> projectWorkpieces_;  ///< the project's its_workpieces
   double angleToDeg_ = 1.0;                  ///< plane_angle_measure to deg
   bool swapAxisAndRef_ = false;              ///< choosePlacementReading
