@@ -104,7 +104,10 @@ bool Lowerer::placeOnFace(const Instance &ws, Node &step) {
   const Node *feature = findFeatureNode(featureSymbol);
   const Instance featureInstance = ws.ref("its_feature");
   const Vec3 axis = *feature->vec("axis");
-  const Instance wpInstance = featureWorkpiece(featureInstance);
+  // The feature's workpiece (featureWorkpiece said what it assumed).
+  Instance wpInstance = featureInstance.ref("its_workpiece");
+  if (!wpInstance && projectWorkpieces_.size() == 1)
+    wpInstance = projectWorkpieces_[0];
   const std::optional<RawExtent> raw = rawExtent(wpInstance);
   const std::optional<Turn> turn = turnFor(axis, raw);
   const Instance placementInstance = featureInstance.ref("feature_placement");

@@ -13,6 +13,7 @@ what the control would reject or do differently:
     `-0`; `L` blocks made of X/Y/Z, R0/RL/RR, F or FMAX and one M function
     from a whitelist; `TOOL CALL n Z S..`; `BLK FORM 0.1 Z` then `0.2` with
     MIN below MAX; cycle 32 and cycle 200 with all their Q parameters; cycle
+    247 (a clamping's datum, then Z alone first as after a TOOL CALL); cycle
     9 (`CYCL DEF 9.0 DWELL TIME`, then `CYCL DEF 9.1 DWELL t`, t > 0 s);
   * motion: the first after each TOOL CALL is an L block with Z alone (up
     to the clearance height: where the tool change left the tool is the
@@ -352,7 +353,7 @@ def check_program(text, arc_tol):
             if body.rstrip().endswith("~"):
                 problems.add(where, "a comment ending in '~' continues the block")
             continue
-        if cont and not body.startswith("CYCL DEF 200 "):
+        if cont and not body.startswith("CYCL DEF 200 ") and not body.startswith("CYCL DEF 247 "):
             problems.add(where, "continuation lines after a block that is not a cycle definition")
         words = body.split()
         if ended:
@@ -409,6 +410,17 @@ def check_program(text, arc_tol):
             continue
         if body.startswith("CYCL DEF 200"):
             check_cycle_200(body, cont, where, mach, problems)
+            continue
+        if body.startswith("CYCL DEF 247"):
+            # The datum of a clamping (a program that re-clamps the
+            # workpiece): a line of the preset table. Where the axes are
+            # after it is not where they were.
+            if body != "CYCL DEF 247 DATUM SETTING ~" or len(cont) != 1 or \
+                    not re.fullmatch(r"Q339=\+[1-9][0-9]* ;DATUM NUMBER", cont[0]):
+                problems.add(where, "cycle 247 not written as 'CYCL DEF 247 DATUM SETTING ~' and "
+                                    "'Q339=+n ;DATUM NUMBER' (n >= 1)")
+            mach.pos = [None, None, None]
+            mach.up_first = where
             continue
         if words[0] == "L":
             ms = check_l(words[1:], where, mach, problems, i == last - 1)

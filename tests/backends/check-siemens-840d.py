@@ -64,7 +64,9 @@ from toolpath_ir import arc_sweep
 RADIUS_TOL = 1e-3
 MAX_NAME = 24
 
-G_CODES = {0, 1, 2, 3, 4, 17, 40, 64, 71, 90, 94, 642}
+# G54..G57 and the user frames G505..G599: the work offset of each clamping
+# of a program that re-clamps the workpiece (docs/setups.md).
+G_CODES = {0, 1, 2, 3, 4, 17, 40, 64, 71, 90, 94, 642} | set(range(54, 58)) | set(range(505, 600))
 MOTION = {0, 1, 2, 3}
 M_CODES = {0, 1, 3, 4, 5, 6, 7, 8, 9, 30}
 LENGTH_WORDS = set("XYZIJK") | {"CR", "F"}
