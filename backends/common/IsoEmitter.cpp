@@ -268,8 +268,18 @@ void IsoEmitter::arc(const Move &m) {
       text += ' ';
       text += radiusWord(pieceSweep > std::numbers::pi ? -r : r);
     } else {
-      const geom::Vec2 ij = roundedCentreOffset(start, printedTo, geom::balancedCentre(start, printedTo, m.centre),
-                                                d_.coordDecimals);
+      // The centre on the printed chord's bisector, so that both printed
+      // ends are as far from it; but over a chord much shorter than the
+      // radius the bisector turns with the rounding of the ends, and
+      // projecting moves the centre by far more than the rounding: there
+      // the planned centre is kept when its radii to the printed ends
+      // already agree within two units (0.0002 mm at 4 decimals; LinuxCNC
+      // allows 0.00127 mm by default).
+      const double unit = std::pow(10.0, -d_.coordDecimals);
+      const bool agrees = std::abs((m.centre - start).norm() - (m.centre - printedTo).norm()) <= 2 * unit;
+      const bool shortChord = (printedTo - start).norm() < 0.1 * (m.centre - start).norm();
+      const geom::Vec2 centre = agrees && shortChord ? m.centre : geom::balancedCentre(start, printedTo, m.centre);
+      const geom::Vec2 ij = roundedCentreOffset(start, printedTo, centre, d_.coordDecimals);
       text += word(" I", num(ij.x())) + word(" J", num(ij.y()));
     }
     if (oneBlockTurns) {

@@ -57,7 +57,7 @@ public:
     } else if (n.kind == ir::Kind::Helix) {
       fail("an untrimmed helix has no ends: it must be a trimmed curve's basis");
     } else if (n.kind == ir::Kind::BSplineCurve) {
-      fail("B-spline curves are not expanded into moves yet");
+      spline(n, forward);
     } else {
       fail("'" + n.kindName() + "' is not a curve");
     }
@@ -83,6 +83,48 @@ private:
       std::swap(p[i].from, p[i].to);
       p[i].ccw = !p[i].ccw;
     }
+  }
+
+  /// Chords of the curve: each knot span cut in eight, each piece halved
+  /// until its middle lies within kSplineChordTolerance of its chord.
+  void spline(const Node &n, bool forward) {
+    std::string error;
+    const std::optional<BSpline> s = bspline(n, error);
+    if (!s) {
+      fail(error);
+      return;
+    }
+    const size_t first = result.pieces.size();
+    std::vector<double> cuts;
+    for (size_t k = static_cast<size_t>(s->degree); k + 1 < s->knots.size() - static_cast<size_t>(s->degree); ++k) {
+      const double a = std::max(s->knots[k], s->start), b = std::min(s->knots[k + 1], s->end);
+      if (b > a)
+        for (int i = 0; i < 8; ++i)
+          cuts.push_back(a + (b - a) * i / 8);
+    }
+    cuts.push_back(s->end);
+    Vec3 from = s->at(cuts.front());
+    for (size_t i = 1; i < cuts.size(); ++i) {
+      const Vec3 to = s->at(cuts[i]);
+      chords(*s, cuts[i - 1], from, cuts[i], to, 0);
+      from = to;
+    }
+    if (!forward)
+      reverseFrom(first);
+  }
+
+  void chords(const BSpline &s, double u0, const Vec3 &a, double u1, const Vec3 &b, int depth) {
+    const double um = (u0 + u1) / 2;
+    const Vec3 m = s.at(um);
+    const Vec3 chord = b - a;
+    const double len = chord.norm();
+    const double off = len > 0 ? (m - a).cross(chord).norm() / len : (m - a).norm();
+    if (off > kSplineChordTolerance && depth < 24) {
+      chords(s, u0, a, um, m, depth + 1);
+      chords(s, um, m, u1, b, depth + 1);
+      return;
+    }
+    addLine(a, b);
   }
 
   void polyline(const Node &n, bool forward) {
@@ -171,6 +213,97 @@ private:
 };
 
 } // namespace
+
+Vec3 BSpline::at(double u) const {
+  // De Boor's algorithm in homogeneous coordinates (w x, w y, w z, w).
+  const int p = degree;
+  const size_t n = points.size();
+  u = std::clamp(u, start, end);
+  // The span k with knots[k] <= u < knots[k + 1], within [p, n - 1].
+  size_t k = static_cast<size_t>(p);
+  while (k + 1 < n && knots[k + 1] <= u)
+    ++k;
+  std::vector<Eigen::Vector4d> d(static_cast<size_t>(p) + 1);
+  for (int j = 0; j <= p; ++j) {
+    const size_t i = k - static_cast<size_t>(p) + static_cast<size_t>(j);
+    d[static_cast<size_t>(j)] << points[i] * weights[i], weights[i];
+  }
+  for (int r = 1; r <= p; ++r)
+    for (int j = p; j >= r; --j) {
+      const size_t i = k - static_cast<size_t>(p) + static_cast<size_t>(j);
+      const double den = knots[i + static_cast<size_t>(p) + 1 - static_cast<size_t>(r)] - knots[i];
+      const double alpha = den > 0 ? (u - knots[i]) / den : 0;
+      d[static_cast<size_t>(j)] = (1 - alpha) * d[static_cast<size_t>(j) - 1] + alpha * d[static_cast<size_t>(j)];
+    }
+  const Eigen::Vector4d &h = d[static_cast<size_t>(p)];
+  return h.head<3>() / h[3];
+}
+
+std::optional<BSpline> bspline(const ir::Node &curve, std::string &error) {
+  BSpline s;
+  s.degree = static_cast<int>(curve.count("degree").value_or(0));
+  for (const Node *pt : curve.childrenOf(ir::Kind::Point)) {
+    s.points.push_back(pt->vec("at").value_or(Vec3::Zero()));
+    s.weights.push_back(pt->number("weight").value_or(1.0));
+  }
+  const int p = s.degree;
+  const int n = static_cast<int>(s.points.size());
+  if (p < 1 || n < p + 1) {
+    error = "a B-spline of degree " + std::to_string(p) + " needs more than " + std::to_string(p) +
+            " control points, it has " + std::to_string(n);
+    return std::nullopt;
+  }
+  for (double w : s.weights)
+    if (!(w > 0) || !std::isfinite(w)) {
+      error = "a rational B-spline's weights must be positive";
+      return std::nullopt;
+    }
+  // ISO 10303-42's knot vectors for the forms that do not list their knots.
+  const std::string form = curve.text("form").value_or("with_knots");
+  const int last = n - 1;  // the upper index of the control points
+  if (form == "with_knots") {
+    for (const Node *k : curve.childrenOf(ir::Kind::Knot))
+      for (int64_t m = 0; m < k->count("multiplicity").value_or(0); ++m)
+        s.knots.push_back(k->number("value").value_or(0));
+  } else if (form == "uniform") {
+    for (int i = -p; i <= last + 1; ++i)
+      s.knots.push_back(i);
+  } else if (form == "quasi_uniform") {
+    const int spans = last - p + 1;
+    s.knots.insert(s.knots.end(), static_cast<size_t>(p), 0.0);
+    for (int i = 0; i <= spans; ++i)
+      s.knots.push_back(i);
+    s.knots.insert(s.knots.end(), static_cast<size_t>(p), static_cast<double>(spans));
+  } else {  // bezier: pieces of degree p, end knots p + 1 times, inner ones p times
+    if (last % p != 0) {
+      error = "a piecewise Bezier curve of degree " + std::to_string(p) + " needs a multiple of " + std::to_string(p) +
+              " points and one more, it has " + std::to_string(n);
+      return std::nullopt;
+    }
+    const int pieces = last / p;
+    s.knots.push_back(0);
+    for (int i = 0; i <= pieces; ++i)
+      s.knots.insert(s.knots.end(), static_cast<size_t>(p), static_cast<double>(i));
+    s.knots.push_back(pieces);
+  }
+  if (s.knots.size() != static_cast<size_t>(n + p + 1)) {
+    error = "a B-spline of degree " + std::to_string(p) + " with " + std::to_string(n) + " control points needs " +
+            std::to_string(n + p + 1) + " knots (counted with their multiplicities), it has " +
+            std::to_string(s.knots.size());
+    return std::nullopt;
+  }
+  if (!std::is_sorted(s.knots.begin(), s.knots.end())) {
+    error = "a B-spline's knots must not decrease";
+    return std::nullopt;
+  }
+  s.start = s.knots[static_cast<size_t>(p)];
+  s.end = s.knots[static_cast<size_t>(n)];
+  if (!(s.end > s.start)) {
+    error = "a B-spline's knots leave it no parameter range";
+    return std::nullopt;
+  }
+  return s;
+}
 
 CurveResult curvePieces(const ir::Node &curve) {
   Converter c;

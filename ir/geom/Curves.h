@@ -1,11 +1,14 @@
-// IR curves (lines, polylines, circles, helices, trimmed and composite curves)
-// as straight and circular pieces in space: what a general profile's outline
-// and an explicit toolpath are made of. Circles and helices stay circular.
+// IR curves (lines, polylines, circles, helices, trimmed and composite curves,
+// B-splines) as straight and circular pieces in space: what a general
+// profile's outline, a slot's course and an explicit toolpath are made of.
+// Circles and helices stay circular; B-splines become chords within
+// kSplineChordTolerance of the curve.
 #pragma once
 
 #include "geom/Geometry.h"
 #include "ir/Node.h"
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,6 +26,25 @@ struct CurvePiece {
   /// `to` is over `from` (the toolpath IR's rule for arcs).
   int64_t turns = 0;
 };
+
+/// How far a B-spline's chords may stray from the curve, mm: a tenth of the
+/// verifier's default tolerance.
+inline constexpr double kSplineChordTolerance = 0.001;
+
+/// A B-spline curve node (ISO 10303-42: uniform, quasi-uniform, Bezier or
+/// with knots; rational with weights on its points) as a function of its
+/// parameter over [start, end]. Built once per curve; nullopt with `error`
+/// set when the node does not make one (too few points for its degree,
+/// knots that do not fit).
+struct BSpline {
+  int degree = 0;
+  std::vector<Vec3> points;
+  std::vector<double> weights;  ///< one per point (1 when not rational)
+  std::vector<double> knots;    ///< expanded by multiplicity: points + degree + 1 values
+  double start = 0, end = 0;
+  Vec3 at(double u) const;
+};
+std::optional<BSpline> bspline(const ir::Node &curve, std::string &error);
 
 struct CurveResult {
   std::vector<CurvePiece> pieces;
