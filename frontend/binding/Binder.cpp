@@ -230,11 +230,8 @@ void Binder::reportUnknown(size_t index, std::string_view name, uint64_t at) {
   d.entity(entry(index).id, std::string(name));
   // A name another schema of the model declares: the file forgot to list it.
   if (!declaredIn.empty()) {
-    std::string listed = declaredIn;
-    for (char &c : listed)
-      c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-    d.note("'" + express::lower(name) + "' is declared in schema '" + declaredIn + "': list '" + listed +
-           "' in the file's FILE_SCHEMA");
+    d.note("'" + express::lower(name) + "' is declared in schema '" + declaredIn + "': list '" +
+           express::upper(declaredIn) + "' in the file's FILE_SCHEMA");
     return;
   }
   if (!best.empty())
@@ -725,12 +722,8 @@ void Binder::run() {
       } else if (isAlias[nameId]) {
         ++aliasUses_[std::string(name)].count;
       }
-      if (isAlias[nameId]) {
-        std::string target = aliasUses_[std::string(name)].target;
-        for (char &c : target)
-          c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-        out_.fixes_.push_back({en.id, -1, std::move(target)});
-      }
+      if (isAlias[nameId])
+        out_.fixes_.push_back({en.id, -1, express::upper(aliasUses_[std::string(name)].target)});
       if (slot == kNone) {
         // Decided once its references are known (after pass 2).
         if (const auto [best, declaredIn] = nearest(name); best.empty() && declaredIn.empty())

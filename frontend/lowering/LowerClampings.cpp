@@ -10,6 +10,8 @@
 // after lowering then sees features facing +z in their setup's frame.
 #include "frontend/lowering/Lowerer.h"
 
+#include "frontend/express/Schema.h"
+#include "ir/Program.h"
 #include "support/Format.h"
 
 #include <array>
@@ -41,13 +43,6 @@ constexpr FaceTurn kFaces[] = {
 
 /// The face in a symbol: "px" for +x, "nz" for -z.
 std::string faceTag(const std::string &face) { return std::string(face[0] == '+' ? "p" : "n") + face[1]; }
-
-std::string upper(std::string s) {
-  for (char &c : s)
-    if (c >= 'a' && c <= 'z')
-      c = static_cast<char>(c - 32);
-  return s;
-}
 
 /// "+Y" for the workpiece axis that a machine axis `k` runs along after `t`.
 std::string workpieceAxisAlong(const Turn &t, int k) {
@@ -101,7 +96,7 @@ std::optional<Turn> Lowerer::turnFor(const Vec3 &axis, const std::optional<RawEx
 
 bool Lowerer::placeOnFace(const Instance &ws, Node &step) {
   const std::string featureSymbol = *step.text("feature");
-  const Node *feature = findFeatureNode(featureSymbol);
+  const Node *feature = ir::findFeature(*module_, featureSymbol);
   const Instance featureInstance = ws.ref("its_feature");
   const Vec3 axis = *feature->vec("axis");
   // The feature's workpiece (featureWorkpiece said what it assumed).
@@ -125,16 +120,10 @@ bool Lowerer::placeOnFace(const Instance &ws, Node &step) {
       if (auto p = placement(w.ref("its_origin")))
         if ((p->axis - Vec3::UnitZ()).norm() > kAlong || (p->ref - Vec3::UnitX()).norm() > kAlong)
           diags_.assumption(w.loc(), "the workpiece setup turns the workpiece; stepnc clamps workingstep " +
-                                         hashId(ws.id()) + "'s feature with its " + upper(turn->face) +
+                                         hashId(ws.id()) + "'s feature with its " + express::upper(turn->face) +
                                          " face up by its own rule (docs/setups.md), not by this placement")
               .entity(w.id(), std::string(w.entityName()));
-  const Node *owner = nullptr;
-  for (const Node &w : module_->root.children)
-    if (w.kind == ir::Kind::Workpiece)
-      for (const Node &c : w.children)
-        if (&c == feature)
-          owner = &w;
-  const std::string workpiece = turnedWorkpiece(owner->symbol, *turn);
+  const std::string workpiece = turnedWorkpiece(ir::workpieceOf(*module_, *feature)->symbol, *turn, raw);
   step.set("feature", Value::ref(turnedFeature(featureSymbol, *turn, workpiece)));
   step.set("setup", Value::ref(turnedSetup(workpiece, *turn, raw, ws)));
   if (auto h = turnedSecplane(ws, *turn, raw))
@@ -143,7 +132,8 @@ bool Lowerer::placeOnFace(const Instance &ws, Node &step) {
   return true;
 }
 
-std::string Lowerer::turnedWorkpiece(const std::string &workpiece, const Turn &turn) {
+std::string Lowerer::turnedWorkpiece(const std::string &workpiece, const Turn &turn,
+                                     const std::optional<RawExtent> &raw) {
   const std::string key = workpiece + " " + turn.face;
   if (auto it = turned_.find(key); it != turned_.end())
     return it->second;
@@ -156,18 +146,10 @@ std::string Lowerer::turnedWorkpiece(const std::string &workpiece, const Turn &t
   // The raw block in the turned frame: the box around its turned corners,
   // exact for a block whose axes are the workpiece's. The clamping points
   // are the first clamping's: not carried over.
-  if (const Node *raw = original->child(ir::Kind::Rawpiece)) {
-    Node r = *raw;
-    if (raw->text("shape") == "block" && raw->has("size")) {
-      const Vec3 at = *raw->vec("at"), axis = *raw->vec("axis"), ref = *raw->vec("ref"), size = *raw->vec("size");
-      const Vec3 y = axis.cross(ref);
-      Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-      for (int c = 0; c < 8; ++c) {
-        const Vec3 corner = turn.point(at + ref * ((c & 1) ? size.x() : 0) + y * ((c & 2) ? size.y() : 0) +
-                                       axis * ((c & 4) ? size.z() : 0));
-        lo = lo.cwiseMin(corner);
-        hi = hi.cwiseMax(corner);
-      }
+  if (const Node *rawpiece = original->child(ir::Kind::Rawpiece)) {
+    Node r = *rawpiece;
+    if (raw && rawpiece->text("shape") == "block") {
+      const auto [lo, hi] = turnedBox(*raw, turn);
       r.set("at", Value::point(lo));
       r.set("axis", Value::direction(Vec3::UnitZ()));
       r.set("ref", Value::direction(Vec3::UnitX()));
@@ -186,7 +168,7 @@ std::string Lowerer::turnedFeature(const std::string &feature, const Turn &turn,
   const std::string key = feature + " " + turn.face;
   if (auto it = turned_.find(key); it != turned_.end())
     return it->second;
-  Node copy = *findFeatureNode(feature);
+  Node copy = *ir::findFeature(*module_, feature);
   copy.symbol = symbolFor('%', feature.substr(1) + " " + faceTag(turn.face) + " up", "feature");
   // The feature's placement turns; its profiles and paths are placed in it.
   for (const char *name : {"at"})
@@ -232,7 +214,7 @@ std::string Lowerer::turnedSetup(const std::string &workpiece, const Turn &turn,
   const Vec3 corner = raw ? raw->min : Vec3::Zero();
   s.set("instruction",
         Value::string("work offset " + std::to_string(workOffsets_) + ": re-clamp the workpiece with its " +
-                      upper(turn.face) + " face up, its " + workpieceAxisAlong(turn, 0) + " along X and " +
+                      express::upper(turn.face) + " face up, its " + workpieceAxisAlong(turn, 0) + " along X and " +
                       workpieceAxisAlong(turn, 1) + " along Y; the raw block's lowest corner at X" +
                       formatFixed(corner.x(), 3) + " Y" + formatFixed(corner.y(), 3) + " Z" +
                       formatFixed(corner.z(), 3)));
@@ -279,14 +261,14 @@ std::optional<double> Lowerer::turnedSecplane(const Instance &owner, const Turn 
     const double height = *top + clearance;
     if (secplanesAssumed_.insert({plane.index(), turn.face}).second)
       assumed(plane, "position",
-              "is normal to the workpiece's z, not to its " + upper(turn.face) +
+              "is normal to the workpiece's z, not to its " + express::upper(turn.face) +
                   " face that workingsteps machine from; for them the security plane is taken " +
-                  formatFixed(clearance, 3) + " mm above the raw piece turned " + upper(turn.face) +
+                  formatFixed(clearance, 3) + " mm above the raw piece turned " + express::upper(turn.face) +
                   " up (z " + formatFixed(height, 3) + " mm in that setup), as far as this plane is above its top");
     return height;
   }
   unsupported(plane, "security plane whose normal " + formatTuple({p->axis.x(), p->axis.y(), p->axis.z()}, 6) +
-                         " is neither z nor the axis of the face (" + upper(turn.face) + ") the feature is on");
+                         " is neither z nor the axis of the face (" + express::upper(turn.face) + ") the feature is on");
   return std::nullopt;
 }
 

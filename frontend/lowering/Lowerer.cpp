@@ -2,6 +2,7 @@
 // workingsteps and NC functions, plus the helpers every lowering file uses.
 #include "frontend/lowering/Lowerer.h"
 #include "ir/Plausible.h"
+#include "ir/Program.h"
 
 #include "support/Format.h"
 
@@ -103,15 +104,6 @@ Node *Lowerer::findResource(const std::string &symbol) {
   for (Node &c : module_->root.children)
     if (c.symbol == symbol)
       return &c;
-  return nullptr;
-}
-
-Node *Lowerer::findFeatureNode(const std::string &symbol) {
-  for (Node &w : module_->root.children)
-    if (w.kind == ir::Kind::Workpiece)
-      for (Node &c : w.children)
-        if (c.symbol == symbol)
-          return &c;
   return nullptr;
 }
 
@@ -233,7 +225,7 @@ std::optional<Node> Lowerer::workingstep(const Instance &ws) {
     node.set("feature", Value::ref(*f));
   else
     missing(ws, "its_feature");
-  const Node *featureNode = f ? findFeatureNode(*f) : nullptr;
+  const Node *featureNode = f ? ir::findFeature(*module_, *f) : nullptr;
   const bool onTop = !featureNode || (featureNode->vec("axis").value_or(Vec3::UnitZ()) - Vec3::UnitZ()).norm() < 1e-9;
   if (onTop)
     if (auto h = planeHeight(ws, "its_secplane", "security plane"))

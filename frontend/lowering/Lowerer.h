@@ -202,10 +202,8 @@ private:
   std::optional<Node> workingstep(const Instance &ws);
   std::optional<Node> workplan(const Instance &wp);
   Node *findResource(const std::string &symbol);
-  /// A feature node by symbol, in any workpiece.
-  Node *findFeatureNode(const std::string &symbol);
   /// The copies placeOnFace makes, each once per face (LowerClampings.cpp).
-  std::string turnedWorkpiece(const std::string &workpiece, const Turn &turn);
+  std::string turnedWorkpiece(const std::string &workpiece, const Turn &turn, const std::optional<RawExtent> &raw);
   std::string turnedFeature(const std::string &feature, const Turn &turn, const std::string &workpiece);
   std::string turnedSetup(const std::string &workpiece, const Turn &turn, const std::optional<RawExtent> &raw,
                           const Instance &stepInstance);
