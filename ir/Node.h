@@ -135,7 +135,8 @@ struct SourceUnits {
 /// says it explicitly: parameter `parameter` (0-based) of instance
 /// `entityId`, or with `parameter` -1 its entity name (an alias read as the
 /// schema's entity). The machine-optimised STEP-NC writes them, so that the
-/// file it writes needs none of these assumptions.
+/// file it writes needs none of these assumptions. `#@k` in `text` refers to
+/// the Module's new source instance k.
 struct SourceFix {
   uint64_t entityId = 0;
   int parameter = 0;
@@ -150,6 +151,10 @@ struct Module {
   SourceUnits sourceUnits;
   /// Set by binding and lowering, in the order met; not part of the IR text.
   std::vector<SourceFix> sourceFixes;
+  /// Instances a fix needs that the source file lacks, as Part 21 text
+  /// `ENTITY(parameters)` (a depth plane, a cutting component): `#@k` in a
+  /// fix or in a later one of these refers to the k-th. Not part of the IR text.
+  std::vector<std::string> sourceInstances;
 };
 
 /// Structural equality (kinds, symbols, labels, attributes, children; not origins).

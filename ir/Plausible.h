@@ -17,5 +17,12 @@ inline constexpr double kPlausibleMinSpindleRpm = 1;
 inline constexpr double kPlausibleMaxSpindleRpm = 100000;
 /// Feed per tooth, at most this share of the tool's diameter.
 inline constexpr double kPlausibleChipLoadShare = 0.1;
+/// mm: a workpiece's global_tolerance above this is no machining tolerance
+/// (some generators write 50 mm); lowering does not use it.
+inline constexpr double kPlausibleMaxTolerance = 1.0;
+/// mm: the tolerance toolpaths are verified to when neither the workpiece nor
+/// an option gives one; a dimension the file gives no tolerance is written
+/// back with it.
+inline constexpr double kDefaultTolerance = 0.01;
 
 } // namespace stepnc::ir

@@ -29,6 +29,7 @@
 
 #include "geom/Boolean.h"
 #include "ir/Kinds.h"
+#include "ir/Plausible.h"
 #include "ir/Program.h"
 #include "ir/geom/FeatureShape.h"
 #include "ir/geom/MoveWalk.h"
@@ -51,7 +52,7 @@ using geom::Seg;
 using geom::Vec2;
 using ir::Vec3;
 
-constexpr double kDefaultTolerance = 0.01;  ///< mm, when neither the option nor the workpiece gives one
+using ir::kDefaultTolerance;
 constexpr double kLevelEps = 1e-6;          ///< heights closer than this are one depth level
 constexpr double kUncutShare = 0.001;       ///< uncut area allowed at the floor: 0.1 % of the target
 /// mm a tool may pass a through bottom beyond its point when the overcut is

@@ -20,6 +20,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -413,12 +414,19 @@ std::optional<std::pair<size_t, size_t>> parameterSpan(std::string_view line, si
   return std::nullopt;
 }
 
-/// The line with its parameter `index` replaced by `value`; empty when the
-/// line has no such parameter.
+/// The line with its parameter `index` replaced by `value`, or with `value`
+/// appended when `index` is one past its last parameter (a subtype's
+/// attributes after its supertype's); empty when the line has no such
+/// parameter.
 std::string withParameter(std::string_view line, size_t index, std::string_view value) {
   const auto span = parameterSpan(line, index);
-  if (!span)
-    return {};
+  if (!span) {
+    const auto last = index > 0 ? parameterSpan(line, index - 1) : std::nullopt;
+    if (!last || last->second >= line.size() || line[last->second] != ')')
+      return {};
+    return std::string(line.substr(0, last->second)) + ',' + std::string(value) +
+           std::string(line.substr(last->second));
+  }
   return std::string(line.substr(0, span->first)) + std::string(value) + std::string(line.substr(span->second));
 }
 
@@ -622,12 +630,30 @@ std::string writeOptimisedPart21(const p21::Part21File &input, const ir::Module 
     return {};
   // What reading the file assumed, said explicitly: read again, it needs no
   // assumption (ir::SourceFix).
+  std::vector<InstanceId> made;
+  const auto resolve = [&made](std::string text) {
+    for (size_t at = text.find("#@"); at != std::string::npos; at = text.find("#@", at)) {
+      size_t end = at + 2;
+      while (end < text.size() && std::isdigit(static_cast<unsigned char>(text[end])))
+        ++end;
+      const size_t k = std::stoul(text.substr(at + 2, end - at - 2));
+      const std::string ref = Instances::ref(made.at(k));
+      text.replace(at, end - at, ref);
+      at += ref.size();
+    }
+    return text;
+  };
+  for (const std::string &instance : module.sourceInstances) {
+    const std::string resolved = resolve(instance);
+    const size_t open = resolved.find('(');
+    made.push_back(out.add(resolved.substr(0, open), resolved.substr(open + 1, resolved.size() - open - 2)));
+  }
   std::map<InstanceId, std::string> renames;
   for (const ir::SourceFix &f : module.sourceFixes) {
     if (f.parameter < 0)
       renames[f.entityId] = f.text;
     else
-      patches[f.entityId].emplace_back(static_cast<size_t>(f.parameter), f.text);
+      patches[f.entityId].emplace_back(static_cast<size_t>(f.parameter), resolve(f.text));
   }
 
   // Patch the canonical text: one header entity or instance per line.

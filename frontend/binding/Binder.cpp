@@ -1,5 +1,6 @@
 #include "frontend/binding/Binder.h"
 
+#include "ir/Plausible.h"
 #include "support/Format.h"
 
 #include <algorithm>
@@ -135,13 +136,16 @@ private:
   size_t intForReal_ = 0;
   uint64_t firstIntForReal_ = 0;
   // `$` in a mandatory attribute that real writers use for "empty" or "no name".
-  enum class Drift { None, EmptyAggregate, MissingString };
+  /// What a `$` in a mandatory attribute of this type is read as: common
+  /// drift (an empty aggregate, '', the general tolerance) tallied in one
+  /// warning; false for a BOOLEAN (a warning per instance); else absent.
+  enum class Drift { None, EmptyAggregate, MissingString, MissingTolerance, Boolean };
   Drift driftOf(TypeId type) const;
   struct Tally {
     size_t count = 0;
     uint64_t first = 0;
   };
-  Tally unsetAggregate_, unsetString_;
+  Tally unsetAggregate_, unsetString_, unsetTolerance_;
   void reportTally(const Tally &t, const std::string &what);
   std::map<std::string, std::string> suggestions_;  ///< unknown name -> closest entity
   /// An instance of an entity no schema of the model has, with no close
@@ -169,10 +173,15 @@ Binder::Drift Binder::driftOf(TypeId type) const {
     if (t.kind == TypeExpr::Aggregate)
       return t.lower == 0 ? Drift::EmptyAggregate : Drift::None;
     if (t.kind == TypeExpr::Simple)
-      return t.simple == express::SimpleKind::String ? Drift::MissingString : Drift::None;
+      return t.simple == express::SimpleKind::String    ? Drift::MissingString
+             : t.simple == express::SimpleKind::Boolean ? Drift::Boolean
+                                                        : Drift::None;
     if (t.kind != TypeExpr::Named || t.declared == kNone)
       return Drift::None;
-    type = model_.typeDecl(t.declared).underlying;
+    const express::TypeDecl &decl = model_.typeDecl(t.declared);
+    if (decl.name == "tolerance_select")  // ISO 14649-10: the tolerance of a toleranced length
+      return Drift::MissingTolerance;
+    type = decl.underlying;
   }
   return Drift::None;
 }
@@ -459,21 +468,33 @@ bool Binder::checkValue(const Value &v, TypeId type, const Context &ctx, bool op
     if (optionalAllowed)
       return true;
     const Drift drift = ctx.path.empty() && !options_.strict ? driftOf(type) : Drift::None;
-    if (drift != Drift::None) {
-      Tally &t = drift == Drift::EmptyAggregate ? unsetAggregate_ : unsetString_;
+    const bool simple = entry(ctx.entry).name() != p21::kComplexInstance;
+    const int parameter = static_cast<int>(ctx.position) - 1;
+    if (drift == Drift::EmptyAggregate || drift == Drift::MissingString || drift == Drift::MissingTolerance) {
+      Tally &t = drift == Drift::EmptyAggregate  ? unsetAggregate_
+                 : drift == Drift::MissingString ? unsetString_
+                                                 : unsetTolerance_;
       if (t.count++ == 0)
         t.first = entry(ctx.entry).begin() + v.offset;
-      if (entry(ctx.entry).name() != p21::kComplexInstance)
-        out_.fixes_.push_back({entry(ctx.entry).id, static_cast<int>(ctx.position) - 1,
-                               drift == Drift::EmptyAggregate ? "()" : "''"});
+      if (simple)
+        out_.fixes_.push_back({entry(ctx.entry).id, parameter,
+                               drift == Drift::EmptyAggregate  ? "()"
+                               : drift == Drift::MissingString ? "''"
+                                                               : "",
+                               drift == Drift::MissingTolerance});
       return true;
     }
     if (options_.lenient && ctx.path.empty()) {
       const p21::InstanceEntry &e = entry(ctx.entry);
+      // A flag the file leaves unset is off: what every reader of it assumes.
+      const bool flag = drift == Drift::Boolean;
       diags_.assumption(file_.loc(e.begin() + v.offset),
                         "attribute " + std::to_string(ctx.position) + " '" + (ctx.slot ? ctx.slot->name : "") +
-                            "': '$' (no value) where a value is required (" + expected(type) + "); read as absent")
+                            "': '$' (no value) where a value is required (" + expected(type) + "); read as " +
+                            (flag ? "false (.F.)" : "absent"))
           .entity(e.id, entityName(ctx.entry));
+      if (flag && simple)
+        out_.fixes_.push_back({e.id, parameter, ".F."});
       return true;
     }
     error(ctx, v, "'$' (no value) where a value is required (" + expected(type) + ")");
@@ -799,6 +820,9 @@ void Binder::run() {
   }
   reportTally(unsetAggregate_, "'$' written for a mandatory aggregate; read as empty");
   reportTally(unsetString_, "'$' written for a mandatory string (a name, label or identifier); read as ''");
+  reportTally(unsetTolerance_, "'$' written for the tolerance of a toleranced length (implicit_tolerance); read as "
+                              "the general tolerance: the workpiece's global_tolerance, else " +
+                                  formatFixed(ir::kDefaultTolerance, 2) + " mm either way");
   if (intForReal_ > 0)
     diags_.warning(file_.loc(firstIntForReal_),
                    "integer written where a REAL is expected; read as a real (" + std::to_string(intForReal_) +

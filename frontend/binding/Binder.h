@@ -43,12 +43,15 @@ public:
 
   /// What the lenient reading assumed, as Part 21 text that says it (for
   /// simple instances): a `$` in a mandatory aggregate is `()`, in a
-  /// mandatory string `''`; an alias is the schema's entity name
-  /// (parameter -1). The machine-optimised STEP-NC writes them.
+  /// mandatory string `''`, in a BOOLEAN `.F.`; an alias is the schema's
+  /// entity name (parameter -1). The machine-optimised STEP-NC writes them.
   struct Fix {
     uint64_t id = 0;
     int parameter = 0;
     std::string text;
+    /// A tolerance the file leaves out, read as the general tolerance:
+    /// lowering, which knows the workpiece's, writes it (`text` is empty).
+    bool generalTolerance = false;
   };
   const std::vector<Fix> &fixes() const { return fixes_; }
 
@@ -69,8 +72,9 @@ private:
 struct BindOptions {
   const AliasTable *aliases = &AliasTable::builtin();
   /// Report common drift as errors instead of warnings: `$` written for a
-  /// mandatory aggregate that may be empty (read as empty) or for a mandatory
-  /// string such as a name or label (read as ''), and an entity name from the
+  /// mandatory aggregate that may be empty (read as empty), for a mandatory
+  /// string such as a name or label (read as ''), or for a length's
+  /// tolerance (read as the general tolerance), and an entity name from the
   /// alias table (--strict).
   bool strict = false;
   /// The commands' reading without --strict (driver::bindOptions): report as

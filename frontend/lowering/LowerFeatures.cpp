@@ -23,6 +23,7 @@ void setDepth(Lowerer &l, Node &n, const Instance &f) {
     l.assumed(f.ref("depth"), "position",
               "places the floor " + formatFixed(*z, 4) + " mm above the feature's origin, where no floor can be; "
               "read as a depth of " + formatFixed(*z, 4) + " mm below it");
+    l.fix(f, "depth", l.depthPlane(*z));  // a plane of its own: the file's may be shared
     *z = -*z;
   }
   n.set("depth", Value::length(-*z));
@@ -62,6 +63,7 @@ Instance Lowerer::featureWorkpiece(const Instance &f) {
   if (projectWorkpieces_.size() != 1)
     return {};
   assumed(f, "its_workpiece", "absent; assumed " + describe(projectWorkpieces_[0]) + ", the project's only workpiece");
+  fix(f, "its_workpiece", hashId(projectWorkpieces_[0].id()));
   return projectWorkpieces_[0];
 }
 
@@ -131,6 +133,10 @@ void Lowerer::placeProfileOnce(const Instance &profileInstance, Node &profile, c
     profile.set("axis", Value::direction(r.transpose() * *axis));
   if (auto ref = profile.vec("ref"))
     profile.set("ref", Value::direction(r.transpose() * *ref));
+  // Written back in the feature's frame, as ISO 14649 places a profile.
+  fix(profileInstance, "placement",
+      newPlacement(relative, axis ? profile.vec("axis") : std::nullopt,
+                   profileInstance.ref("placement").ref("ref_direction") ? profile.vec("ref") : std::nullopt));
   if (!outsideComposed) {
     assumed(profileInstance, "placement",
             "origin " + formatTuple({at->x(), at->y(), at->z()}, 4) + " mm and axis " +
@@ -263,11 +269,13 @@ std::optional<std::string> Lowerer::feature(const Instance &f) {
           const Vec3 was = frame.at;
           frame.at += frame.axis * -span->first;
           setPlacement(n, frame);
+          fix(f, "feature_placement", placementAt(f.ref("feature_placement"), frame.at));
           what += ", from where its axis enters it, " + formatTuple({frame.at.x(), frame.at.y(), frame.at.z()}, 4) +
                   " mm (its placement " + formatTuple({was.x(), was.y(), was.z()}, 4) + " mm is inside the raw piece)";
         }
         n.set("depth", Value::length(depth));
         assumed(f, "depth", what);
+        fix(f, "depth", depthPlane(depth));
       } else {
         missing(f, "depth",
                 raw ? "is needed to lower it: the hole's placement is not inside the raw piece, so how deep it goes "

@@ -89,6 +89,7 @@ std::optional<Placement> Lowerer::placement(const Instance &a) {
   } else if (!a.ref("axis") && !a.ref("ref_direction")) {
     // A placement with no location and no directions is its parent frame.
     assumed(a, "location", "absent (and no axis or ref_direction); assumed (0, 0, 0): the frame it is placed in");
+    fix(a, "location", newInstance("CARTESIAN_POINT('',(0.,0.,0.))"));
   } else {
     missing(a, "location");
     return std::nullopt;
@@ -217,6 +218,13 @@ std::optional<Node> Lowerer::profile(const Instance &p) {
     angleOf(n, "first_angle", "first_angle", false);
     length(n, "second_radius", "second_radius", false);
     angleOf(n, "second_angle", "second_angle", false);
+    // Walls at angles the file leaves out are vertical (what the slot's
+    // shape is made with); the write-back says so in the file's angle unit.
+    // A radius left out stays so: the schema's positive length cannot say
+    // a sharp corner.
+    for (std::string_view wall : {"first_angle", "second_angle"})
+      if (!p.real(wall))
+        fix(p, wall, real(90.0 / writtenAngleToDeg_));
   } else if (p.isA("rounded_u_profile")) {
     n.kind = ir::Kind::RoundedUProfile;
     length(n, "width", "width", true);
@@ -265,6 +273,7 @@ std::optional<Node> Lowerer::path(const Instance &t, const PathContext *context)
       // Along the feature's x axis: the direction its frame is written for.
       dir = Vec3::UnitX();
       assumed(t, "its_direction", "absent; assumed (1, 0, 0), the x axis of the feature's frame");
+      fix(t, "its_direction", newInstance("DIRECTION('',(1.,0.,0.))"));
     }
     if (dir)
       line.set("dir", Value::direction(*dir));
@@ -283,6 +292,7 @@ std::optional<Node> Lowerer::path(const Instance &t, const PathContext *context)
                 "absent; assumed " + formatFixed(*length, 4) + " mm, to where the path leaves the raw piece " +
                     hashId(context->raw->block.id()) + " " + std::string(context->raw->block.entityName()) +
                     " (both ends of the slot are open)");
+        fix(t, "distance", tolerancedLength(*length));
       }
     }
     if (length)

@@ -2,9 +2,11 @@
 // operations with their technology, machine functions, strategies and
 // approach/retract, explicit toolpaths; and the tools they use (ISO 14649-111).
 #include "frontend/lowering/Lowerer.h"
+#include "frontend/express/Schema.h"
 #include "ir/Plausible.h"
 #include "support/Format.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <utility>
@@ -84,11 +86,44 @@ bool Lowerer::toolFromUse(const Instance &t, Node &n) {
     return false;
   n.set("type", Value::word(std::string(type)));
   n.set("diameter", Value::length(*diameter));
+  // The body as ISO 14649-111 writes it: the entity of the tool type, its
+  // dimension the diameter; a boring tool also says whether it may retract
+  // with the spindle turning (not forbidden: what the program does).
+  const auto body = std::ranges::find_if(kToolBodies, [&](const auto &b) { return b.second == type; });
+  std::string entity = express::upper(body->first);
+  fix(t, "its_tool_body",
+      newInstance(entity + "(" + newInstance("MILLING_TOOL_DIMENSION(" + real(*diameter) + ",$,$,$,$,$,$)") +
+                  ",$,$,$,$" + (type == "boring_tool" ? ",.F.)" : ")")));
   assumed(t, "its_tool_body",
           "absent (no type, no dimension); assumed from its use by " + hashId(op.id()) + " " +
               std::string(op.entityName()) + ": type " + std::string(type) + ", diameter " +
               formatFixed(*diameter, 4) + " mm (" + why + ")");
   return true;
+}
+
+void Lowerer::writeToolExplicitly(const Instance &t) {
+  // An abstract cutting_tool (binding read it as written) is the milling
+  // cutting tool its body describes: ISO 14649-111 makes drills, taps and
+  // reamers milling cutting tools too. The subtype adds two optional
+  // attributes after the four of cutting_tool.
+  if (t.entityName() == "cutting_tool" && t.parameterIndex("its_tool_body") >= 0) {
+    fixAt(t.id(), -1, "MILLING_CUTTING_TOOL");
+    for (int extra : {4, 5})
+      fixAt(t.id(), extra, "$");
+  }
+  // A cutting edge the file leaves out or lists none of, or one without its
+  // offset length: the tool's overall assembly length is the length from
+  // the gauge line to the tip, which is what the edge's offset length says.
+  const std::optional<double> overall = t.real("overall_assembly_length");
+  if (!overall || *overall <= 0)
+    return;
+  const std::string length = real(*overall);
+  const std::vector<Instance> edges = t.refs("its_cutting_edge");
+  if (edges.empty())
+    fix(t, "its_cutting_edge", "(" + newInstance("CUTTING_COMPONENT(" + length + ",$,$,$,$)") + ")");
+  for (const Instance &edge : edges)
+    if (!edge.real("tool_offset_length") && edge.isA("cutting_component"))
+      fix(edge, "tool_offset_length", length);
 }
 
 std::optional<std::string> Lowerer::tool(const Instance &t) {
@@ -135,6 +170,7 @@ std::optional<std::string> Lowerer::tool(const Instance &t) {
     missing(t, "its_tool_body");
   }
   copyReal(n, "overall_length", t, "overall_assembly_length", Value::length);
+  writeToolExplicitly(t);
   std::vector<Instance> edges = t.refs("its_cutting_edge");
   if (!edges.empty())
     if (auto offset = edges[0].real("tool_offset_length"))
@@ -266,7 +302,10 @@ Node technology(Lowerer &l, const Instance &tech) {
     n.set("spindle", Value::spindle(rpm));
     checkPlausible(l, tech, "spindle", rpm, ir::kPlausibleMinSpindleRpm, ir::kPlausibleMaxSpindleRpm, "rev/min");
   }
-  n.set("feed_reference", Value::word(tech.enumeration("feedrate_reference").value_or("tcp")));
+  const std::optional<std::string> reference = tech.enumeration("feedrate_reference");
+  n.set("feed_reference", Value::word(reference.value_or("tcp")));
+  if (!reference)
+    l.fix(tech, "feedrate_reference", ".TCP.");  // binding said: read as absent (the tool's centre point)
   copyFlag(n, "sync_spindle_feed", tech, "synchronize_spindle_with_feed");
   copyFlag(n, "inhibit_feed_override", tech, "inhibit_feedrate_override");
   copyFlag(n, "inhibit_spindle_override", tech, "inhibit_spindle_override");
@@ -345,6 +384,8 @@ std::optional<Node> Lowerer::operation(const Instance &op) {
   }
   if (Instance mf = op.ref("its_machine_functions"))
     n.add(machineFunctions(mf));
+  else  // binding said: read as absent (no coolant, no chip removal)
+    fix(op, "its_machine_functions", newInstance("MILLING_MACHINE_FUNCTIONS(.F.,$,$,.F.,$,(),.F.,$,$,())"));
   if (Instance strategy = op.ref("its_machining_strategy")) {
     if (strategy.isA("drilling_type_strategy")) {
       Node d(ir::Kind::DrillingStrategy);

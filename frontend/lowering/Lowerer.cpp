@@ -1,6 +1,7 @@
 // Lowering of the program structure: project, workpieces, setups, workplans,
 // workingsteps and NC functions, plus the helpers every lowering file uses.
 #include "frontend/lowering/Lowerer.h"
+#include "frontend/part21/Writer.h"
 #include "ir/Plausible.h"
 #include "ir/Program.h"
 
@@ -59,7 +60,77 @@ void Lowerer::assumed(const Instance &inst, std::string_view attribute, std::str
 
 void Lowerer::fix(const Instance &inst, std::string_view attribute, std::string text) {
   if (const int i = inst.parameterIndex(attribute); i >= 0)
-    (module_ ? module_->sourceFixes : pendingFixes_).push_back({inst.id(), i, std::move(text)});
+    fixAt(inst.id(), i, std::move(text));
+}
+
+void Lowerer::fixAt(uint64_t entityId, int parameter, std::string text) {
+  (module_ ? module_->sourceFixes : pendingFixes_).push_back({entityId, parameter, std::move(text)});
+}
+
+std::string Lowerer::generalTolerance() {
+  // The tightest global_tolerance of a workpiece lowering uses, else the
+  // tolerance toolpaths are verified to without one.
+  double tolerance = ir::kDefaultTolerance;
+  bool given = false;
+  for (size_t i = 0; i < bound_.file().entries().size(); ++i) {
+    const Instance wp(bound_, i);
+    if (!wp.isA("workpiece"))
+      continue;
+    if (auto t = wp.real("global_tolerance"); t && *t > 0 && *t <= ir::kPlausibleMaxTolerance) {
+      tolerance = given ? std::min(tolerance, *t) : *t;
+      given = true;
+    }
+  }
+  const std::string value = real(tolerance);
+  return newInstance("PLUS_MINUS_VALUE(" + value + ',' + value + ",4)");
+}
+
+std::string Lowerer::quoted(std::string_view text) {
+  std::string out;
+  p21::appendString(out, text);
+  return out;
+}
+
+std::string Lowerer::real(double value) {
+  std::string text;
+  p21::appendReal(text, value);
+  return text;
+}
+
+std::string Lowerer::depthPlane(double depth) {
+  const std::string origin = newInstance("CARTESIAN_POINT('',(0.,0.," + real(-depth) + "))");
+  return newInstance("PLANE('depth'," + newInstance("AXIS2_PLACEMENT_3D(''," + origin + ",$,$)") + ")");
+}
+
+std::string Lowerer::tolerancedLength(double value) {
+  return newInstance("TOLERANCED_LENGTH_MEASURE(" + real(value) + "," + generalTolerance() + ")");
+}
+
+std::string Lowerer::placementAt(const Instance &original, const Vec3 &at) {
+  Instance axis = original.ref("axis"), ref = original.ref("ref_direction");
+  if (swapAxisAndRef_ && axis && ref)
+    std::swap(axis, ref);
+  const std::string point =
+      newInstance("CARTESIAN_POINT('',(" + real(at.x()) + "," + real(at.y()) + "," + real(at.z()) + "))");
+  return newInstance("AXIS2_PLACEMENT_3D(''," + point + "," + (axis ? hashId(axis.id()) : "$") + "," +
+                     (ref ? hashId(ref.id()) : "$") + ")");
+}
+
+std::string Lowerer::newPlacement(const Vec3 &at, const std::optional<Vec3> &axis, const std::optional<Vec3> &ref) {
+  auto triple = [](const Vec3 &v) { return "(" + real(v.x()) + "," + real(v.y()) + "," + real(v.z()) + ")"; };
+  auto direction = [&](const std::optional<Vec3> &d) {
+    return d ? newInstance("DIRECTION(''," + triple(*d) + ")") : std::string("$");
+  };
+  return newInstance("AXIS2_PLACEMENT_3D(''," + newInstance("CARTESIAN_POINT(''," + triple(at) + ")") + "," +
+                     direction(axis) + "," + direction(ref) + ")");
+}
+
+std::string Lowerer::newInstance(std::string text) {
+  std::vector<std::string> &instances = module_ ? module_->sourceInstances : pendingInstances_;
+  auto it = std::find(instances.begin(), instances.end(), text);
+  if (it == instances.end())
+    it = instances.insert(instances.end(), std::move(text));
+  return "#@" + std::to_string(it - instances.begin());
 }
 
 std::string Lowerer::symbolFor(char sigil, const std::optional<std::string> &label, std::string_view fallback) {
@@ -127,7 +198,7 @@ std::optional<std::string> Lowerer::workpiece(const Instance &wp) {
     // The verifier checks toolpaths to this tolerance; a value no machined
     // part is toleranced to (some generators write 50 mm) would let it pass
     // gouges and uncut floors.
-    constexpr double kMaxTolerance = 1.0;  // mm
+    constexpr double kMaxTolerance = ir::kPlausibleMaxTolerance;
     if (*tol > 0 && *tol <= kMaxTolerance)
       node.set("global_tolerance", Value::length(*tol));
     else {
@@ -345,10 +416,33 @@ constexpr std::pair<std::string_view, std::string_view> kAngles[] = {
 
 } // namespace
 
+namespace {
+
+/// The value that, multiplied by `factor`, gives exactly `target` (a few
+/// units in the last place either side of the quotient searched), else the
+/// quotient: what a converted value is written as so that reading it back
+/// gives the value used.
+double readsBackAs(double target, double factor) {
+  const double guess = target / factor;
+  double up = guess, down = guess;
+  for (int i = 0; i <= 4; ++i) {
+    if (up * factor == target)
+      return up;
+    if (down * factor == target)
+      return down;
+    up = std::nextafter(up, INFINITY);
+    down = std::nextafter(down, -INFINITY);
+  }
+  return guess;
+}
+
+} // namespace
+
 void Lowerer::chooseAngleUnit(const std::vector<Instance> &withAngles) {
   using Angle = UnitConventions::Angle;
   if (options_.units.angles != Angle::Auto) {
     angleToDeg_ = options_.units.angles == Angle::Radian ? 180 / std::numbers::pi : 1.0;
+    writtenAngleToDeg_ = angleToDeg_;  // the unit an option gives stays the file's
     return;
   }
   // Radians when every angle is below 2 pi and none is a whole number of
@@ -376,6 +470,12 @@ void Lowerer::chooseAngleUnit(const std::vector<Instance> &withAngles) {
   if (!example)
     return;
   angleToDeg_ = 180 / std::numbers::pi;
+  // The write-back writes every angle in degrees (ir::SourceFix).
+  for (const Instance &inst : withAngles)
+    for (const auto &[entity, attribute] : kAngles)
+      if (inst.isA(entity))
+        if (std::optional<double> v = inst.real(attribute))
+          fix(inst, attribute, real(readsBackAs(*v * angleToDeg_, 1.0)));
   const auto &[inst, attribute] = *example;
   diags_
       .assumption(inst.attrLoc(attribute),
@@ -506,6 +606,23 @@ void Lowerer::chooseSpeedUnits(const std::vector<Instance> &operations) {
            [&](const SpeedValue &, double vc) { return plausibleCutspeed(std::abs(vc)); });
   if (u.rotSpeedToRevPerMin <= 0)
     report(spindles, kSpindleReadings[spindle], kSpindleReadings[0], "spindle speeds", "rev/min", plausibleSpindle);
+  // The write-back writes a quantity whose reading was assumed in the
+  // standard's unit, every value converted: read again, the file needs no
+  // assumption. A reading an option gave stays the file's.
+  writtenUnits_ = {feedToMmPerMin_, cutspeedToMmPerMin_, spindleToRevPerMin_};
+  auto convert = [&](const std::vector<SpeedValue> &values, double option, double chosen, double standard,
+                     double &written) {
+    if (option > 0 || chosen == standard)
+      return;
+    written = standard;
+    for (const SpeedValue &v : values)
+      fix(v.tech, v.attribute, real(readsBackAs(v.value * chosen, standard)));
+  };
+  convert(feeds, u.feedToMmPerMin, feedToMmPerMin_, kSpeedReadings[0].factor, writtenUnits_.feedToMmPerMin);
+  convert(cutspeeds, u.cutspeedToMmPerMin, cutspeedToMmPerMin_, kSpeedReadings[0].factor,
+          writtenUnits_.cutspeedToMmPerMin);
+  convert(spindles, u.rotSpeedToRevPerMin, spindleToRevPerMin_, kSpindleReadings[0].factor,
+          writtenUnits_.spindleToRevPerMin);
   // A spindle speed that no reading makes plausible with the others: say
   // what it gives on its tool (feeds and cutting speeds are checked as they
   // are lowered).
@@ -598,9 +715,10 @@ std::unique_ptr<ir::Module> Lowerer::run() {
   choosePlacementReading(placements);
   module_ = std::make_unique<ir::Module>();
   module_->sourceName = std::string(bound_.file().source().name());
-  module_->sourceUnits = {feedToMmPerMin_, cutspeedToMmPerMin_, spindleToRevPerMin_};
+  module_->sourceUnits = writtenUnits_;
+  module_->sourceInstances = std::move(pendingInstances_);  // what pendingFixes_ refer to
   for (const binding::BoundFile::Fix &f : bound_.fixes())
-    module_->sourceFixes.push_back({f.id, f.parameter, f.text});
+    module_->sourceFixes.push_back({f.id, f.parameter, f.generalTolerance ? generalTolerance() : f.text});
   module_->sourceFixes.insert(module_->sourceFixes.end(), pendingFixes_.begin(), pendingFixes_.end());
   Instance main;
   if (projects.empty()) {
@@ -658,6 +776,23 @@ std::unique_ptr<ir::Module> Lowerer::run() {
   module_->root.children = std::move(ordered);
   if (plan)
     module_->root.add(std::move(*plan));
+  if (projects.empty()) {
+    // Said above; the write-back writes the project it took the file for.
+    std::set<uint64_t> workpieces;
+    for (const Node &c : module_->root.children)
+      if (c.kind == ir::Kind::Workpiece && c.origin.entityId)
+        workpieces.insert(c.origin.entityId);
+    std::string list;
+    for (uint64_t id : workpieces)
+      list += (list.empty() ? "" : ",") + hashId(id);
+    newInstance("PROJECT(" + quoted(main.string("its_id").value_or("")) + "," + hashId(main.id()) + ",(" + list +
+                "),$,$,$)");
+  }
+  // Tools no operation uses: what the file leaves implicit of them is
+  // written too, so that the written file reads without assumptions.
+  for (size_t i = 0; i < entries.size(); ++i)
+    if (const Instance t(bound_, i); t.isA("cutting_tool") && !lowered_.count(i))
+      writeToolExplicitly(t);
   return std::move(module_);
 }
 

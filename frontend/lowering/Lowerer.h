@@ -96,6 +96,33 @@ public:
   /// `attribute` of `inst`, for the machine-optimised STEP-NC to write
   /// (ir::SourceFix); nothing for a complex instance.
   void fix(const Instance &inst, std::string_view attribute, std::string text);
+  /// The same by parameter index (-1: the entity name; one past the last
+  /// parameter: appended) of a simple instance.
+  void fixAt(uint64_t entityId, int parameter, std::string text);
+  /// What the write-back writes of tool `t` that the file leaves implicit:
+  /// the milling subtype of an abstract cutting_tool, a cutting edge and its
+  /// offset length from the tool's overall length.
+  void writeToolExplicitly(const Instance &t);
+  /// A new instance for the machine-optimised STEP-NC to write, `ENTITY(...)`
+  /// (ir::Module::sourceInstances); returns the reference to it a fix or a
+  /// later new instance uses ("#@3"). The same text is one instance.
+  std::string newInstance(std::string text);
+  /// The general tolerance as a new plus_minus_value (newInstance): what a
+  /// toleranced length without a tolerance is read as (binding's tally).
+  std::string generalTolerance();
+  /// A new depth plane `depth` mm below a feature's origin (newInstance).
+  std::string depthPlane(double depth);
+  /// A new toleranced length of `value` mm with the general tolerance.
+  std::string tolerancedLength(double value);
+  /// A new axis2_placement_3d at `at` with the directions of `original`
+  /// (as lowering reads them: swapped back where the file swaps them).
+  std::string placementAt(const Instance &original, const Vec3 &at);
+  /// A new axis2_placement_3d at `at` with new directions (`$` for none).
+  std::string newPlacement(const Vec3 &at, const std::optional<Vec3> &axis, const std::optional<Vec3> &ref);
+  /// `value` as a Part 21 real.
+  static std::string real(double value);
+  /// `text` as a Part 21 string.
+  static std::string quoted(std::string_view text);
   /// A fresh symbol with `sigil`, from a STEP-NC id string or a fallback.
   std::string symbolFor(char sigil, const std::optional<std::string> &label, std::string_view fallback);
   /// Sets origin and label from an instance.
@@ -233,6 +260,7 @@ private:
   std::set<std::pair<size_t, std::string>> secplanesAssumed_;  ///< (plane, face) reported once
   int64_t workOffsets_ = 1;                  ///< work offsets used: the file's own is 1
   std::vector<ir::SourceFix> pendingFixes_;  ///< fix() before the module exists
+  std::vector<std::string> pendingInstances_;  ///< newInstance() before the module exists
   std::vector<Instance> projectWorkpieces_;  ///< the project's its_workpieces
   double angleToDeg_ = 1.0;                  ///< plane_angle_measure to deg
   bool swapAxisAndRef_ = false;              ///< choosePlacementReading
@@ -243,6 +271,12 @@ private:
   double feedToMmPerMin_ = 60000.0;          ///< a technology's feedrate to mm/min
   double cutspeedToMmPerMin_ = 60000.0;      ///< its cutspeed to mm/min
   double spindleToRevPerMin_ = 60.0;         ///< its spindle to rev/min
+  /// The units the write-back writes speeds in: the reading's, except where
+  /// the reading was assumed (then the standard's, every value converted).
+  ir::SourceUnits writtenUnits_;
+  /// Angles the write-back writes to deg: the reading's, except where
+  /// radians were assumed (then every angle is converted to degrees).
+  double writtenAngleToDeg_ = 1.0;
 };
 
 } // namespace stepnc::lowering
