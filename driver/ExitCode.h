@@ -1,6 +1,6 @@
 // How a driver step ends, as the command line's exit status: one contract
 // for every stepnc command (README: 0 success, 1 the input has errors, 2 usage
-// or I/O).
+// or I/O, 3 a defect of stepnc).
 #pragma once
 
 namespace stepnc::driver {
@@ -11,6 +11,7 @@ enum ExitCode : int {
   kExitOk = 0,          ///< success; warnings allowed
   kExitDiagnostics = 1, ///< the input has errors
   kExitUsage = 2,       ///< bad command line, or a file could not be read or written
+  kExitInternal = 3,    ///< an exception no step caught: a defect of stepnc, said, never an abort
 };
 
 } // namespace stepnc::driver

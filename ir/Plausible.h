@@ -17,6 +17,15 @@ inline constexpr double kPlausibleMinSpindleRpm = 1;
 inline constexpr double kPlausibleMaxSpindleRpm = 100000;
 /// Feed per tooth, at most this share of the tool's diameter.
 inline constexpr double kPlausibleChipLoadShare = 0.1;
+/// The largest magnitudes an IR value can have and still mean something on
+/// a machine tool: no machine travels 100 m, dwells for days or turns a
+/// spindle at a million rev/min. The IR verifier refuses values beyond
+/// them, so that no pass computes with 1e308 (overflow to inf, endless
+/// loops) whatever a file says.
+inline constexpr double kMaxLengthMm = 1e5;
+inline constexpr double kMaxAngleDeg = 1e5;
+inline constexpr double kMaxTimeS = 1e6;
+inline constexpr double kMaxRate = 1e7;  ///< mm/min, rev/min, W, g/min
 /// mm: a workpiece's global_tolerance above this is no machining tolerance
 /// (some generators write 50 mm); lowering does not use it.
 inline constexpr double kPlausibleMaxTolerance = 1.0;

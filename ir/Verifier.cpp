@@ -4,6 +4,7 @@
 // few rules the kind table cannot express (which kind a reference must name,
 // which children an operation has at most one of) are tables here.
 #include "ir/Verifier.h"
+#include "ir/Plausible.h"
 
 #include "ir/Printer.h"
 #include "support/Format.h"
@@ -12,6 +13,7 @@
 #include <iterator>
 #include <cmath>
 #include <unordered_map>
+#include <vector>
 
 namespace stepnc::ir {
 
@@ -128,14 +130,21 @@ private:
 
   DiagnosticEngine &diags_;
   std::unordered_map<std::string_view, const Node *> symbols_;
+  std::vector<const Node *> enclosing_;  ///< the nodes checkNode is inside, outermost first
   unsigned errors_ = 0;
 };
 
 InFlightDiagnostic Verifier::report(const Node &n, const std::string &message) {
   ++errors_;
-  InFlightDiagnostic d = diags_.error(n.origin.loc, nameOf(n) + ": " + message);
-  if (n.origin.entityId != 0)
-    d.entity(n.origin.entityId);
+  // A node made without a place of its own (a technology lowering built
+  // from several instances) is reported where its nearest placed
+  // enclosing node is.
+  const Origin *origin = &n.origin;
+  for (auto it = enclosing_.rbegin(); !origin->loc.valid() && it != enclosing_.rend(); ++it)
+    origin = &(*it)->origin;
+  InFlightDiagnostic d = diags_.error(origin->loc, nameOf(n) + ": " + message);
+  if (origin->entityId != 0)
+    d.entity(origin->entityId);
   return d;
 }
 
@@ -200,8 +209,10 @@ void Verifier::checkNode(const Node &n, const KindSpec *parent, bool isRoot) {
     checkToolFit(n);
   if (n.comment.find('\n') != std::string::npos)
     report(n, "the comment has a line break, expected one line");
+  enclosing_.push_back(&n);
   for (const Node &c : n.children)
     checkNode(c, &spec, false);
+  enclosing_.pop_back();
 }
 
 /// Below the root: never `project`, other kinds only where their parent's spec allows them.
@@ -249,12 +260,55 @@ void Verifier::checkAttrs(const Node &n, const KindSpec &spec) {
   }
 }
 
-/// Numbers finite, directions of unit length, dimensions positive.
+namespace {
+
+/// The largest magnitude a value of type `t` may have (ir/Plausible.h);
+/// none for counts, words and unit-less numbers.
+std::optional<double> magnitudeBound(ValueType t) {
+  switch (t) {
+  case ValueType::Length:
+  case ValueType::Point: return kMaxLengthMm;
+  case ValueType::Angle: return kMaxAngleDeg;
+  case ValueType::Time: return kMaxTimeS;
+  case ValueType::Feed:
+  case ValueType::Spindle:
+  case ValueType::Power:
+  case ValueType::MassFlow: return kMaxRate;
+  default: return std::nullopt;
+  }
+}
+
+std::string_view unitOf(ValueType t) {
+  switch (t) {
+  case ValueType::Angle: return "deg";
+  case ValueType::Time: return "s";
+  case ValueType::Feed: return "mm/min";
+  case ValueType::Spindle: return "rev/min";
+  case ValueType::Power: return "W";
+  case ValueType::MassFlow: return "g/min";
+  default: return "mm";
+  }
+}
+
+} // namespace
+
+/// Numbers finite and within what a machine does, directions of unit
+/// length, dimensions positive.
 void Verifier::checkValue(const Node &n, const Attr &a) {
   const Value &v = a.value;
   auto attr = [&] { return attribute(a.name); };
   if (isNumber(v.type) && !std::isfinite(v.number))
     report(n, attr() + " must be a finite number, found " + formatShortest(v.number));
+  else if (const std::optional<double> bound = magnitudeBound(v.type);
+           bound && (std::abs(v.number) > *bound || v.vec.cwiseAbs().maxCoeff() > *bound)) {
+    Eigen::Index at = 0;
+    v.vec.cwiseAbs().maxCoeff(&at);
+    const double beyond = v.type == ValueType::Point ? v.vec[at] : v.number;
+    const std::string unit(unitOf(v.type));
+    report(n, attr() + (v.type == ValueType::Point ? std::string(" has the coordinate ") : std::string(" is ")) +
+                  formatShortest(beyond) + " " + unit + ", beyond what a machine tool does (at most " +
+                  formatShortest(*bound) + " " + unit + " either way)");
+  }
   else if (v.type == ValueType::Length && isDimension(a.name) && (isRadius(a.name) ? v.number < 0 : v.number <= 0))
     report(n, attr() + (isRadius(a.name) ? " must not be negative" : " must be positive") + ", found " + printed(v));
   else if (v.type == ValueType::Reals &&

@@ -1,12 +1,76 @@
 #include "support/OutputFile.h"
 
 #include <cerrno>
+#include <csignal>
 #include <cstdlib>
+#include <signal.h>
 #include <sys/stat.h>
 #include <cstring>
 #include <unistd.h>
 
 namespace stepnc {
+
+namespace {
+
+// Temporary files that are open, for the signal handler to remove: a kill
+// (SIGTERM, as `timeout` sends; SIGINT, Ctrl-C; SIGHUP) must not leave a
+// `.tmp.XXXXXX` beside the target. Fixed slots of fixed size, because a
+// handler may only touch memory that needs no allocation or lock; a slot is
+// published by setting `used` last and retired by clearing it first.
+constexpr int kSlots = 16;
+constexpr size_t kPathMax = 4096;
+struct Slot {
+  volatile std::sig_atomic_t used = 0;
+  char path[kPathMax] = {};
+};
+Slot gSlots[kSlots];
+
+extern "C" void removeTemporariesAndDie(int sig) {
+  for (Slot &slot : gSlots)
+    if (slot.used)
+      ::unlink(slot.path);  // async-signal-safe
+  std::signal(sig, SIG_DFL);
+  std::raise(sig);  // end as the signal would have: the caller sees it
+}
+
+void installHandlers() {
+  static bool installed = false;
+  if (installed)
+    return;
+  installed = true;
+  for (int sig : {SIGTERM, SIGINT, SIGHUP}) {
+    struct sigaction action {};
+    action.sa_handler = removeTemporariesAndDie;
+    sigemptyset(&action.sa_mask);
+    // A signal the caller chose to ignore (nohup) stays ignored.
+    struct sigaction before {};
+    if (::sigaction(sig, nullptr, &before) == 0 && before.sa_handler == SIG_IGN)
+      continue;
+    ::sigaction(sig, &action, nullptr);
+  }
+}
+
+/// The slot that now holds `path`, or -1 when none is free or it is too long
+/// (the file is still removed on every ordinary exit, only not on a kill).
+int track(const std::string &path) {
+  if (path.size() >= kPathMax)
+    return -1;
+  installHandlers();
+  for (int i = 0; i < kSlots; ++i)
+    if (!gSlots[i].used) {
+      std::memcpy(gSlots[i].path, path.c_str(), path.size() + 1);
+      gSlots[i].used = 1;
+      return i;
+    }
+  return -1;
+}
+
+void untrack(int slot) {
+  if (slot >= 0)
+    gSlots[slot].used = 0;
+}
+
+} // namespace
 
 OutputFile::~OutputFile() { discard(); }
 
@@ -80,6 +144,7 @@ bool OutputFile::open(const std::string &path, std::string &error) {
     tempPath_.clear();
     return false;
   }
+  slot_ = track(tempPath_);
   // A buffer of its own: several output files may be open at once.
   buffer_ = std::make_unique<char[]>(kBufferSize);
   std::setvbuf(file_, buffer_.get(), _IOFBF, kBufferSize);
@@ -135,6 +200,8 @@ bool OutputFile::commit(std::string &error) {
     discard();
     return false;
   }
+  untrack(slot_);
+  slot_ = -1;
   tempPath_.clear();
   return true;
 }
@@ -144,6 +211,8 @@ void OutputFile::discard() {
     std::fclose(file_);
   file_ = nullptr;
   if (!tempPath_.empty()) {
+    untrack(slot_);
+    slot_ = -1;
     ::unlink(tempPath_.c_str());
     tempPath_.clear();
   }

@@ -4,7 +4,8 @@
 // exists and is not a regular file (a device such as /dev/null, a FIFO) is
 // written directly, since renaming over it would replace the device. A
 // read-only target is refused rather than renamed over; a replaced file keeps
-// its permissions.
+// its permissions. SIGTERM, SIGINT and SIGHUP remove the temporary files
+// that are open before the process ends by the signal.
 #pragma once
 
 #include <cstdio>
@@ -49,6 +50,7 @@ private:
   std::FILE *file_ = nullptr;
   bool isStdout_ = false;
   bool direct_ = false;  ///< writing straight to a device or FIFO
+  int slot_ = -1;        ///< where a kill's handler finds tempPath_ (OutputFile.cpp)
 };
 
 } // namespace stepnc

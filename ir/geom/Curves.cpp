@@ -182,6 +182,15 @@ private:
       if (!axisAlongZ(*basis, positive, result.error))
         return;
       const Vec3 c = *basis->vec("at");
+      const double radius = basis->number("radius").value_or(0);
+      for (const Vec3 &end : {a, b})
+        if (const double off = (end - c).head<2>().norm() - radius; std::abs(off) > kArcEndTolerance) {
+          fail("the trimmed " + basis->kindName() + " ends at (" + formatFixed(end.x(), 4) + ", " +
+               formatFixed(end.y(), 4) + ") mm, " + formatFixed(std::abs(off), 4) + " mm " +
+               (off > 0 ? "outside" : "inside") + " its circle of radius " + formatFixed(radius, 4) +
+               " mm (more than " + formatShortest(kArcEndTolerance) + " mm): no arc has both ends there");
+          return;
+        }
       const bool ccw = positive == alongBasis;
       int64_t turns = 0;
       if (basis->kind == ir::Kind::Helix) {

@@ -30,6 +30,11 @@ struct CurvePiece {
 /// How far a B-spline's chords may stray from the curve, mm: a tenth of the
 /// verifier's default tolerance.
 inline constexpr double kSplineChordTolerance = 0.001;
+/// mm an arc's ends may lie off its circle (the circle's radius from its
+/// centre, measured in its plane): what a file's rounding of its points
+/// gives. Further off, the arc is refused: every target would have to move
+/// its centre or an end, each its own way (LinuxCNC refuses it).
+inline constexpr double kArcEndTolerance = 0.001;
 
 /// A B-spline curve node (ISO 10303-42: uniform, quasi-uniform, Bezier or
 /// with knots; rational with weights on its points) as a function of its

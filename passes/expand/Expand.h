@@ -58,6 +58,13 @@ inline constexpr double kDefaultScallopHeight = 0.01;
 /// the operation's overcut is smaller (mm).
 inline constexpr double kBreakthrough = 1.0;
 
+/// The most depth levels and radial passes (rings or strokes per level) a
+/// step is planned with: more come only from a depth of cut or stepover far
+/// too small for the feature (a micrometre on a pocket), and would plan for
+/// hours; such a step is a located error instead.
+inline constexpr int kMaxLevels = 2000;
+inline constexpr int kMaxRadialPasses = 2000;
+
 /// A plane point at height z.
 inline Vec3 at(const Vec2 &p, double z) { return {p.x(), p.y(), z}; }
 

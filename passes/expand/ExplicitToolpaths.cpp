@@ -440,14 +440,15 @@ void settleExplicitRapids(Expander &x) {
   }
 
   // A canned cycle's clearance plane (its R plane) within the stock: raised
-  // above it, where the cycle's rapids to the plane then end.
+  // above it, where the cycle's rapids to the plane then end, and its feed
+  // out of the hole (a reamer or boring bar leaves at feed up to the R plane).
   for (auto &[constCycle, raise] : raisedCycles) {
     Node &cycle = *const_cast<Node *>(constCycle);  // the pass's own module
     const double old = cycle.number("clearance").value_or(raise.z);
     if (raise.z <= old)
       continue;
     for (Node &c : cycle.children)
-      if (c.kind == ir::Kind::Rapid)
+      if (c.kind == ir::Kind::Rapid || c.kind == ir::Kind::Linear)
         if (const Vec3 to = *c.vec("to"); std::abs(to.z() - old) < 1e-9)
           c.set("to", ir::Value::point(Vec3(to.x(), to.y(), raise.z)));
     cycle.set("clearance", ir::Value::length(raise.z));

@@ -82,7 +82,19 @@ std::vector<double> levelsOf(Expander &x, const Node &ws, const Node &op, const 
     return {};
   }
   const double ap = op.number("axial_depth").value_or(0);
-  const int count = ap > 1e-9 ? std::max(1, static_cast<int>(std::ceil((s.top - floorZ) / ap - 1e-9))) : 1;
+  const double depth = s.top - floorZ;
+  if (ap < 0 || (ap > 0 && depth / ap > kMaxLevels)) {
+    // A depth of cut that makes more levels than any part is cut in (a
+    // micrometre on a pocket) would plan for hours: refused, not cut in one.
+    x.report(ws, "axial_depth " + formatShortest(ap) + " mm " +
+                     (ap < 0 ? std::string("is negative")
+                             : "makes " + formatShortest(std::ceil(depth / ap)) + " levels over the " +
+                                   formatFixed(depth, 4) + " mm to cut of " + s.symbol + ", more than the " +
+                                   std::to_string(kMaxLevels) + " stepnc plans") +
+                     ": give a larger depth of cut");
+    return {};
+  }
+  const int count = ap > 0 ? std::max(1, static_cast<int>(std::ceil(depth / ap - 1e-9))) : 1;
   std::vector<double> out;
   for (int i = 1; i <= count; ++i)
     out.push_back(s.top - (s.top - floorZ) * i / count);
@@ -124,6 +136,17 @@ bool planLevel(Expander &x, const Step &step, const ir::FeatureShape &s, const P
   const std::string &type = ls.type;
   out.centres = centreArea(s, s.unbounded ? s.target : s.limit, islands, p);
   out.paths.clear();
+  if (!out.centres.empty()) {
+    const geom::Box box = out.centres.box();
+    const double across = std::max(box.hi.x() - box.lo.x(), box.hi.y() - box.lo.y());
+    if (across / ls.stepover > kMaxRadialPasses) {
+      x.report(ws, "a stepover of " + formatShortest(ls.stepover) + " mm makes about " +
+                       formatShortest(std::ceil(across / ls.stepover)) + " passes across the " +
+                       formatFixed(across, 4) + " mm of " + s.symbol + " the tool's centre covers, more than the " +
+                       std::to_string(kMaxRadialPasses) + " stepnc plans: give a larger radial depth of cut");
+      return false;
+    }
+  }
   // Center milling, and slots exactly as wide as the tool: along the course of travel.
   if (s.slot && (type == "center_milling" || out.centres.empty())) {
     std::optional<Path2D> line = slotCentreline(*s.slot, p);

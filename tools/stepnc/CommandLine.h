@@ -20,6 +20,7 @@ class App;
 namespace stepnc::tool {
 
 using driver::kExitDiagnostics;
+using driver::kExitInternal;
 using driver::kExitOk;
 using driver::kExitUsage;
 

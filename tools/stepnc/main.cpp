@@ -3,7 +3,9 @@
 #include "tools/stepnc/Commands.h"
 
 #include <CLI/CLI.hpp>
+#include <exception>
 #include <iostream>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -14,7 +16,7 @@ int main(int argc, char **argv) {
                "stepnc");
   app.require_subcommand(1);
   app.set_version_flag("--version", "stepnc 0.1.0");
-  app.footer("Exit status: 0 success, 1 the input has errors, 2 usage or I/O error.");
+  app.footer("Exit status: 0 success, 1 the input has errors, 2 usage or I/O error, 3 an internal error.");
   int result = kExitOk;
   auto setResult = [&result](int r) { result = r; };
   registerCompile(app, setResult);
@@ -55,6 +57,15 @@ int main(int argc, char **argv) {
   } catch (const CLI::ParseError &e) {
     app.exit(e);
     return kExitUsage;
+  } catch (const std::bad_alloc &) {
+    // What a pass could not bound ahead (they refuse, located, what they can).
+    printToolError("out of memory: the input asks for more work than this machine holds; nothing written");
+    return kExitDiagnostics;
+  } catch (const std::exception &e) {
+    // A defect of stepnc, not of the input: said, never an abort.
+    printToolError(std::string("internal error: ") + e.what() +
+                   "; nothing written (please report it with the input)");
+    return kExitInternal;
   }
   return result;
 }

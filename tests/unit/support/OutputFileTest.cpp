@@ -4,7 +4,10 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <csignal>
 #include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 using namespace stepnc;
 namespace fs = std::filesystem;
@@ -155,4 +158,29 @@ TEST_CASE("a replaced file keeps its permissions", "[support]") {
   REQUIRE(::stat(target.c_str(), &st) == 0);
   CHECK((st.st_mode & 07777) == 0640);
   fs::remove_all(dir);
+}
+
+TEST_CASE("a kill while writing leaves no temporary file", "[support]") {
+  // In a child, so that the signal ends the child and not the test run.
+  for (int sig : {SIGTERM, SIGINT}) {
+    const fs::path dir = scratchDir() / ("killed-" + std::to_string(sig));
+    fs::create_directories(dir);
+    const pid_t child = ::fork();
+    REQUIRE(child >= 0);
+    if (child == 0) {
+      OutputFile out;
+      std::string error;
+      if (!out.open((dir / "out.ngc").string(), error))
+        ::_exit(3);
+      out.write("partial");
+      ::kill(::getpid(), sig);
+      ::_exit(4);  // not reached: the signal ends the child
+    }
+    int status = 0;
+    REQUIRE(::waitpid(child, &status, 0) == child);
+    CHECK(WIFSIGNALED(status));
+    CHECK(WTERMSIG(status) == sig);
+    CHECK(fs::is_empty(dir));  // neither the target nor its .tmp.XXXXXX
+    fs::remove_all(dir);
+  }
 }
