@@ -10,6 +10,10 @@
 //           (up, or down into the free space above the feature); the first
 //           move a rapid up to the security plane; the spindle turning while
 //           feeding;
+//   reach   the material a step's feed moves meet stands no higher above
+//           the tool's tip than its overall length (else the holder hits:
+//           error) and its cutting edge length (else the shank rubs:
+//           warning), on the in-process stock;
 //   depth   no move below the floor (bottom + allowance_bottom; through
 //           bottoms allow the tool's point and an overcut);
 //   gouge   the disc swept by feed moves below the feature's top stays in
@@ -314,10 +318,50 @@ private:
     }
     const double tol = tolerance_.value_or(kDefaultTolerance);
     walkStock(module_, rapidCheckCell(module_), [&](const StockMove &sm) {
-      if (sm.move->kind == ir::MoveKind::Rapid)
+      if (sm.move->kind == ir::MoveKind::Rapid) {
         if (std::optional<StockHit> hit = rapidMeetsStock(*sm.stock, *sm.move, sm.radius, sm.point, tol))
           stockHits_.emplace(sm.move->node, std::pair(*hit, *sm.move->from));
+      } else if (sm.move->isFeed()) {
+        // How high the material the tool's disc meets stands above its tip
+        // (the chord of an arc): what its flutes, then its body and holder,
+        // must clear.
+        const Vec2 a = sm.move->from->head<2>(), b = sm.move->to.head<2>();
+        const cutting::HeightMap::Peak peak = sm.stock->highest(a, b, std::max(0.0, sm.radius - sm.stock->cell()));
+        const double engaged = peak.height - std::min(sm.move->from->z(), sm.move->to.z());
+        Reach &r = reach_[sm.executable];
+        if (engaged > r.engaged)
+          r = {engaged, Vec3(peak.at.x(), peak.at.y(), peak.height), sm.move->node};
+      }
     });
+  }
+
+  /// The tool's flutes and length against the material its feed moves meet
+  /// (walkProgram): a tool whose holder would meet the stock (it meets
+  /// material higher above its tip than its overall length) is an error; one
+  /// whose shank would rub it (higher than its cutting edge length) a
+  /// warning: tools with a neck relieved behind the flutes clear it, and
+  /// ISO 14649-111 does not say which have one.
+  void checkReach(const Step &s) {
+    const auto it = reach_.find(s.exec);
+    if (it == reach_.end() || !s.tool)
+      return;
+    const Reach &r = it->second;
+    const std::optional<double> flutes = s.tool->number("cutting_edge_length");
+    const std::optional<double> overall = s.tool->number("overall_length");
+    const std::string where = " stands " + mm(r.engaged) + " above the tool's tip (at " + pointText(r.at) + ")";
+    if (overall && r.engaged > *overall + s.tol) {
+      report(s,
+             {{r.move, "the material its tool " + s.tool->symbol + " meets" + where +
+                           ", more than its overall length " + mm(*overall) +
+                           ": the holder or spindle would hit the stock; a longer tool reaches it"}},
+             "holder collisions");
+    } else if (flutes && r.engaged > *flutes + s.tol) {
+      report(s,
+             {{r.move, "the material its tool " + s.tool->symbol + " meets" + where +
+                           ", more than its cutting edge length " + mm(*flutes) +
+                           ": the shank above the flutes would rub it (unless the tool is necked)"}},
+             "shank rubs", /*warning=*/true);
+    }
   }
 
   void visit(ir::Node &n) {
@@ -335,6 +379,7 @@ private:
     Step s = prepare(exec, movesNode);
     std::string reason = locate(s);
     checkSafety(s);
+    checkReach(s);
     if (s.shape) {
       try {
         checkShape(s);
@@ -1072,6 +1117,14 @@ private:
   std::map<const ir::Node *, Vec3> starts_;         ///< steps that go on from the step before
   /// Rapids that meet the stock, by move: where, and where the rapid starts.
   std::map<const ir::Node *, std::pair<StockHit, Vec3>> stockHits_;
+  /// Per executable, the highest material its feed moves meet above the
+  /// tool's tip, where, and the move (walkProgram).
+  struct Reach {
+    double engaged = 0;
+    Vec3 at = Vec3::Zero();
+    const ir::Node *move = nullptr;
+  };
+  std::map<const ir::Node *, Reach> reach_;
   std::map<std::string, ir::ShapeResult> shapes_;
   std::map<std::string, std::vector<Floor>> floors_;
   RegionCache cache_;
