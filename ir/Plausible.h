@@ -26,6 +26,9 @@ inline constexpr double kMaxLengthMm = 1e5;
 inline constexpr double kMaxAngleDeg = 1e5;
 inline constexpr double kMaxTimeS = 1e6;
 inline constexpr double kMaxRate = 1e7;  ///< mm/min, rev/min, W, g/min
+/// s: the shortest dwell a controller resolves (G4 P0.001); a time between
+/// 0 and this is no dwell a program can say, refused rather than dropped.
+inline constexpr double kMinDwellS = 0.001;
 /// mm: a workpiece's global_tolerance above this is no machining tolerance
 /// (some generators write 50 mm); lowering does not use it.
 inline constexpr double kPlausibleMaxTolerance = 1.0;

@@ -309,6 +309,10 @@ void Verifier::checkValue(const Node &n, const Attr &a) {
                   formatShortest(beyond) + " " + unit + ", beyond what a machine tool does (at most " +
                   formatShortest(*bound) + " " + unit + " either way)");
   }
+  else if (v.type == ValueType::Time && (n.kind == Kind::Dwell || a.name.starts_with("dwell")) && v.number > 0 &&
+           v.number < kMinDwellS)
+    report(n, attr() + " is " + formatShortest(v.number) + " s, shorter than a controller dwells (" +
+                  formatShortest(kMinDwellS) + " s): give 0 for none");
   else if (v.type == ValueType::Length && isDimension(a.name) && (isRadius(a.name) ? v.number < 0 : v.number <= 0))
     report(n, attr() + (isRadius(a.name) ? " must not be negative" : " must be positive") + ", found " + printed(v));
   else if (v.type == ValueType::Reals &&
