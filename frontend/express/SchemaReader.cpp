@@ -598,6 +598,37 @@ private:
   antlr4::Parser &parser_;
 };
 
+// Thrown by BoundedErrorStrategy to stop a parse that keeps recovering.
+struct TooManySyntaxErrors {
+  antlr4::Token *at;
+};
+
+// ANTLR's error recovery, stopped after kMaxSyntaxRecoveries recoveries.
+// Each computes the follow sets of every rule in progress, so on deeply
+// nested garbage one recovery costs thousands of set operations, and the
+// parser kept recovering long after the diagnostics had stopped (a 77 KB
+// mutant took 25 s). Everything after the first error only adds messages.
+class BoundedErrorStrategy final : public antlr4::DefaultErrorStrategy {
+public:
+  antlr4::Token *recoverInline(antlr4::Parser *recognizer) override {
+    count(recognizer);
+    return DefaultErrorStrategy::recoverInline(recognizer);
+  }
+
+protected:
+  antlr4::misc::IntervalSet getErrorRecoverySet(antlr4::Parser *recognizer) override {
+    count(recognizer);
+    return DefaultErrorStrategy::getErrorRecoverySet(recognizer);
+  }
+
+private:
+  void count(antlr4::Parser *recognizer) {
+    if (++recoveries_ > kMaxSyntaxRecoveries)
+      throw TooManySyntaxErrors{recognizer->getCurrentToken()};
+  }
+  unsigned recoveries_ = 0;
+};
+
 // The offset of the first byte of `text` that does not start well-formed
 // UTF-8, or npos. ANTLR converts its input to UTF-32 with a conversion that
 // throws on ill-formed input, so bad bytes must not reach it.
@@ -787,7 +818,7 @@ bool readExpress(std::unique_ptr<SourceFile> file, Model &model, DiagnosticEngin
       tokens.seek(0);
       parser.reset();
       guard.depth = 0;
-      parser.setErrorHandler(std::make_shared<antlr4::DefaultErrorStrategy>());
+      parser.setErrorHandler(std::make_shared<BoundedErrorStrategy>());
       parser.getInterpreter<antlr4::atn::ParserATNSimulator>()->setPredictionMode(antlr4::atn::PredictionMode::LL);
       tree = parser.syntax();
     }
@@ -795,6 +826,10 @@ bool readExpress(std::unique_ptr<SourceFile> file, Model &model, DiagnosticEngin
     diags.error(locAt(src, deep.at ? deep.at->getLine() : 0, deep.at ? deep.at->getCharPositionInLine() : 0),
                 "EXPRESS declarations nest too deeply (more than " + std::to_string(kMaxParseDepth) +
                     " grammar rules inside each other)");
+    return false;
+  } catch (const TooManySyntaxErrors &stop) {
+    diags.error(locAt(src, stop.at ? stop.at->getLine() : 0, stop.at ? stop.at->getCharPositionInLine() : 0),
+                "EXPRESS syntax: too many errors; stopped reading here");
     return false;
   }
   const bool ok = listener.count == 0;

@@ -12,6 +12,9 @@ inline constexpr unsigned kMaxBracketNesting = 256;
 /// per bracket level, four per `LIST OF`, two per nested statement); deeper
 /// is an error, so no input can overflow the parser's stack.
 inline constexpr unsigned kMaxParseDepth = 4096;
+/// The parser recovers from at most this many syntax errors, then stops with
+/// an error where it is (each recovery costs as much as the nesting is deep).
+inline constexpr unsigned kMaxSyntaxRecoveries = 100;
 
 /// Parses `file` and adds its schemas to `model` (which keeps the file alive).
 /// Syntax errors, bytes that are not UTF-8 and nesting beyond the limits
