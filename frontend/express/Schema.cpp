@@ -95,19 +95,29 @@ bool Model::isSubtypeOf(EntityId sub, EntityId super) const {
     return true;
   // Depth first without recursion, each supertype once: a plain recursion is
   // exponential in a lattice of diamonds and endless on a cycle (which
-  // resolve() rejects, but the model may be queried after errors).
-  thread_local std::vector<EntityId> stack, seen;
+  // resolve() rejects, but the model may be queried after errors). An
+  // entity is seen in this call when its mark is this call's number, so a
+  // call costs what it visits, however many entities the model has.
+  thread_local std::vector<EntityId> stack;
+  thread_local std::vector<uint32_t> mark;
+  thread_local uint32_t call = 0;
+  if (mark.size() < entities_.size())
+    mark.resize(entities_.size(), 0);
+  if (++call == 0) {  // wrapped around: forget every old mark
+    std::fill(mark.begin(), mark.end(), 0);
+    call = 1;
+  }
   stack.assign(1, sub);
-  seen.assign(1, sub);
+  mark[sub] = call;
   while (!stack.empty()) {
     const EntityId e = stack.back();
     stack.pop_back();
     for (EntityId s : entities_[e].supertypes) {
       if (s == super)
         return true;
-      if (std::find(seen.begin(), seen.end(), s) != seen.end())
+      if (mark[s] == call)
         continue;
-      seen.push_back(s);
+      mark[s] = call;
       stack.push_back(s);
     }
   }
