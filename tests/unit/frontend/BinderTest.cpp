@@ -1,6 +1,7 @@
 #include "frontend/binding/Binder.h"
 #include "frontend/binding/Instance.h"
 #include "frontend/express/SchemaReader.h"
+#include "ExpressTestSupport.h"
 
 #include <catch2/catch.hpp>
 
@@ -288,15 +289,11 @@ TEST_CASE("the binder stops on defined types that refer to themselves, even in a
           "[binding]") {
   // resolve() rejects these cycles; bind() is still given the model here, as
   // a caller that ignores the result would, and must end with an error.
-  express::Model model;
-  DiagnosticCollector schemaDiags;
-  DiagnosticEngine schemaEngine(schemaDiags);
-  REQUIRE(express::readExpress(SourceFile::fromString("cyc.exp", "SCHEMA s; TYPE t = t; END_TYPE; TYPE u = v; "
-                                                                   "END_TYPE; TYPE v = u; END_TYPE; ENTITY project; "
-                                                                   "a : t; b : u; END_ENTITY; END_SCHEMA;"),
-                               model, schemaEngine));
-  CHECK_FALSE(model.resolve(schemaEngine));
-  CHECK(schemaEngine.errorCount() == 2);
+  auto loaded = test::loadExpress("SCHEMA s; TYPE t = t; END_TYPE; TYPE u = v; END_TYPE; TYPE v = u; END_TYPE; "
+                                  "ENTITY project; a : t; b : u; END_ENTITY; END_SCHEMA;");
+  CHECK_FALSE(loaded->ok);
+  CHECK(loaded->diags.diags.size() == 2);
+  const express::Model &model = loaded->model;
   auto source = SourceFile::fromString("cyc.stp", "ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION((''),'2;1');\n"
                                                   "FILE_NAME('','',(''),(''),'','','');\nFILE_SCHEMA(('S'));\n"
                                                   "ENDSEC;\nDATA;\n#1=PROJECT(1,2);\nENDSEC;\nEND-ISO-10303-21;\n");
@@ -311,17 +308,12 @@ TEST_CASE("the binder stops on defined types that refer to themselves, even in a
 }
 
 TEST_CASE("a supertype cycle is reported once, and subtype queries on it end", "[binding]") {
-  express::Model model;
-  DiagnosticCollector collected;
-  DiagnosticEngine engine(collected);
-  REQUIRE(express::readExpress(SourceFile::fromString("cyc.exp", "SCHEMA s; ENTITY a SUBTYPE OF (b); END_ENTITY; "
-                                                                   "ENTITY b SUBTYPE OF (a); END_ENTITY; ENTITY c; "
-                                                                   "END_ENTITY; END_SCHEMA;"),
-                               model, engine));
-  CHECK_FALSE(model.resolve(engine));
-  REQUIRE(collected.diags.size() == 1);
-  CHECK(collected.diags[0].message == "entity 'a' is its own supertype (inheritance cycle: a -> b -> a)");
-  CHECK(model.isSubtypeOf(0, 1));
-  CHECK(model.isSubtypeOf(1, 0));
-  CHECK_FALSE(model.isSubtypeOf(0, 2));
+  auto loaded = test::loadExpress("SCHEMA s; ENTITY a SUBTYPE OF (b); END_ENTITY; ENTITY b SUBTYPE OF (a); "
+                                  "END_ENTITY; ENTITY c; END_ENTITY; END_SCHEMA;");
+  CHECK_FALSE(loaded->ok);
+  REQUIRE(loaded->diags.diags.size() == 1);
+  CHECK(loaded->diags.diags[0].message == "entity 'a' is its own supertype (inheritance cycle: a -> b -> a)");
+  CHECK(loaded->model.isSubtypeOf(0, 1));
+  CHECK(loaded->model.isSubtypeOf(1, 0));
+  CHECK_FALSE(loaded->model.isSubtypeOf(0, 2));
 }
