@@ -107,6 +107,7 @@ private:
   void checkComplex(size_t index, const std::vector<EntityId> &set, uint64_t at);
   bool checkValue(const Value &v, TypeId type, const Context &ctx, bool optionalAllowed);
   bool checkNamed(const Value &v, const TypeExpr &t, const Context &ctx);
+  bool checkDeclared(const Value &v, const TypeExpr &t, const Context &ctx);
   bool checkSelect(const Value &v, DeclTypeId decl, const Context &ctx);
   const SelectClosure &closure(DeclTypeId decl);
   std::vector<std::string> enumValues(DeclTypeId decl);
@@ -125,6 +126,24 @@ private:
   const BindOptions &options_;
   BoundFile &out_;
   const p21::ValueArena *arena_ = nullptr;  ///< the instance being checked
+  /// Set in a binder that tries an untyped SELECT value against one member
+  /// type: it does not try again for values inside that value, so trying
+  /// stays linear in the value's size (nested SELECTs of aggregates of
+  /// SELECTs would otherwise multiply the alternatives at every level).
+  bool probing_ = false;
+  /// Defined types followed in a row for one value (TYPE a = b; TYPE b = c).
+  /// resolve() rejects cycles and bounds the chains; this keeps any model
+  /// from making checkNamed recurse without end.
+  unsigned namedChain_ = 0;
+  /// Checks `v` (a value inside the current one: an aggregate element, a
+  /// typed value's content) with a fresh chain count.
+  bool checkInner(const Value &v, TypeId type, const Context &ctx, bool optionalAllowed) {
+    const unsigned saved = namedChain_;
+    namedChain_ = 0;
+    const bool ok = checkValue(v, type, ctx, optionalAllowed);
+    namedChain_ = saved;
+    return ok;
+  }
   p21::ValueArena scratch_;                  ///< for decoding complex instances in pass 1
   std::map<DeclTypeId, SelectClosure> closures_;
   struct AliasUse {
@@ -168,7 +187,7 @@ private:
 
 Binder::Drift Binder::driftOf(TypeId type) const {
   // Follow defined types down to what they are.
-  for (int guard = 0; guard < 32 && type != kNone; ++guard) {
+  for (uint32_t guard = 0; guard <= express::kMaxTypeDepth && type != kNone; ++guard) {
     const TypeExpr &t = model_.type(type);
     if (t.kind == TypeExpr::Aggregate)
       return t.lower == 0 ? Drift::EmptyAggregate : Drift::None;
@@ -383,10 +402,12 @@ bool Binder::checkSelect(const Value &v, DeclTypeId decl, const Context &ctx) {
       return false;
     }
     const Value &inner = arena_->children(v)[0];
-    return checkValue(inner, model_.typeDecl(t).underlying, ctx, false);
+    return checkInner(inner, model_.typeDecl(t).underlying, ctx, false);
   }
   // An untyped simple value: the standard wants it typed; accept it if some
   // member type takes it, and say so.
+  if (probing_)
+    return false;  // the outer try says what was expected
   for (DeclTypeId m : c.types) {
     const TypeExpr &u = model_.type(model_.typeDecl(m).underlying);
     if (u.kind == TypeExpr::Select)
@@ -395,6 +416,7 @@ bool Binder::checkSelect(const Value &v, DeclTypeId decl, const Context &ctx) {
     DiagnosticEngine quiet(scratch);
     Binder probe(file_, model_, schema_, quiet, options_, out_);
     probe.arena_ = arena_;
+    probe.probing_ = true;
     if (probe.checkValue(v, model_.typeDecl(m).underlying, ctx, false) && !quiet.hasErrors()) {
       diags_.warning(file_.loc(entry(ctx.entry).begin() + v.offset),
                      "attribute " + std::to_string(ctx.position) + " '" + (ctx.slot ? ctx.slot->name : "") +
@@ -429,6 +451,18 @@ bool Binder::checkNamed(const Value &v, const TypeExpr &t, const Context &ctx) {
   }
   if (t.declared == kNone)
     return true;  // unresolved name: reported when the schema was resolved
+  if (namedChain_ >= express::kMaxTypeDepth) {
+    error(ctx, v, "type '" + t.name + "' is defined through more than " + std::to_string(express::kMaxTypeDepth) +
+                      " defined types; not checked");
+    return false;
+  }
+  ++namedChain_;
+  const bool ok = checkDeclared(v, t, ctx);
+  --namedChain_;
+  return ok;
+}
+
+bool Binder::checkDeclared(const Value &v, const TypeExpr &t, const Context &ctx) {
   const express::TypeDecl &td = model_.typeDecl(t.declared);
   const TypeExpr &u = model_.type(td.underlying);
   if (u.kind == TypeExpr::Select)
@@ -456,7 +490,7 @@ bool Binder::checkNamed(const Value &v, const TypeExpr &t, const Context &ctx) {
       error(ctx, v, "expected " + article(td.name) + ", found " + describe(v));
       return false;
     }
-    return checkValue(arena_->children(v)[0], td.underlying, ctx, false);
+    return checkInner(arena_->children(v)[0], td.underlying, ctx, false);
   }
   return checkValue(v, td.underlying, ctx, false);
 }
@@ -564,7 +598,7 @@ bool Binder::checkValue(const Value &v, TypeId type, const Context &ctx, bool op
     for (size_t i = 0; i < children.size(); ++i) {
       Context inner = ctx;
       inner.path += "[" + std::to_string(i + 1) + "]";
-      ok &= checkValue(children[i], t.element, inner, t.optionalElements);
+      ok &= checkInner(children[i], t.element, inner, t.optionalElements);
     }
     return ok;
   }

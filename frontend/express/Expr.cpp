@@ -2,6 +2,24 @@
 
 namespace stepnc::express {
 
+Expr::~Expr() {
+  // Move every grandchild out before its parent goes, so each Expr destroyed
+  // here has no children left and the destructor never recurses.
+  std::vector<Expr> pending;
+  for (Expr &a : args)
+    if (!a.args.empty())
+      pending.push_back(std::move(a));
+  args.clear();
+  while (!pending.empty()) {
+    Expr e = std::move(pending.back());
+    pending.pop_back();
+    for (Expr &a : e.args)
+      if (!a.args.empty())
+        pending.push_back(std::move(a));
+    e.args.clear();
+  }
+}
+
 std::string printExpr(const Expr &e) {
   auto list = [&](const std::string &head) {
     std::string out = "(";

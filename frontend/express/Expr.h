@@ -28,6 +28,17 @@ struct Expr {
   Kind kind = Name;
   std::string text;
   std::vector<Expr> args;
+
+  Expr() = default;
+  Expr(Expr &&) noexcept = default;
+  Expr &operator=(Expr &&) noexcept = default;
+  // No copies: a copy would recurse as deep as the tree, and the reader
+  // only ever moves operands into their operator.
+  Expr(const Expr &) = delete;
+  Expr &operator=(const Expr &) = delete;
+  /// Frees the tree without recursion: a chain of n binary operators (a
+  /// WHERE rule of thousands of ANDs) is a left-deep tree n levels deep.
+  ~Expr();
 };
 
 /// A compact, unambiguous S-expression of the tree, for tests and debugging:

@@ -29,6 +29,23 @@ using EntityId = uint32_t;  ///< index of an Entity in Model::entities()
 using DeclTypeId = uint32_t;  ///< index of a TypeDecl in Model::typeDecls()
 inline constexpr uint32_t kNone = UINT32_MAX;
 
+// Limits Model::resolve() enforces, each a located error, so that no schema
+// can make resolution or what follows it (binding, XSD, Part 28) recurse
+// without bound or take quadratic memory. Real schemas stay far below them
+// (the AP238/AP242 long forms: inheritance about 12 deep, type chains 4).
+/// Supertype chains: an entity at most this many levels below its root.
+inline constexpr uint32_t kMaxInheritanceDepth = 256;
+/// Defined types, SELECT members and BASED_ON bases referring to each other:
+/// at most this many declarations in a chain (a cycle is an error anyway).
+inline constexpr uint32_t kMaxTypeDepth = 64;
+/// Attributes of one entity, inherited ones included.
+inline constexpr uint32_t kMaxEntitySlots = 10000;
+/// Attribute slots of all entities together (each entity stores its
+/// inherited ones too, so this bounds what deep hierarchies cost).
+inline constexpr uint64_t kMaxModelSlots = 2000000;
+/// Names visible in all schemas together (USE FROM copies a schema's names).
+inline constexpr uint64_t kMaxScopeNames = 4000000;
+
 enum class SimpleKind : uint8_t { Binary, Boolean, Integer, Logical, Number, Real, String };
 enum class AggregateKind : uint8_t { Array, Bag, List, Set };
 
@@ -188,7 +205,10 @@ public:
   void keepSource(std::unique_ptr<SourceFile> f) { sources_.push_back(std::move(f)); }
 
   /// Resolves interfaces, names, supertypes and attribute lists; reports
-  /// unknown names, missing schemas and inheritance cycles. Returns false on errors.
+  /// unknown names, missing schemas, inheritance cycles, defined types and
+  /// SELECTs that refer to themselves, and anything beyond the limits above.
+  /// Returns false on errors. After a successful resolve the supertype and
+  /// type graphs are acyclic and within kMaxInheritanceDepth / kMaxTypeDepth.
   bool resolve(DiagnosticEngine &diags);
 
   // Queries.
@@ -204,7 +224,8 @@ public:
   /// Entity visible in `schema` under `name` (lower case), or kNone.
   EntityId findEntity(const Schema &schema, std::string_view name) const;
   DeclTypeId findType(const Schema &schema, std::string_view name) const;
-  /// True if `sub` is `super` or one of its subtypes (transitively).
+  /// True if `sub` is `super` or one of its subtypes (transitively). Each
+  /// supertype is visited once, so diamonds cost no more than trees.
   bool isSubtypeOf(EntityId sub, EntityId super) const;
   /// The parsed form of a WHERE rule (parsing it now if needed); null if its
   /// text does not parse.
@@ -213,7 +234,7 @@ public:
   std::string typeText(TypeId id) const;
 
 private:
-  bool computeSlots(EntityId id, std::vector<uint8_t> &state, DiagnosticEngine &diags);
+  bool computeSlots(EntityId id, std::vector<uint8_t> &state, uint64_t &total, DiagnosticEngine &diags);
 
   std::vector<Schema> schemas_;
   std::vector<Entity> entities_;

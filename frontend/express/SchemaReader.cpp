@@ -11,6 +11,11 @@
 
 #include <antlr4-runtime.h>
 
+#include "support/Utf8.h"
+
+#include <cstdio>
+#include <optional>
+
 namespace stepnc::express {
 
 namespace g = stepnc::express::grammar;
@@ -52,11 +57,24 @@ private:
 
 // ---- expressions -----------------------------------------------------------
 
-Expr makeExpr(Expr::Kind kind, std::string text, std::vector<Expr> args = {}) {
+Expr makeList(Expr::Kind kind, std::string text, std::vector<Expr> args) {
   Expr e;
   e.kind = kind;
   e.text = std::move(text);
   e.args = std::move(args);
+  return e;
+}
+
+// Operands are moved in one by one: a braced list would copy them (the
+// elements of an initializer_list are const), and copying the left operand
+// at every step made a chain of n operators cost O(n^2).
+template <typename... Operands>
+Expr makeExpr(Expr::Kind kind, std::string text, Operands &&...operands) {
+  Expr e;
+  e.kind = kind;
+  e.text = std::move(text);
+  e.args.reserve(sizeof...(operands));
+  (e.args.push_back(std::forward<Operands>(operands)), ...);
   return e;
 }
 
@@ -101,15 +119,16 @@ Expr buildPrimary(P::PrimaryContext *ctx) {
   }
   for (auto *qual : ctx->qualifier()) {
     if (auto *a = qual->attribute_qualifier()) {
-      e = makeExpr(Expr::Attribute, lower(a->attribute_ref()->getText()), {std::move(e)});
+      e = makeExpr(Expr::Attribute, lower(a->attribute_ref()->getText()), std::move(e));
     } else if (auto *g = qual->group_qualifier()) {
-      e = makeExpr(Expr::Group, lower(g->entity_ref()->getText()), {std::move(e)});
+      e = makeExpr(Expr::Group, lower(g->entity_ref()->getText()), std::move(e));
     } else {
       auto *ix = qual->index_qualifier();
-      std::vector<Expr> args{std::move(e)};
+      std::vector<Expr> args;
+      args.push_back(std::move(e));
       for (auto *n : ix->numeric_expression())
         args.push_back(buildSimple(n->simple_expression()));
-      e = makeExpr(Expr::Index, "", std::move(args));
+      e = makeList(Expr::Index, "", std::move(args));
     }
   }
   return e;
@@ -121,7 +140,7 @@ Expr buildSimpleFactor(P::Simple_factorContext *ctx) {
     for (auto *el : agg->element()) {
       Expr item = buildExpression(el->expression());
       if (el->numeric_expression())
-        item = makeExpr(Expr::Binary, ":", {std::move(item), buildSimple(el->numeric_expression()->simple_expression())});
+        item = makeExpr(Expr::Binary, ":", std::move(item), buildSimple(el->numeric_expression()->simple_expression()));
       e.args.push_back(std::move(item));
     }
     return e;
@@ -130,15 +149,15 @@ Expr buildSimpleFactor(P::Simple_factorContext *ctx) {
     std::vector<Expr> args;
     for (auto *se : iv->simple_expression())
       args.push_back(buildSimple(se));
-    return makeExpr(Expr::Interval, iv->interval_op(0)->getText() + " " + iv->interval_op(1)->getText(),
+    return makeList(Expr::Interval, iv->interval_op(0)->getText() + " " + iv->interval_op(1)->getText(),
                     std::move(args));
   }
   if (auto *qe = ctx->query_expression())
     return makeExpr(Expr::Query, lower(qe->variable_id()->getText()),
-                    {buildSimple(qe->simple_expression()), buildExpression(qe->logical_expression()->expression())});
+                    buildSimple(qe->simple_expression()), buildExpression(qe->logical_expression()->expression()));
   Expr inner = ctx->expression() ? buildExpression(ctx->expression()) : buildPrimary(ctx->primary());
   if (auto *u = ctx->unary_op())
-    return makeExpr(Expr::Unary, upperText(u), {std::move(inner)});
+    return makeExpr(Expr::Unary, upperText(u), std::move(inner));
   return inner;
 }
 
@@ -146,7 +165,7 @@ Expr buildFactor(P::FactorContext *ctx) {
   auto parts = ctx->simple_factor();
   Expr e = buildSimpleFactor(parts[0]);
   if (parts.size() == 2)
-    e = makeExpr(Expr::Binary, "**", {std::move(e), buildSimpleFactor(parts[1])});
+    e = makeExpr(Expr::Binary, "**", std::move(e), buildSimpleFactor(parts[1]));
   return e;
 }
 
@@ -155,7 +174,7 @@ Expr buildTerm(P::TermContext *ctx) {
   auto ops = ctx->multiplication_like_op();
   Expr e = buildFactor(factors[0]);
   for (size_t i = 1; i < factors.size(); ++i)
-    e = makeExpr(Expr::Binary, upperText(ops[i - 1]), {std::move(e), buildFactor(factors[i])});
+    e = makeExpr(Expr::Binary, upperText(ops[i - 1]), std::move(e), buildFactor(factors[i]));
   return e;
 }
 
@@ -164,7 +183,7 @@ Expr buildSimple(P::Simple_expressionContext *ctx) {
   auto ops = ctx->add_like_op();
   Expr e = buildTerm(terms[0]);
   for (size_t i = 1; i < terms.size(); ++i)
-    e = makeExpr(Expr::Binary, upperText(ops[i - 1]), {std::move(e), buildTerm(terms[i])});
+    e = makeExpr(Expr::Binary, upperText(ops[i - 1]), std::move(e), buildTerm(terms[i]));
   return e;
 }
 
@@ -172,7 +191,7 @@ Expr buildExpression(P::ExpressionContext *ctx) {
   auto sides = ctx->simple_expression();
   Expr e = buildSimple(sides[0]);
   if (sides.size() == 2)
-    e = makeExpr(Expr::Binary, upperText(ctx->rel_op_extended()), {std::move(e), buildSimple(sides[1])});
+    e = makeExpr(Expr::Binary, upperText(ctx->rel_op_extended()), std::move(e), buildSimple(sides[1]));
   return e;
 }
 
@@ -552,7 +571,189 @@ void Builder::schema(P::Schema_declContext *ctx) {
 
 } // namespace
 
+namespace {
+
+// Thrown by DepthGuard to abandon a parse; not a RecognitionException, so the
+// generated rules do not catch it.
+struct ParseTooDeep {
+  antlr4::Token *at;
+};
+
+// Counts the parser's rule invocations in progress: ANTLR's parser recurses
+// once per rule, so input nested deeply enough (types, statements or
+// declarations inside each other) would overflow the stack.
+class DepthGuard final : public antlr4::tree::ParseTreeListener {
+public:
+  explicit DepthGuard(antlr4::Parser &parser) : parser_(parser) {}
+  void enterEveryRule(antlr4::ParserRuleContext *) override {
+    if (++depth > kMaxParseDepth)
+      throw ParseTooDeep{parser_.getCurrentToken()};
+  }
+  void exitEveryRule(antlr4::ParserRuleContext *) override { --depth; }
+  void visitTerminal(antlr4::tree::TerminalNode *) override {}
+  void visitErrorNode(antlr4::tree::ErrorNode *) override {}
+  unsigned depth = 0;
+
+private:
+  antlr4::Parser &parser_;
+};
+
+// Thrown by BoundedErrorStrategy to stop a parse that keeps recovering.
+struct TooManySyntaxErrors {
+  antlr4::Token *at;
+};
+
+// ANTLR's error recovery, stopped after kMaxSyntaxRecoveries recoveries.
+// Each computes the follow sets of every rule in progress, so on deeply
+// nested garbage one recovery costs thousands of set operations, and the
+// parser kept recovering long after the diagnostics had stopped (a 77 KB
+// mutant took 25 s). Everything after the first error only adds messages.
+class BoundedErrorStrategy final : public antlr4::DefaultErrorStrategy {
+public:
+  antlr4::Token *recoverInline(antlr4::Parser *recognizer) override {
+    count(recognizer);
+    return DefaultErrorStrategy::recoverInline(recognizer);
+  }
+
+protected:
+  antlr4::misc::IntervalSet getErrorRecoverySet(antlr4::Parser *recognizer) override {
+    count(recognizer);
+    return DefaultErrorStrategy::getErrorRecoverySet(recognizer);
+  }
+
+private:
+  void count(antlr4::Parser *recognizer) {
+    if (++recoveries_ > kMaxSyntaxRecoveries)
+      throw TooManySyntaxErrors{recognizer->getCurrentToken()};
+  }
+  unsigned recoveries_ = 0;
+};
+
+// The offset of the first byte of `text` that does not start well-formed
+// UTF-8, or npos. ANTLR converts its input to UTF-32 with a conversion that
+// throws on ill-formed input, so bad bytes must not reach it.
+size_t firstInvalidUtf8(std::string_view text) {
+  for (size_t i = 0; i < text.size();) {
+    if (static_cast<unsigned char>(text[i]) < 0x80) {
+      ++i;
+      continue;
+    }
+    const size_t n = utf8::sequenceLength(text, i);
+    if (n == 0)
+      return i;
+    i += n;
+  }
+  return std::string_view::npos;
+}
+
+// Appends text[from, to) with every code point but line breaks turned into
+// one space: the lines and the code-point columns ANTLR reports stay those
+// of the file.
+void appendBlank(std::string &out, std::string_view text, size_t from, size_t to) {
+  for (size_t i = from; i < to; ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c == '\n' || c == '\r')
+      out += static_cast<char>(c);
+    else if ((c & 0xC0) != 0x80)  // not a continuation byte
+      out += ' ';
+  }
+}
+
+// The text with its remarks blanked out (ISO 10303-11 7.1.6: `--` to the end
+// of the line; `(*` to the matching `*)`, nesting), or nullopt after
+// reporting an embedded remark that does not end. Remarks are removed here,
+// not by the grammar's lexer, because ANTLR's lexer needs time and memory
+// that grow with the square of their nesting (20,000 nested remarks: more
+// than a minute and 1.3 GB) and rescans to the end of the file for every
+// `(*` that does not close. Strings are kept as they are: `--` and `(*` in
+// them are text. `text` is well-formed UTF-8.
+std::optional<std::string> blankRemarks(std::string_view text, const SourceFile &src, DiagnosticEngine &diags) {
+  std::string out;
+  out.reserve(text.size());
+  const size_t n = text.size();
+  size_t i = 0;
+  while (i < n) {
+    const char c = text[i];
+    if (c == '\'') {
+      size_t j = i + 1;
+      while (j < n && !(text[j] == '\'' && (j + 1 >= n || text[j + 1] != '\'')))
+        j += text[j] == '\'' ? 2 : 1;
+      // An unterminated string: the lexer reports the quote and goes on
+      // after it, and so does this scan.
+      const size_t end = j < n ? j + 1 : i + 1;
+      out.append(text.substr(i, end - i));
+      i = end;
+    } else if (c == '-' && i + 1 < n && text[i + 1] == '-') {
+      size_t j = i;
+      while (j < n && text[j] != '\n' && text[j] != '\r')
+        ++j;
+      appendBlank(out, text, i, j);
+      i = j;
+    } else if (c == '(' && i + 1 < n && text[i + 1] == '*') {
+      size_t depth = 1, j = i + 2;
+      while (j < n && depth > 0) {
+        if (text[j] == '(' && j + 1 < n && text[j + 1] == '*') {
+          ++depth;
+          j += 2;
+        } else if (text[j] == '*' && j + 1 < n && text[j + 1] == ')') {
+          --depth;
+          j += 2;
+        } else {
+          ++j;
+        }
+      }
+      if (depth > 0) {
+        diags.error(SourceLoc{&src, i}, "EXPRESS remark '(*' does not end: no matching '*)'" +
+                                            std::string(depth > 1 ? " (" + std::to_string(depth) +
+                                                                        " remarks open at the end of the file)"
+                                                                  : ""));
+        return std::nullopt;
+      }
+      appendBlank(out, text, i, j);
+      i = j;
+    } else {
+      out += c;
+      ++i;
+    }
+  }
+  return out;
+}
+
+// Reports the first bracket that opens more than kMaxBracketNesting levels;
+// false if there is one. Expressions nest only through brackets, and parsing
+// them recurses about ten C++ frames per level.
+bool checkBracketDepth(antlr4::CommonTokenStream &tokens, const SourceFile &src, DiagnosticEngine &diags) {
+  unsigned depth = 0;
+  for (antlr4::Token *t : tokens.getTokens()) {
+    if (t->getChannel() != antlr4::Token::DEFAULT_CHANNEL)
+      continue;
+    switch (t->getType()) {
+    case g::ExpressLexer::LPAREN:
+    case g::ExpressLexer::LBRACKET:
+    case g::ExpressLexer::LBRACE:
+      if (++depth > kMaxBracketNesting) {
+        diags.error(locAt(src, t->getLine(), t->getCharPositionInLine()),
+                    "EXPRESS brackets nest deeper than " + std::to_string(kMaxBracketNesting) + " levels");
+        return false;
+      }
+      break;
+    case g::ExpressLexer::RPAREN:
+    case g::ExpressLexer::RBRACKET:
+    case g::ExpressLexer::RBRACE:
+      if (depth > 0)
+        --depth;
+      break;
+    default: break;
+    }
+  }
+  return true;
+}
+
+} // namespace
+
 std::shared_ptr<const Expr> parseExpression(std::string_view text) {
+  if (firstInvalidUtf8(text) != std::string_view::npos)
+    return nullptr;
   antlr4::ANTLRInputStream input{std::string(text)};
   g::ExpressLexer lexer(&input);
   lexer.removeErrorListeners();
@@ -560,6 +761,8 @@ std::shared_ptr<const Expr> parseExpression(std::string_view text) {
   g::ExpressParser parser(&tokens);
   parser.removeErrorListeners();
   parser.setErrorHandler(std::make_shared<antlr4::BailErrorStrategy>());
+  DepthGuard guard(parser);
+  parser.addParseListener(&guard);
   try {
     auto *tree = parser.expression();
     if (tokens.LA(1) != antlr4::Token::EOF)
@@ -569,33 +772,65 @@ std::shared_ptr<const Expr> parseExpression(std::string_view text) {
     return nullptr;
   } catch (const antlr4::RecognitionException &) {
     return nullptr;
+  } catch (const ParseTooDeep &) {
+    return nullptr;
   }
 }
 
 bool readExpress(std::unique_ptr<SourceFile> file, Model &model, DiagnosticEngine &diags) {
   const SourceFile &src = *file;
-  antlr4::ANTLRInputStream input(std::string(src.text()));
+  // Keep the file whatever happens: diagnostics point into it.
+  model.keepSource(std::move(file));
+  if (const size_t bad = firstInvalidUtf8(src.text()); bad != std::string_view::npos) {
+    char hex[8];
+    std::snprintf(hex, sizeof hex, "0x%02X", static_cast<unsigned>(static_cast<unsigned char>(src.text()[bad])));
+    diags.error(SourceLoc{&src, bad}, std::string("EXPRESS text is not valid UTF-8: byte ") + hex +
+                                          " does not start a well-formed sequence");
+    return false;
+  }
+  std::optional<std::string> blanked = blankRemarks(src.text(), src, diags);
+  if (!blanked)
+    return false;
+  antlr4::ANTLRInputStream input(*blanked);
+  blanked.reset();
   g::ExpressLexer lexer(&input);
   ErrorListener listener(src, diags);
   lexer.removeErrorListeners();
   lexer.addErrorListener(&listener);
   antlr4::CommonTokenStream tokens(&lexer);
+  tokens.fill();
+  if (!checkBracketDepth(tokens, src, diags))
+    return false;
   g::ExpressParser parser(&tokens);
   parser.removeErrorListeners();
   parser.addErrorListener(&listener);
-  // Two-stage parsing: SLL first (fast, enough for every known schema), full
-  // LL only if SLL fails.
-  parser.getInterpreter<antlr4::atn::ParserATNSimulator>()->setPredictionMode(antlr4::atn::PredictionMode::SLL);
-  parser.setErrorHandler(std::make_shared<antlr4::BailErrorStrategy>());
+  DepthGuard guard(parser);
+  parser.addParseListener(&guard);
   g::ExpressParser::SyntaxContext *tree = nullptr;
   try {
-    tree = parser.syntax();
-  } catch (const antlr4::ParseCancellationException &) {
-    tokens.seek(0);
-    parser.reset();
-    parser.setErrorHandler(std::make_shared<antlr4::DefaultErrorStrategy>());
-    parser.getInterpreter<antlr4::atn::ParserATNSimulator>()->setPredictionMode(antlr4::atn::PredictionMode::LL);
-    tree = parser.syntax();
+    // Two-stage parsing: SLL first (fast, enough for every known schema),
+    // full LL only if SLL fails.
+    parser.getInterpreter<antlr4::atn::ParserATNSimulator>()->setPredictionMode(antlr4::atn::PredictionMode::SLL);
+    parser.setErrorHandler(std::make_shared<antlr4::BailErrorStrategy>());
+    try {
+      tree = parser.syntax();
+    } catch (const antlr4::ParseCancellationException &) {
+      tokens.seek(0);
+      parser.reset();
+      guard.depth = 0;
+      parser.setErrorHandler(std::make_shared<BoundedErrorStrategy>());
+      parser.getInterpreter<antlr4::atn::ParserATNSimulator>()->setPredictionMode(antlr4::atn::PredictionMode::LL);
+      tree = parser.syntax();
+    }
+  } catch (const ParseTooDeep &deep) {
+    diags.error(locAt(src, deep.at ? deep.at->getLine() : 0, deep.at ? deep.at->getCharPositionInLine() : 0),
+                "EXPRESS declarations nest too deeply (more than " + std::to_string(kMaxParseDepth) +
+                    " grammar rules inside each other)");
+    return false;
+  } catch (const TooManySyntaxErrors &stop) {
+    diags.error(locAt(src, stop.at ? stop.at->getLine() : 0, stop.at ? stop.at->getCharPositionInLine() : 0),
+                "EXPRESS syntax: too many errors; stopped reading here");
+    return false;
   }
   const bool ok = listener.count == 0;
   if (ok) {
@@ -603,7 +838,6 @@ bool readExpress(std::unique_ptr<SourceFile> file, Model &model, DiagnosticEngin
     for (auto *schema : tree->schema_decl())
       builder.schema(schema);
   }
-  model.keepSource(std::move(file));
   return ok;
 }
 

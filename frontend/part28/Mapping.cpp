@@ -29,9 +29,10 @@ std::vector<std::string> attributeElementNames(const express::Model &model, expr
 
 TypeView viewType(const express::Model &model, express::TypeId type) {
   TypeView view;
-  // A chain of defined types is finite (resolve() rejects cycles), but bound
-  // the walk anyway so a bad model cannot hang the mapping.
-  for (int depth = 0; depth < 64 && type != express::kNone; ++depth) {
+  // A chain of defined types is finite and short (resolve() rejects cycles
+  // and chains beyond kMaxTypeDepth), but bound the walk anyway so a bad
+  // model cannot hang the mapping.
+  for (uint32_t depth = 0; depth <= express::kMaxTypeDepth && type != express::kNone; ++depth) {
     const express::TypeExpr &t = model.type(type);
     switch (t.kind) {
     case express::TypeExpr::Simple:

@@ -24,9 +24,9 @@ using express::TypeId;
 
 namespace {
 
-/// Guards the walks along TYPE a = b chains, which resolution does not check
-/// for cycles.
-constexpr int kMaxTypeChain = 64;
+/// Guards the walks along TYPE a = b chains: resolution rejects cycles and
+/// longer chains, but a model read with errors may still have them.
+constexpr int kMaxTypeChain = static_cast<int>(express::kMaxTypeDepth) + 1;
 
 std::string groupName(std::string_view expressName) { return xmlName(expressName) + "-group"; }
 

@@ -1,6 +1,7 @@
 #include "frontend/binding/Binder.h"
 #include "frontend/binding/Instance.h"
 #include "frontend/express/SchemaReader.h"
+#include "ExpressTestSupport.h"
 
 #include <catch2/catch.hpp>
 
@@ -282,4 +283,37 @@ TEST_CASE("instances give typed access to attributes by name", "[binding]") {
   LineCol lc = r->source->lineCol(step.attrLoc("passes").offset);
   CHECK(lc.line == 9);
   CHECK(lc.col == 12);
+}
+
+TEST_CASE("the binder stops on defined types that refer to themselves, even in a model that failed to resolve",
+          "[binding]") {
+  // resolve() rejects these cycles; bind() is still given the model here, as
+  // a caller that ignores the result would, and must end with an error.
+  auto loaded = test::loadExpress("SCHEMA s; TYPE t = t; END_TYPE; TYPE u = v; END_TYPE; TYPE v = u; END_TYPE; "
+                                  "ENTITY project; a : t; b : u; END_ENTITY; END_SCHEMA;");
+  CHECK_FALSE(loaded->ok);
+  CHECK(loaded->diags.diags.size() == 2);
+  const express::Model &model = loaded->model;
+  auto source = SourceFile::fromString("cyc.stp", "ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION((''),'2;1');\n"
+                                                  "FILE_NAME('','',(''),(''),'','','');\nFILE_SCHEMA(('S'));\n"
+                                                  "ENDSEC;\nDATA;\n#1=PROJECT(1,2);\nENDSEC;\nEND-ISO-10303-21;\n");
+  DiagnosticCollector collected;
+  DiagnosticEngine diags(collected);
+  auto file = p21::readPart21(*source, diags);
+  REQUIRE(file);
+  binding::bind(*file, model, model.schemas().front(), diags, {});
+  CHECK(diags.errorCount() == 2);  // one per attribute
+  for (const Diagnostic &d : collected.diags)
+    CHECK(d.loc.valid());
+}
+
+TEST_CASE("a supertype cycle is reported once, and subtype queries on it end", "[binding]") {
+  auto loaded = test::loadExpress("SCHEMA s; ENTITY a SUBTYPE OF (b); END_ENTITY; ENTITY b SUBTYPE OF (a); "
+                                  "END_ENTITY; ENTITY c; END_ENTITY; END_SCHEMA;");
+  CHECK_FALSE(loaded->ok);
+  REQUIRE(loaded->diags.diags.size() == 1);
+  CHECK(loaded->diags.diags[0].message == "entity 'a' is its own supertype (inheritance cycle: a -> b -> a)");
+  CHECK(loaded->model.isSubtypeOf(0, 1));
+  CHECK(loaded->model.isSubtypeOf(1, 0));
+  CHECK_FALSE(loaded->model.isSubtypeOf(0, 2));
 }

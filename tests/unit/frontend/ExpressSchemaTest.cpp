@@ -229,3 +229,37 @@ TEST_CASE("built-in WHERE rules are parsed on first use", "[express]") {
   CHECK(parseExpression("1 + ") == nullptr);
   CHECK(parseExpression("a b") == nullptr);
 }
+
+TEST_CASE("operator chains keep their left-deep shape and long ones are built and freed", "[express]") {
+  auto small = parseExpression("a AND b AND c.e[1]");
+  REQUIRE(small);
+  CHECK(printExpr(*small) == "(AND (AND a b) ([] (. e c) 1))");
+  // 100,000 operands: copying the left operand at each step took minutes;
+  // the tree is 100,000 levels deep, more than a recursive destructor
+  // survives under ASan.
+  std::string text = "x";
+  for (int i = 0; i < 100000; ++i)
+    text += " AND x";
+  auto chain = parseExpression(text);
+  REQUIRE(chain);
+  const Expr *e = chain.get();
+  size_t depth = 0;
+  while (e->kind == Expr::Binary) {
+    e = &e->args[0];
+    ++depth;
+  }
+  CHECK(depth == 100000);
+}
+
+TEST_CASE("EXPRESS text that is not UTF-8 or nests too deeply is a located error", "[express]") {
+  auto bad = load("SCHEMA s;\n-- caf\xe9\nEND_SCHEMA;\n");
+  CHECK_FALSE(bad->ok);
+  REQUIRE(bad->diags.diags.size() == 1);
+  CHECK(bad->diags.diags[0].loc.offset == 16);
+  CHECK(parseExpression("'\xff'") == nullptr);
+  auto deep = load("SCHEMA s; CONSTANT c : INTEGER := " + std::string(300, '(') + "1" + std::string(300, ')') +
+                   "; END_CONSTANT; END_SCHEMA;");
+  CHECK_FALSE(deep->ok);
+  REQUIRE(deep->diags.diags.size() == 1);
+  CHECK(deep->diags.diags[0].message == "EXPRESS brackets nest deeper than 256 levels");
+}
