@@ -6,6 +6,7 @@
 #include <signal.h>
 #include <sys/stat.h>
 #include <cstring>
+#include <iterator>
 #include <unistd.h>
 
 namespace stepnc {
@@ -25,28 +26,40 @@ struct Slot {
 };
 Slot gSlots[kSlots];
 
+constexpr int kSignals[] = {SIGTERM, SIGINT, SIGHUP};
+/// What each of kSignals did before removeTemporariesAndDie took it over.
+struct sigaction gPrevious[std::size(kSignals)];
+
 extern "C" void removeTemporariesAndDie(int sig) {
   for (Slot &slot : gSlots)
     if (slot.used)
       ::unlink(slot.path);  // async-signal-safe
+  // Then what the signal did before: a handler the program had installed,
+  // else end as the signal ends a process (the caller sees it).
+  for (size_t i = 0; i < std::size(kSignals); ++i)
+    if (kSignals[i] == sig && gPrevious[i].sa_handler != SIG_DFL && gPrevious[i].sa_handler != SIG_IGN &&
+        !(gPrevious[i].sa_flags & SA_SIGINFO)) {
+      gPrevious[i].sa_handler(sig);
+      return;
+    }
   std::signal(sig, SIG_DFL);
-  std::raise(sig);  // end as the signal would have: the caller sees it
+  std::raise(sig);
 }
 
+/// Takes over kSignals where something else holds them now (checked at each
+/// open: the program may have installed handlers since); a signal the
+/// caller chose to ignore (nohup) stays ignored.
 void installHandlers() {
-  static bool installed = false;
-  if (installed)
-    return;
-  installed = true;
-  for (int sig : {SIGTERM, SIGINT, SIGHUP}) {
+  for (size_t i = 0; i < std::size(kSignals); ++i) {
+    struct sigaction current {};
+    if (::sigaction(kSignals[i], nullptr, &current) != 0 || current.sa_handler == SIG_IGN ||
+        (!(current.sa_flags & SA_SIGINFO) && current.sa_handler == removeTemporariesAndDie))
+      continue;
+    gPrevious[i] = current;
     struct sigaction action {};
     action.sa_handler = removeTemporariesAndDie;
     sigemptyset(&action.sa_mask);
-    // A signal the caller chose to ignore (nohup) stays ignored.
-    struct sigaction before {};
-    if (::sigaction(sig, nullptr, &before) == 0 && before.sa_handler == SIG_IGN)
-      continue;
-    ::sigaction(sig, &action, nullptr);
+    ::sigaction(kSignals[i], &action, nullptr);
   }
 }
 
