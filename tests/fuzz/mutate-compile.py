@@ -134,7 +134,8 @@ def mutate(text, rng):
 
 def limit_memory(mb):
     def apply():
-        resource.setrlimit(resource.RLIMIT_AS, (mb << 20, mb << 20))
+        if mb > 0:  # 0: none (AddressSanitizer reserves terabytes of address space)
+            resource.setrlimit(resource.RLIMIT_AS, (mb << 20, mb << 20))
     return apply
 
 
@@ -193,7 +194,7 @@ def main():
     ap.add_argument("--count", type=int, default=100, help="mutants to run")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--timeout", type=int, default=60, help="seconds per compile")
-    ap.add_argument("--memory-mb", type=int, default=4096, help="address space per compile")
+    ap.add_argument("--memory-mb", type=int, default=4096, help="address space per compile; 0 for no limit (sanitizer builds)")
     ap.add_argument("--out", help="directory for failing mutants (default: a temporary one, kept on failure)")
     ap.add_argument("--native", metavar="MACHINE", help="also plan natively for this machine and run sim")
     ap.add_argument("--no-rs274", action="store_true", help="do not run LinuxCNC's rs274")
