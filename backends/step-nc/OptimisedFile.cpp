@@ -17,6 +17,7 @@
 #include "ir/Program.h"
 #include "ir/geom/FeatureShape.h"
 #include "ir/geom/MoveWalk.h"
+#include "support/Preimage.h"
 
 #include <algorithm>
 #include <array>
@@ -39,22 +40,7 @@ using ir::PlaneFrame;
 constexpr double kTwoPi = 2 * std::numbers::pi;
 /// Units in the last place searched either side of a first guess for a value
 /// that reads back exactly.
-constexpr int kUlpSearch = 4;
-
-/// The double near `guess` for which `forward` gives exactly `target`; the
-/// guess when none within kUlpSearch units in the last place does.
-template <class Forward> double preimage(double target, double guess, Forward forward) {
-  double down = guess, up = guess;
-  for (int i = 0; i <= kUlpSearch; ++i) {
-    if (forward(up) == target)
-      return up;
-    if (forward(down) == target)
-      return down;
-    up = std::nextafter(up, INFINITY);
-    down = std::nextafter(down, -INFINITY);
-  }
-  return guess;
-}
+constexpr int kUlpSearch = kPreimageUlps;
 
 /// Candidates within kUlpSearch units in the last place of `x`, nearest first.
 std::vector<double> around(double x) {

@@ -6,6 +6,7 @@
 #include "ir/Program.h"
 
 #include "support/Format.h"
+#include "support/Preimage.h"
 
 #include <algorithm>
 #include <cmath>
@@ -98,8 +99,8 @@ std::string Lowerer::real(double value) {
 }
 
 std::string Lowerer::depthPlane(double depth) {
-  const std::string origin = newInstance("CARTESIAN_POINT('',(0.,0.," + real(-depth) + "))");
-  return newInstance("PLANE('depth'," + newInstance("AXIS2_PLACEMENT_3D(''," + origin + ",$,$)") + ")");
+  return newInstance("PLANE('depth'," + newInstance("AXIS2_PLACEMENT_3D(''," + newPoint(Vec3(0, 0, -depth)) + ",$,$)") +
+                     ")");
 }
 
 std::string Lowerer::tolerancedLength(double value) {
@@ -110,20 +111,20 @@ std::string Lowerer::placementAt(const Instance &original, const Vec3 &at) {
   Instance axis = original.ref("axis"), ref = original.ref("ref_direction");
   if (swapAxisAndRef_ && axis && ref)
     std::swap(axis, ref);
-  const std::string point =
-      newInstance("CARTESIAN_POINT('',(" + real(at.x()) + "," + real(at.y()) + "," + real(at.z()) + "))");
-  return newInstance("AXIS2_PLACEMENT_3D(''," + point + "," + (axis ? hashId(axis.id()) : "$") + "," +
+  return newInstance("AXIS2_PLACEMENT_3D(''," + newPoint(at) + "," + (axis ? hashId(axis.id()) : "$") + "," +
                      (ref ? hashId(ref.id()) : "$") + ")");
 }
 
 std::string Lowerer::newPlacement(const Vec3 &at, const std::optional<Vec3> &axis, const std::optional<Vec3> &ref) {
-  auto triple = [](const Vec3 &v) { return "(" + real(v.x()) + "," + real(v.y()) + "," + real(v.z()) + ")"; };
   auto direction = [&](const std::optional<Vec3> &d) {
     return d ? newInstance("DIRECTION(''," + triple(*d) + ")") : std::string("$");
   };
-  return newInstance("AXIS2_PLACEMENT_3D(''," + newInstance("CARTESIAN_POINT(''," + triple(at) + ")") + "," +
-                     direction(axis) + "," + direction(ref) + ")");
+  return newInstance("AXIS2_PLACEMENT_3D(''," + newPoint(at) + "," + direction(axis) + "," + direction(ref) + ")");
 }
+
+std::string Lowerer::triple(const Vec3 &v) { return "(" + real(v.x()) + "," + real(v.y()) + "," + real(v.z()) + ")"; }
+
+std::string Lowerer::newPoint(const Vec3 &at) { return newInstance("CARTESIAN_POINT(''," + triple(at) + ")"); }
 
 std::string Lowerer::newInstance(std::string text) {
   std::vector<std::string> &instances = module_ ? module_->sourceInstances : pendingInstances_;
@@ -418,22 +419,10 @@ constexpr std::pair<std::string_view, std::string_view> kAngles[] = {
 
 namespace {
 
-/// The value that, multiplied by `factor`, gives exactly `target` (a few
-/// units in the last place either side of the quotient searched), else the
-/// quotient: what a converted value is written as so that reading it back
-/// gives the value used.
+/// The value that, multiplied by `factor`, gives exactly `target`: what a
+/// converted value is written as so that reading it back gives the value used.
 double readsBackAs(double target, double factor) {
-  const double guess = target / factor;
-  double up = guess, down = guess;
-  for (int i = 0; i <= 4; ++i) {
-    if (up * factor == target)
-      return up;
-    if (down * factor == target)
-      return down;
-    up = std::nextafter(up, INFINITY);
-    down = std::nextafter(down, -INFINITY);
-  }
-  return guess;
+  return preimage(target, target / factor, [factor](double v) { return v * factor; });
 }
 
 } // namespace

@@ -119,8 +119,11 @@ public:
   std::string placementAt(const Instance &original, const Vec3 &at);
   /// A new axis2_placement_3d at `at` with new directions (`$` for none).
   std::string newPlacement(const Vec3 &at, const std::optional<Vec3> &axis, const std::optional<Vec3> &ref);
-  /// `value` as a Part 21 real.
+  /// A new cartesian_point at `at` (newInstance).
+  std::string newPoint(const Vec3 &at);
+  /// `value` as a Part 21 real; `v` as a Part 21 list of three.
   static std::string real(double value);
+  static std::string triple(const Vec3 &v);
   /// `text` as a Part 21 string.
   static std::string quoted(std::string_view text);
   /// A fresh symbol with `sigil`, from a STEP-NC id string or a fallback.
