@@ -321,7 +321,7 @@ std::array<Vec3, 6> blendPoints(const Segment &a, double la, const Segment &b, d
 // takes eight sample points at a time in the one for processors with
 // AVX-512, four in the one with AVX, two in the other, with the same
 // operations on each (the same bits).
-#if defined(__GNUC__) && defined(__x86_64__) && defined(__ELF__)
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__ELF__)
 __attribute__((target("default"))) double blendDeviation(const std::array<Vec3, 6> &ctrl, const Segment &a, double la,
                                                          const Segment &b, double lb, const Vec3 &bStart) {
   return blendDeviationOf(ctrl, a, la, b, lb, bStart);

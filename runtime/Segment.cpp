@@ -208,8 +208,9 @@ template <int D, class V>
 // The blend kernels in three versions on x86-64 (GCC's function
 // multiversioning picks one when the program starts): for processors with
 // AVX-512 (preferring its full width where the compiler vectorizes loops),
-// with AVX, and for the rest.
-#if defined(__GNUC__) && defined(__x86_64__) && defined(__ELF__)
+// with AVX, and for the rest. Clang (the fuzz build) takes the one version:
+// it has no "prefer-vector-width" target attribute.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__ELF__)
 #define STEPNC_MULTIVERSIONED 1
 #endif
 

@@ -8,8 +8,8 @@ set -euo pipefail
 packages=(
   # toolchain
   build-essential cmake ninja-build python3 pkg-config
-  # fuzzing (libFuzzer ships with clang's runtime)
-  clang libclang-rt-14-dev
+  # fuzzing (libFuzzer ships with clang's runtime; 16, not 14, builds the ANTLR lexer)
+  clang-16 libclang-rt-16-dev
   # EXPRESS frontend: ANTLR 4.7.2 tool + 4.9 C++ runtime
   antlr4 libantlr4-runtime-dev
   # geometry
