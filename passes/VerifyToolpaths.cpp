@@ -13,7 +13,9 @@
 //   reach   the material a step's feed moves meet stands no higher above
 //           the tool's tip than its overall length (else the holder hits:
 //           error) and its cutting edge length (else the shank rubs:
-//           warning), on the in-process stock;
+//           warning), on the in-process stock; a holder wider than the
+//           tool (holder_diameter) meets no material, within its diameter,
+//           higher than the overall length either (error);
 //   depth   no move below the floor (bottom + allowance_bottom; through
 //           bottoms allow the tool's point and an overcut);
 //   gouge   the disc swept by feed moves below the feature's top stays in
@@ -326,11 +328,15 @@ private:
         // (the chord of an arc): what its flutes, then its body and holder,
         // must clear.
         const Vec2 a = sm.move->from->head<2>(), b = sm.move->to.head<2>();
+        const double tip = std::min(sm.move->from->z(), sm.move->to.z());
         const cutting::HeightMap::Peak peak = sm.stock->highest(a, b, std::max(0.0, sm.radius - sm.stock->cell()));
-        const double engaged = peak.height - std::min(sm.move->from->z(), sm.move->to.z());
         Reach &r = reach_[sm.executable];
-        if (engaged > r.engaged)
-          r = {engaged, Vec3(peak.at.x(), peak.at.y(), peak.height), sm.move->node};
+        r.flutes.raise(peak, tip, sm.move->node);
+        // A holder wider than the tool sweeps a wider disc: a wall beside
+        // the tool can meet it.
+        const double holder = holderRadius(sm.executable);
+        if (holder > sm.radius)
+          r.holder.raise(sm.stock->highest(a, b, holder - sm.stock->cell()), tip, sm.move->node);
       }
     });
   }
@@ -348,20 +354,43 @@ private:
     const Reach &r = it->second;
     const std::optional<double> flutes = s.tool->number("cutting_edge_length");
     const std::optional<double> overall = s.tool->number("overall_length");
-    const std::string where = " stands " + mm(r.engaged) + " above the tool's tip (at " + pointText(r.at) + ")";
-    if (overall && r.engaged > *overall + s.tol) {
+    auto where = [](const Reach::Peak &p) {
+      return " stands " + mm(p.engaged) + " above the tool's tip (at " + pointText(p.at) + ")";
+    };
+    if (overall && r.flutes.engaged > *overall + s.tol) {
       report(s,
-             {{r.move, "the material its tool " + s.tool->symbol + " meets" + where +
-                           ", more than its overall length " + mm(*overall) +
-                           ": the holder or spindle would hit the stock; a longer tool reaches it"}},
+             {{r.flutes.move, "the material its tool " + s.tool->symbol + " meets" + where(r.flutes) +
+                                  ", more than its overall length " + mm(*overall) +
+                                  ": the holder or spindle would hit the stock; a longer tool reaches it"}},
              "holder collisions");
-    } else if (flutes && r.engaged > *flutes + s.tol) {
+    } else if (overall && r.holder.move && r.holder.engaged > *overall + s.tol) {
       report(s,
-             {{r.move, "the material its tool " + s.tool->symbol + " meets" + where +
-                           ", more than its cutting edge length " + mm(*flutes) +
-                           ": the shank above the flutes would rub it (unless the tool is necked)"}},
+             {{r.holder.move, "the material within the " + mm(2 * holderRadius(s.exec)) + " holder of its tool " +
+                                  s.tool->symbol + where(r.holder) + ", more than the tool's overall length " +
+                                  mm(*overall) +
+                                  ": the holder would hit the stock beside the tool; a longer tool or a slimmer "
+                                  "holder reaches it"}},
+             "holder collisions");
+    } else if (flutes && r.flutes.engaged > *flutes + s.tol) {
+      report(s,
+             {{r.flutes.move, "the material its tool " + s.tool->symbol + " meets" + where(r.flutes) +
+                                  ", more than its cutting edge length " + mm(*flutes) +
+                                  ": the shank above the flutes would rub it (unless the tool is necked)"}},
              "shank rubs", /*warning=*/true);
     }
+  }
+
+  /// The radius of the holder of the tool `exec`'s moves name (its
+  /// `holder_diameter`, ISO 14649-111's tool_holder_diameter_for_spindle_-
+  /// orientation); 0 when the tool does not give one.
+  double holderRadius(const ir::Node *exec) const {
+    const ir::Node *moves = exec ? exec->child(ir::Kind::Moves) : nullptr;
+    if (!moves)
+      return 0;
+    const auto it = tools_.find(moves->text("tool").value_or(""));
+    if (it == tools_.end() || !it->second)
+      return 0;
+    return it->second->number("holder_diameter").value_or(0.0) / 2;
   }
 
   void visit(ir::Node &n) {
@@ -1119,10 +1148,20 @@ private:
   std::map<const ir::Node *, std::pair<StockHit, Vec3>> stockHits_;
   /// Per executable, the highest material its feed moves meet above the
   /// tool's tip, where, and the move (walkProgram).
+  /// Per step, the highest material its feed moves meet above the tool's
+  /// tip: within the tool's disc (what the flutes and shank meet) and, for a
+  /// holder wider than the tool, within the holder's.
   struct Reach {
-    double engaged = 0;
-    Vec3 at = Vec3::Zero();
-    const ir::Node *move = nullptr;
+    struct Peak {
+      double engaged = 0;
+      Vec3 at = Vec3::Zero();
+      const ir::Node *move = nullptr;
+      void raise(const cutting::HeightMap::Peak &p, double tip, const ir::Node *by) {
+        if (p.height - tip > engaged)
+          *this = {p.height - tip, Vec3(p.at.x(), p.at.y(), p.height), by};
+      }
+    };
+    Peak flutes, holder;
   };
   std::map<const ir::Node *, Reach> reach_;
   std::map<std::string, ir::ShapeResult> shapes_;

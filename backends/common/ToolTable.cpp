@@ -1,5 +1,7 @@
 #include "backends/common/ToolTable.h"
 
+#include "ir/Plausible.h"
+
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -213,19 +215,45 @@ std::optional<ToolTable> ToolTable::parse(const SourceFile &file, DiagnosticEngi
         diags.error(e.loc, "tool table: " + key + " has no tool number");
         bad = true;
       }
-      if (!bad && fields.size() >= 3) {
-        const std::string &l = fields[2].first;
+      size_t next = 2;
+      if (!bad && fields.size() > next && fields[next].first.find('=') == std::string::npos) {
+        const std::string &l = fields[next].first;
         double length = 0;
         auto [p, ec] = std::from_chars(l.data(), l.data() + l.size(), length);
         if (ec != std::errc() || p != l.data() + l.size() || !(length >= 0)) {
-          diags.error(SourceLoc{&file, fields[2].second}, "tool table: '" + l + "' is not a length in mm");
+          diags.error(SourceLoc{&file, fields[next].second}, "tool table: '" + l + "' is not a length in mm");
           bad = true;
         }
         e.length = length;
+        ++next;
       }
-      if (!bad && fields.size() > 3) {
-        diags.error(SourceLoc{&file, fields[3].second}, "tool table: more than three fields (tool, number, length)");
-        bad = true;
+      // The holder's geometry, as key=value fields.
+      for (; !bad && next < fields.size(); ++next) {
+        const std::string &f = fields[next].first;
+        const size_t eq = f.find('=');
+        const SourceLoc at{&file, fields[next].second};
+        const std::string key = eq == std::string::npos ? f : f.substr(0, eq);
+        std::optional<double> *slot = key == "holder" ? &e.holderDiameter : key == "stickout" ? &e.stickout : nullptr;
+        if (eq == std::string::npos || !slot) {
+          diags.error(at, "tool table: '" + f + "' is not a field of a tool's line (tool, number, length, then " +
+                              "holder=<diameter mm>, stickout=<mm from the tip to the holder>)");
+          bad = true;
+          break;
+        }
+        const std::string v = f.substr(eq + 1);
+        double value = 0;
+        auto [p, ec] = std::from_chars(v.data(), v.data() + v.size(), value);
+        if (ec != std::errc() || p != v.data() + v.size() || !(value > 0) || value > ir::kMaxLengthMm) {
+          diags.error(at.advanced(eq + 1), "tool table: '" + v + "' is not a positive length in mm for " + key);
+          bad = true;
+          break;
+        }
+        if (slot->has_value()) {
+          diags.error(at, "tool table: " + key + "= is given twice");
+          bad = true;
+          break;
+        }
+        *slot = value;
       }
       if (!bad)
         table.entries_.push_back(std::move(e));
@@ -236,6 +264,20 @@ std::optional<ToolTable> ToolTable::parse(const SourceFile &file, DiagnosticEngi
   if (!ok)
     return std::nullopt;
   return table;
+}
+
+void ToolTable::applyGeometry(ir::Module &module) const {
+  for (ir::Node &n : module.root.children) {
+    if (n.kind != ir::Kind::Tool)
+      continue;
+    const Entry *e = find(n);
+    if (!e)
+      continue;
+    if (e->holderDiameter)
+      n.set("holder_diameter", ir::Value::length(*e->holderDiameter));
+    if (e->stickout)
+      n.set("overall_length", ir::Value::length(*e->stickout));
+  }
 }
 
 const ToolTable::Entry *ToolTable::find(const ir::Node &tool) const {

@@ -2,9 +2,13 @@
 // optionally, its length offset. A plain text file, one tool per line
 // (docs/tool-table.md):
 //
-//   # tool                     number  length (mm, optional)
-//   "T2 ENDMILL D12 Z3"        12      85.000
+//   # tool                     number  length (mm, optional)  holder geometry (optional)
+//   "T2 ENDMILL D12 Z3"        12      85.000                 holder=40 stickout=35
 //   %t3_endmill_d10_z4         7
+//
+// `holder=D` (the holder's diameter) and `stickout=L` (from the tool's tip to
+// the holder's face) go onto the tool before its toolpaths are verified
+// (applyGeometry): the reach check walks the holder's disc from there.
 //
 // A tool is named by its STEP-NC id in double quotes or by its IR symbol.
 //
@@ -36,6 +40,8 @@ public:
     int number = 0;
     std::optional<double> length;    ///< mm (LinuxCNC: the Z offset)
     std::optional<double> diameter;  ///< mm (LinuxCNC's D)
+    std::optional<double> holderDiameter;  ///< mm, `holder=`
+    std::optional<double> stickout;        ///< mm, `stickout=`: from the tip to the holder's face
     SourceLoc loc;
     SourceLoc diameterLoc;  ///< where the D word is (LinuxCNC)
   };
@@ -47,6 +53,10 @@ public:
   /// The entry for a tool node, or null: by id or symbol; in a LinuxCNC
   /// table, the entry whose comment is the tool's STEP-NC id.
   const Entry *find(const ir::Node &tool) const;
+  /// Puts the table's holder geometry onto the module's tools: `holder=`
+  /// as holder_diameter, `stickout=` as overall_length (replacing the
+  /// file's). Tools the table does not list keep theirs.
+  void applyGeometry(ir::Module &module) const;
   /// The entry for tool number `number`, or null.
   const Entry *findNumber(int number) const;
   const std::string &name() const { return name_; }

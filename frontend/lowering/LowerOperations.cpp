@@ -170,6 +170,7 @@ std::optional<std::string> Lowerer::tool(const Instance &t) {
     missing(t, "its_tool_body");
   }
   copyReal(n, "overall_length", t, "overall_assembly_length", Value::length);
+  copyReal(n, "holder_diameter", t, "tool_holder_diameter_for_spindle_orientation", Value::length);
   writeToolExplicitly(t);
   std::vector<Instance> edges = t.refs("its_cutting_edge");
   if (!edges.empty())

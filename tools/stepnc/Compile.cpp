@@ -160,6 +160,21 @@ int compileSource(const CompileOptions &opts, const std::string &emit, std::uniq
     printToolError("compile: --emit=stepnc writes a STEP-NC file back: give a STEP-NC input, not IR text");
     return kExitUsage;
   }
+  // The tool table is read first: its holder geometry is checked with the
+  // toolpaths (docs/tool-table.md).
+  std::optional<backends::ToolTable> table;
+  std::unique_ptr<SourceFile> tableFile;
+  if (!opts.toolTable.empty()) {
+    tableFile = openInput(opts.toolTable);
+    if (!tableFile)
+      return kExitUsage;
+    table = backends::ToolTable::parse(*tableFile, diags);
+    if (!table) {
+      printStatus("the tool table " + opts.toolTable + " has errors; nothing written");
+      return kExitDiagnostics;
+    }
+    table->applyGeometry(*module);
+  }
   // The toolpath IR is the feature IR after the passes that make and check
   // moves; a program is written from the toolpath IR.
   // The motion IR and the native target add the motion planned on the machine.
@@ -194,18 +209,6 @@ int compileSource(const CompileOptions &opts, const std::string &emit, std::uniq
   if (emit == "stepnc")
     return writeOptimised(opts, schemas, *file, *module, pipelineText, reports, diags);
   if (backend) {
-    std::optional<backends::ToolTable> table;
-    std::unique_ptr<SourceFile> tableFile;
-    if (!opts.toolTable.empty()) {
-      tableFile = openInput(opts.toolTable);
-      if (!tableFile)
-        return kExitUsage;
-      table = backends::ToolTable::parse(*tableFile, diags);
-      if (!table) {
-        printStatus("the tool table " + opts.toolTable + " has errors; nothing written");
-        return kExitDiagnostics;
-      }
-    }
     backends::EmitOptions emitOptions;
     emitOptions.source = std::filesystem::path(opts.input).filename().string();
     emitOptions.programName = programName(opts);
