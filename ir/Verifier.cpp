@@ -67,7 +67,7 @@ bool isRadius(std::string_view name) { return name == "radius" || name.ends_with
 /// Lengths that must be positive; radii may also be 0.
 bool isDimension(std::string_view name) {
   return isRadius(name) || name == "depth" || name == "diameter" || name == "width" || name == "length" ||
-         name == "pitch" || name == "travel" || name == "step" || name == "radial_step";
+         name == "pitch" || name == "travel" || name == "step" || name == "radial_step" || name == "holder_diameter";
 }
 
 bool isNumber(ValueType t) {
@@ -322,6 +322,11 @@ void Verifier::checkValue(const Node &n, const Attr &a) {
     report(n, attr() + " must have finite coordinates");
   else if (v.type == ValueType::Direction && !(std::abs(v.vec.norm() - 1) <= kUnitTolerance))
     report(n, attr() + " must be a unit vector, found length " + formatFixed(v.vec.norm(), 6));
+  // An approach or retract angle is a slope: a ramp or helix at 0 deg never
+  // gets down, one past 90 deg goes the wrong way.
+  else if ((n.kind == Kind::Approach || n.kind == Kind::Retract) && a.name == "angle" &&
+           !(v.number > 0 && v.number <= 90))
+    report(n, attr() + " must be a slope, more than 0 and at most 90 deg, found " + printed(v));
   else if ((v.type == ValueType::FeedPerRev || (n.kind == Kind::Dwell && a.name == "time")) && v.number <= 0)
     report(n, attr() + " must be positive, found " + printed(v));
   // (A state's spindle speed keeps its sign: negative is clockwise, as everywhere.)

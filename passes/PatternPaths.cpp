@@ -100,21 +100,28 @@ Vec2 SmoothGuide::at(double s) const {
   return sum;
 }
 
-long trochoidLoops(const SmoothGuide &guide, double step) {
-  return std::max(1L, long(std::ceil((guide.length() + 2 * guide.halfWidth()) / step - 1e-9)));
+double trochoidLoops(const SmoothGuide &guide, double step) {
+  return std::max(1.0, std::ceil((guide.length() + 2 * guide.halfWidth()) / step - 1e-9));
 }
 
-std::vector<Vec2> trochoidPoints(const SmoothGuide &guide, const TrochoidMotif &motif, double chordTolerance) {
+std::optional<std::vector<Vec2>> trochoidPoints(const SmoothGuide &guide, const TrochoidMotif &motif,
+                                                double chordTolerance, double maxPoints) {
   const double w = guide.halfWidth();
   const double travel = guide.length() + 2 * w;
-  const long loops = trochoidLoops(guide, motif.step);
+  const double loopCount = trochoidLoops(guide, motif.step);
+  if (!(loopCount * 8 + 1 <= maxPoints))
+    return std::nullopt;
+  const long loops = long(loopCount);
   const double advance = travel / double(loops); // per loop, <= motif.step
   // The chord of an arc of the curve spanning dtheta strays from it by at
   // most |OM''| dtheta^2 / 8, and |OM''| <= R_t + (advance / 2 pi)^2 |G''|
   // with |G''| <= 2 / w.
   const double bound = motif.radius + std::pow(advance / (2 * kPi), 2) * 2 / w;
   const double dtheta = std::sqrt(8 * chordTolerance / bound);
-  const long perLoop = std::max(8L, long(std::ceil(2 * kPi / dtheta)));
+  const double perLoopCount = std::max(8.0, std::ceil(2 * kPi / dtheta));
+  if (!(loopCount * perLoopCount + 1 <= maxPoints))
+    return std::nullopt;
+  const long perLoop = long(perLoopCount);
   const double sense = motif.ccw ? 1 : -1;
   std::vector<Vec2> out;
   out.reserve(size_t(loops * perLoop + 1));
@@ -199,7 +206,8 @@ double largestTrochoidStep(double toolRadius, double loopRadius, double maxAngle
   return lo;
 }
 
-std::vector<Vec2> plungeCentres(const std::vector<Seg> &chain, double spacing, double reach) {
+std::optional<std::vector<Vec2>> plungeCentres(const std::vector<Seg> &chain, double spacing, double reach,
+                                               double maxPoints) {
   std::vector<Vec2> out;
   if (chain.empty())
     return out;
@@ -222,7 +230,10 @@ std::vector<Vec2> plungeCentres(const std::vector<Seg> &chain, double spacing, d
     const Vec2 u = chain.back().tangent(1), v = chain.front().tangent(0);
     total += reach * std::abs(std::atan2(geom::cross(u, v), u.dot(v)));
   }
-  const long intervals = std::max(1L, long(std::ceil(total / spacing - 1e-9)));
+  const double intervalCount = std::max(1.0, std::ceil(total / spacing - 1e-9));
+  if (!(intervalCount + 1 <= maxPoints))
+    return std::nullopt;
+  const long intervals = long(intervalCount);
   const long count = closed ? intervals : intervals + 1;
   size_t i = 0;
   for (long k = 0; k < count; ++k) {

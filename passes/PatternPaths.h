@@ -16,6 +16,7 @@
 #include "geom/Geometry.h"
 
 #include <algorithm>
+#include <optional>
 #include <vector>
 
 namespace stepnc::passes {
@@ -64,16 +65,20 @@ struct TrochoidMotif {
 };
 
 /// How many loops trochoidPoints makes along `guide`: as few as keep the
-/// advance per loop within `step`.
-long trochoidLoops(const SmoothGuide &guide, double step);
+/// advance per loop within `step`. A double: a step far too small for the
+/// guide counts past what a long holds.
+double trochoidLoops(const SmoothGuide &guide, double step);
 
 /// The trochoid along `guide`: OM(theta) = G(s(theta)) + R_t (cos theta, +-sin theta)
 /// with s running evenly from -w to L + w over a whole number of loops (as
 /// few as keep the advance per loop within the motif's step), so that it
 /// starts and ends at G's end points plus (R_t, 0), the guide at rest there.
 /// Sampled at equal angles, as many per loop as keep every chord within
-/// `chordTolerance` of the curve. The first point is the start.
-std::vector<geom::Vec2> trochoidPoints(const SmoothGuide &guide, const TrochoidMotif &motif, double chordTolerance);
+/// `chordTolerance` of the curve. The first point is the start. None when
+/// that takes more than `maxPoints` points (a step far too small for the
+/// guide), before any is made.
+std::optional<std::vector<geom::Vec2>> trochoidPoints(const SmoothGuide &guide, const TrochoidMotif &motif,
+                                                      double chordTolerance, double maxPoints);
 
 /// The half-width of the smoothing of a trochoid's guide: short against a
 /// loop, so that the guide cuts corners by a fraction of the step.
@@ -97,7 +102,10 @@ double largestTrochoidStep(double toolRadius, double loopRadius, double maxAngle
 /// chain, are at most `spacing` apart along it: the chain's length with each
 /// turn weighted by `reach` (an arc of radius r counts (1 + reach / r) times
 /// its length, a corner reach times its angle). Both ends are included for
-/// an open chain, the start only for a closed one.
-std::vector<geom::Vec2> plungeCentres(const std::vector<geom::Seg> &chain, double spacing, double reach);
+/// an open chain, the start only for a closed one. None when that takes
+/// more than `maxPoints` places (a spacing far too small for the chain),
+/// before any is made.
+std::optional<std::vector<geom::Vec2>> plungeCentres(const std::vector<geom::Seg> &chain, double spacing,
+                                                     double reach, double maxPoints);
 
 } // namespace stepnc::passes

@@ -64,6 +64,11 @@ inline constexpr double kBreakthrough = 1.0;
 /// hours; such a step is a located error instead.
 inline constexpr int kMaxLevels = 2000;
 inline constexpr int kMaxRadialPasses = 2000;
+/// The most points a pattern strategy samples for one step (a trochoid's
+/// points, plunges): as for levels, more come only from a step far too
+/// small for the feature (a trochoid advancing a nanometre per loop), and
+/// such a step is a located error, before the points are made.
+inline constexpr double kMaxPatternPoints = 5e6;
 
 /// A plane point at height z.
 inline Vec3 at(const Vec2 &p, double z) { return {p.x(), p.y(), z}; }

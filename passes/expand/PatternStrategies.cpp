@@ -42,6 +42,14 @@ std::optional<Guided> guided(Expander &x, const Step &step) {
   return Guided{guide, std::move(levels)};
 }
 
+/// A pattern that would sample more than kMaxPatternPoints points for one
+/// step: `what` names the step that makes them.
+void tooManyPoints(Expander &x, const Node &ws, const Node &pattern, const std::string &what) {
+  x.report(ws, pattern,
+           "its " + what + " would take more than " + formatFixed(kMaxPatternPoints, 0) +
+               " points for this step, the most stepnc plans: it is far too small for the feature");
+}
+
 /// The guide's paths at height z for a motif that reaches `reach.radius`
 /// from the guide (the tool's radius plus the motif's), `spacing` apart,
 /// kept `margin` further from the walls; `area` receives where the guide
@@ -209,6 +217,7 @@ bool expandTrochoidal(Expander &x, const Step &step) {
   const double angle = std::max(a ? a->number("angle").value_or(5.0) : 5.0, 0.5) * kPi / 180;
   Emitter e(step.moves, step.moves.number("secplane").value_or(0));
   long loops = 0;
+  size_t planned = 0;  // points, against kMaxPatternPoints
   int fallbacks = 0;
   for (double z : g0->levels) {
     Region area;
@@ -217,8 +226,15 @@ bool expandTrochoidal(Expander &x, const Step &step) {
       return false;
     for (Path2D &chain : chains(*paths, area)) {
       const SmoothGuide g(std::move(chain), w);
-      const std::vector<Vec2> points = trochoidPoints(g, motif, x.chordTolerance);
-      loops += trochoidLoops(g, used);
+      const std::optional<std::vector<Vec2>> sampled =
+          trochoidPoints(g, motif, x.chordTolerance, kMaxPatternPoints - double(planned));
+      if (!sampled) {
+        tooManyPoints(x, ws, pattern, "trochoid step " + formatShortest(used) + " mm");
+        return false;
+      }
+      const std::vector<Vec2> &points = *sampled;
+      planned += points.size();
+      loops += long(trochoidLoops(g, used));
       // Down about the guide's start on the first loop: a helix, unless
       // the operation asks for a plunge along the tool axis (any other
       // approach is reported by the pass).
@@ -286,6 +302,7 @@ bool expandPlunging(Expander &x, const Step &step) {
   const double corner = std::min(linkRadius, above - s.top);
   Emitter e(step.moves, secplane);
   long plunges = 0;
+  size_t planned = 0;  // plunges, against kMaxPatternPoints
   int fallbacks = 0;
   for (double z : g0->levels) {
     Region area;
@@ -297,7 +314,14 @@ bool expandPlunging(Expander &x, const Step &step) {
       const bool closed = path.size() > 1 && (path.front().a - path.back().b).norm() < 1e-7;
       if (closed && e.positioned())
         path = startNearest(Loop{path}, e.position().head<2>()).segs;
-      const std::vector<Vec2> centres = plungeCentres(path, pitch, bottom);
+      const std::optional<std::vector<Vec2>> placed =
+          plungeCentres(path, pitch, bottom, kMaxPatternPoints - double(planned));
+      if (!placed) {
+        tooManyPoints(x, ws, pattern, "plunge radial step " + formatShortest(pitch) + " mm");
+        return false;
+      }
+      const std::vector<Vec2> &centres = *placed;
+      planned += centres.size();
       for (size_t k = 0; k < centres.size(); ++k) {
         const Vec2 c = centres[k];
         if (k == 0)
