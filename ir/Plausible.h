@@ -30,8 +30,15 @@ inline constexpr double kMaxRate = 1e7;  ///< mm/min, rev/min, W, g/min
 /// 0 and this is no dwell a program can say, refused rather than dropped.
 inline constexpr double kMinDwellS = 0.001;
 /// mm: a workpiece's global_tolerance above this is no machining tolerance
-/// (some generators write 50 mm); lowering does not use it.
+/// (some generators write 50 mm); lowering does not use it...
 inline constexpr double kPlausibleMaxTolerance = 1.0;
+/// mm: nor below this, finer than any machine tool positions (a tenth of a
+/// micrometre); a tolerance of 1e-300 made levels and chords without end.
+inline constexpr double kPlausibleMinTolerance = 1e-4;
+/// Whether a workpiece's global_tolerance is one lowering uses.
+inline constexpr bool isPlausibleTolerance(double mm) {
+  return mm >= kPlausibleMinTolerance && mm <= kPlausibleMaxTolerance;
+}
 /// mm: the tolerance toolpaths are verified to when neither the workpiece nor
 /// an option gives one; a dimension the file gives no tolerance is written
 /// back with it.

@@ -77,7 +77,7 @@ std::string Lowerer::generalTolerance() {
     const Instance wp(bound_, i);
     if (!wp.isA("workpiece"))
       continue;
-    if (auto t = wp.real("global_tolerance"); t && *t > 0 && *t <= ir::kPlausibleMaxTolerance) {
+    if (auto t = wp.real("global_tolerance"); t && ir::isPlausibleTolerance(*t)) {
       tolerance = given ? std::min(tolerance, *t) : *t;
       given = true;
     }
@@ -199,13 +199,13 @@ std::optional<std::string> Lowerer::workpiece(const Instance &wp) {
     // The verifier checks toolpaths to this tolerance; a value no machined
     // part is toleranced to (some generators write 50 mm) would let it pass
     // gouges and uncut floors.
-    constexpr double kMaxTolerance = ir::kPlausibleMaxTolerance;
-    if (*tol > 0 && *tol <= kMaxTolerance)
+    if (ir::isPlausibleTolerance(*tol))
       node.set("global_tolerance", Value::length(*tol));
     else {
       assumed(wp, "global_tolerance",
-              formatFixed(*tol, 4) + " mm is no machining tolerance (it must be above 0 and at most " +
-                  formatFixed(kMaxTolerance, 1) + " mm); not used: toolpaths are verified to 0.01 mm "
+              formatShortest(*tol) + " mm is no machining tolerance (it must be at least " +
+                  formatTrimmed(ir::kPlausibleMinTolerance, 4) + " and at most " +
+                  formatTrimmed(ir::kPlausibleMaxTolerance, 4) + " mm); not used: toolpaths are verified to 0.01 mm "
                   "(verify-toolpaths<tolerance=...> sets another)");
       fix(wp, "global_tolerance", "$");  // OPTIONAL: what is not used is not given
     }
