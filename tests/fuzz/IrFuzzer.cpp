@@ -27,31 +27,15 @@ namespace {
 using namespace stepnc;
 using namespace stepnc::fuzz;
 
-constexpr unsigned kMaxErrors = 20;
-
 void checkInput(std::string_view input) {
   auto source = SourceFile::fromString("fuzz-input.ir", input);
-  DiagnosticCollector collected;
-  DiagnosticEngine diags(collected);
-  diags.setMaxErrors(kMaxErrors);
-  auto module = ir::parseModule(*source, diags);
-  checkReaderRun(module != nullptr, diags, collected.diags, {source.get()}, input);
+  auto module = readChecked(*source, input, ir::parseModule);
   if (!module)
     return;
-
   checkVerifies(*module, {source.get()}, input);
-
   const std::string printed = ir::printModule(*module);
-  auto again = SourceFile::fromString("fuzz-printed.ir", printed);
-  DiagnosticCollector reread;
-  DiagnosticEngine rereadDiags(reread);
-  auto second = ir::parseModule(*again, rereadDiags);
-  if (!second || rereadDiags.hasErrors()) {
-    violation("reread", "the printed module does not parse again",
-              textOf(reread.diags) + "--- printed ---\n" + clip(printed) + "\n--- input ---\n" + clip(input));
-    return;
-  }
-  checkSameText("roundtrip", "print -> parse -> print changed the text", printed, ir::printModule(*second));
+  if (auto second = rereadClean(printed, input, ir::parseModule))
+    checkSameText("roundtrip", "print -> parse -> print changed the text", printed, ir::printModule(*second));
 }
 
 } // namespace

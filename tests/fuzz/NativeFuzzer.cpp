@@ -31,8 +31,6 @@ namespace {
 using namespace stepnc;
 using namespace stepnc::fuzz;
 
-constexpr unsigned kMaxErrors = 20;
-
 const runtime::Machine &machine() {
   static const runtime::Machine m = [] {
     std::unique_ptr<SourceFile> file;
@@ -50,26 +48,13 @@ const runtime::Machine &machine() {
 
 void checkInput(std::string_view input) {
   auto source = SourceFile::fromString("fuzz-input.motion", input);
-  DiagnosticCollector collected;
-  DiagnosticEngine diags(collected);
-  diags.setMaxErrors(kMaxErrors);
-  auto trajectory = runtime::readNative(*source, diags);
-  checkReaderRun(trajectory.has_value(), diags, collected.diags, {source.get()}, input);
+  auto trajectory = readChecked(*source, input, runtime::readNative);
   if (!trajectory)
     return;
-
   const std::string written = runtime::writeNative(*trajectory, "fuzz-input.motion");
-  auto again = SourceFile::fromString("fuzz-written.motion", written);
-  DiagnosticCollector reread;
-  DiagnosticEngine rereadDiags(reread);
-  auto second = runtime::readNative(*again, rereadDiags);
-  if (!second || rereadDiags.hasErrors()) {
-    violation("reread", "the written trajectory does not read again",
-              textOf(reread.diags) + "--- written ---\n" + clip(written) + "\n--- input ---\n" + clip(input));
-    return;
-  }
-  checkSameText("roundtrip", "write -> read -> write changed the text", written,
-                runtime::writeNative(*second, "fuzz-input.motion"));
+  if (auto second = rereadClean(written, input, runtime::readNative))
+    checkSameText("roundtrip", "write -> read -> write changed the text", written,
+                  runtime::writeNative(*second, "fuzz-input.motion"));
   checkPlays(*trajectory, machine(), "report", input);
 }
 

@@ -57,4 +57,35 @@ void checkSameText(std::string_view tag, const char *what, const std::string &fi
 void checkReaderRun(bool accepted, const DiagnosticEngine &diags, const std::vector<Diagnostic> &collected,
                     std::initializer_list<const SourceFile *> sources, std::string_view input);
 
+/// At most this many errors per read, as `stepnc` stops at its default.
+inline constexpr unsigned kMaxErrors = 20;
+
+/// Runs `read(source, diags)` (a reader returning a pointer or an optional)
+/// and checks the run (checkReaderRun against `source` alone).
+template <class Read>
+auto readChecked(const SourceFile &source, std::string_view input, Read read) {
+  DiagnosticCollector collected;
+  DiagnosticEngine diags(collected);
+  diags.setMaxErrors(kMaxErrors);
+  auto result = read(source, diags);
+  checkReaderRun(static_cast<bool>(result), diags, collected.diags, {&source}, input);
+  return result;
+}
+
+/// Reads `written`, what a writer made of `input`, again with `read`: it
+/// must read without errors (tag reread); empty when it did not.
+template <class Read>
+auto rereadClean(const std::string &written, std::string_view input, Read read) {
+  auto source = SourceFile::fromString("fuzz-written", written);
+  DiagnosticCollector collected;
+  DiagnosticEngine diags(collected);
+  auto result = read(*source, diags);
+  if (!result || diags.hasErrors()) {
+    violation("reread", "what the writer wrote does not read again",
+              textOf(collected.diags) + "--- written ---\n" + clip(written) + "\n--- input ---\n" + clip(input));
+    return decltype(result){};
+  }
+  return result;
+}
+
 } // namespace stepnc::fuzz

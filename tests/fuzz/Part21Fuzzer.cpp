@@ -46,7 +46,6 @@ namespace {
 using namespace stepnc;
 using namespace stepnc::fuzz;
 
-constexpr unsigned kMaxErrors = 20;
 constexpr std::string_view kEndKeyword = "END-ISO-10303-21";
 
 /// One read of a text: the source, its diagnostics and the instance table.

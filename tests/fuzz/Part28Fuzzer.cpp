@@ -30,8 +30,6 @@ namespace {
 using namespace stepnc;
 using namespace stepnc::fuzz;
 
-constexpr unsigned kMaxErrors = 20;
-
 void checkInput(std::string_view input) {
   if (!p28::isXml(input))
     return;  // Part 21 has its own target

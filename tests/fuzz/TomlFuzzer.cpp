@@ -29,7 +29,6 @@ namespace {
 using namespace stepnc;
 using namespace stepnc::fuzz;
 
-constexpr unsigned kMaxErrors = 20;
 
 /// A few moves of the kinds a program has, 10 to 40 mm long.
 runtime::PathInput smallPath() {
@@ -65,22 +64,11 @@ void checkMachinePlans(const runtime::Machine &machine, std::string_view input) 
 
 void checkInput(std::string_view input) {
   auto source = SourceFile::fromString("fuzz-input.toml", input);
-  {
-    DiagnosticCollector collected;
-    DiagnosticEngine diags(collected);
-    diags.setMaxErrors(kMaxErrors);
-    auto machine = runtime::readMachine(*source, diags);
-    checkReaderRun(machine.has_value(), diags, collected.diags, {source.get()}, input);
-    if (machine)
-      checkMachinePlans(*machine, input);
-  }
-  {
-    DiagnosticCollector collected;
-    DiagnosticEngine diags(collected);
-    diags.setMaxErrors(kMaxErrors);
-    auto data = cutting::readCuttingData(*source, cutting::shippedCuttingData(), diags);
-    checkReaderRun(data.has_value(), diags, collected.diags, {source.get()}, input);
-  }
+  if (auto machine = readChecked(*source, input, runtime::readMachine))
+    checkMachinePlans(*machine, input);
+  (void)readChecked(*source, input, [](const SourceFile &file, DiagnosticEngine &diags) {
+    return cutting::readCuttingData(file, cutting::shippedCuttingData(), diags);
+  });
 }
 
 } // namespace
