@@ -506,6 +506,15 @@ private:
           offences.push_back({m.node, "feed move with the spindle stopped (spindle=0 on its moves)"});
           break;
         }
+    // A feed no machine is programmed to: a controller reads F0 (what it
+    // rounds to) as no feed and refuses the move.
+    for (const ir::Move &m : s.moves)
+      if (m.isFeed() && !(m.feed >= ir::kPlausibleMinFeedMmPerMin)) {
+        offences.push_back({m.node, "feed move at " + formatShortest(m.feed) + " mm/min, below the " +
+                                        formatTrimmed(ir::kPlausibleMinFeedMmPerMin, 3) +
+                                        " mm/min any machine is programmed to feed"});
+        break;
+      }
     // The rapids of a rapid movement or of the file's explicit toolpaths are
     // the file's own path: below the security plane they are judged on the
     // stock alone (expand-strategies lifted those it showed in the way).

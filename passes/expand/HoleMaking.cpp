@@ -8,6 +8,8 @@
 // with the controller's canned cycle writes that instead.
 #include "passes/expand/Expand.h"
 
+#include "ir/Plausible.h"
+
 #include "support/Format.h"
 
 #include <algorithm>
@@ -61,6 +63,14 @@ std::vector<Zone> reducedFeedZones(Expander &x, const Step &step, double top, do
                 std::string("drilling_strategy ") + end.ratio + " " + formatFixed(*ratio, 3) + " over " + end.depth +
                     " " + formatFixed(*depth, 3) +
                     " mm is not a reduced feed (a ratio in (0, 1] over a positive depth): not applied");
+      continue;
+    }
+    if (feed * *ratio < ir::kPlausibleMinFeedMmPerMin) {
+      x.assumed(step.ws, *ds,
+                std::string("drilling_strategy ") + end.ratio + " " + formatShortest(*ratio) + " of " +
+                    formatTrimmed(feed, 3) + " mm/min makes a feed below the " +
+                    formatTrimmed(ir::kPlausibleMinFeedMmPerMin, 3) +
+                    " mm/min any machine is programmed to feed: not applied");
       continue;
     }
     Zone z;
