@@ -319,6 +319,8 @@ private:
         position = m.to;
     }
     const double tol = tolerance_.value_or(kDefaultTolerance);
+    const ir::Node *holderOf = nullptr;  // the step `holder` is the holder radius of
+    double holder = 0;
     walkStock(module_, rapidCheckCell(module_), [&](const StockMove &sm) {
       if (sm.move->kind == ir::MoveKind::Rapid) {
         if (std::optional<StockHit> hit = rapidMeetsStock(*sm.stock, *sm.move, sm.radius, sm.point, tol))
@@ -334,7 +336,10 @@ private:
         r.flutes.raise(peak, tip, sm.move->node);
         // A holder wider than the tool sweeps a wider disc: a wall beside
         // the tool can meet it.
-        const double holder = holderRadius(sm.executable);
+        if (sm.executable != holderOf) {  // once per step, not per move
+          holderOf = sm.executable;
+          holder = holderRadius(sm.executable);
+        }
         if (holder > sm.radius)
           r.holder.raise(sm.stock->highest(a, b, holder - sm.stock->cell()), tip, sm.move->node);
       }
