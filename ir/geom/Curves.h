@@ -35,6 +35,11 @@ inline constexpr double kSplineChordTolerance = 0.001;
 /// gives. Further off, the arc is refused: every target would have to move
 /// its centre or an end, each its own way (LinuxCNC refuses it).
 inline constexpr double kArcEndTolerance = 0.001;
+/// Whole turns a trimmed helix may make: a 100 mm bore thread-milled at a
+/// 0.01 mm pitch. A pitch that makes more is outside physical sense (a typo,
+/// another unit) and the curve is refused: every turn is motion the
+/// controller runs and the stock check walks.
+inline constexpr double kMaxHelixTurns = 10000;
 
 /// A B-spline curve node (ISO 10303-42: uniform, quasi-uniform, Bezier or
 /// with knots; rational with weights on its points) as a function of its

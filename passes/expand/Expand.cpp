@@ -242,11 +242,11 @@ private:
       return;
     }
     Node moves = makeMoves(ws, tool->symbol, p.spindle, coolant(*op), setup);
+    const double retract = retractPlane(ws, *op);
     // Axial approaches start the retract plane above the feature's top, never
     // above the security plane the moves travel at.
     auto clearanceAbove = [&](double top) {
-      return std::min(top + op->number("retract_plane").value_or(kDefaultClearance),
-                      moves.number("secplane").value_or(1e300));
+      return std::min(top + retract, moves.number("secplane").value_or(1e300));
     };
     bool expanded = false;
     if (!family->needsShape) {
@@ -280,12 +280,31 @@ private:
       if (raw)
         reportOutsideRaw(ws, s, *raw);
       if (secplane < s.top || (raw && secplane < raw->top))
-        raiseSecplane(ws, *op, s, raw, secplane, moves);
+        raiseSecplane(ws, retract, s, raw, secplane, moves);
       p.clearanceZ = clearanceAbove(s.top);
       expanded = dispatch(*family, Step{ws, *op, sel.node, &s, nullptr, p, moves});
     }
     if (expanded)
       x_.attach(ws, std::move(moves));
+  }
+
+  /// The operation's retract plane: the height above the feature's top at
+  /// which axial approaches and drilling cycles start, kDefaultClearance
+  /// when the file gives none. One below the top would start them inside
+  /// the material (a drilling cycle's R below its bottom, which controllers
+  /// refuse): the default is assumed instead, and said.
+  double retractPlane(Node &ws, const Node &op) {
+    const std::optional<double> given = op.number("retract_plane");
+    if (!given)
+      return kDefaultClearance;
+    if (*given < 0) {
+      x_.assumed(ws, op,
+                 "retract_plane " + formatFixed(*given, 4) +
+                     " mm is below the feature's top: approaches and cycles would start inside the material; "
+                     "assumed " + formatFixed(kDefaultClearance, 4) + " mm above it");
+      return kDefaultClearance;
+    }
+    return *given;
   }
 
   /// A security plane below the feature's top or the raw piece's leaves no
@@ -294,10 +313,10 @@ private:
   /// material may remain. The step then travels at the feature's
   /// top or the raw piece's, whichever is higher, plus the retract plane:
   /// an assumption, reported (an error with --strict).
-  void raiseSecplane(Node &ws, const Node &op, const ir::FeatureShape &s, const std::optional<ir::RawBlock> &raw,
+  void raiseSecplane(Node &ws, double retract, const ir::FeatureShape &s, const std::optional<ir::RawBlock> &raw,
                      double secplane, Node &moves) {
     const double top = raw ? std::max(s.top, raw->top) : s.top;
-    const double raised = top + op.number("retract_plane").value_or(kDefaultClearance);
+    const double raised = top + retract;
     const bool belowRaw = raw && raw->top > s.top;
     std::string why = "its security plane z=" + formatFixed(secplane, 4) + " mm is below the top of " +
                       (belowRaw ? "the raw piece" : s.symbol) + " (z=" + formatFixed(top, 4) +
