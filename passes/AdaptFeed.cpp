@@ -16,6 +16,7 @@
 // comments and the
 // `--stats` report.
 #include "passes/CuttingModel.h"
+#include "ir/Plausible.h"
 #include "ir/Program.h"
 #include "passes/CuttingPass.h"
 #include "ir/motion/MotionIR.h"
@@ -38,8 +39,8 @@ constexpr double kPieceCost = 0.25;
 /// Rounds of capping feeds at what the machine reaches (each plans the program).
 constexpr int kCapRounds = 64;
 
-enum class Limit { Chip, Force, Spindle, Programmed, Air };
-constexpr Limit kLimits[] = {Limit::Chip, Limit::Force, Limit::Spindle, Limit::Programmed, Limit::Air};
+enum class Limit { Chip, Force, Spindle, Programmed, Air, Ceiling };
+constexpr Limit kLimits[] = {Limit::Chip, Limit::Force, Limit::Spindle, Limit::Programmed, Limit::Air, Limit::Ceiling};
 const char *limitName(Limit l) {
   switch (l) {
   case Limit::Chip:
@@ -52,6 +53,8 @@ const char *limitName(Limit l) {
     return "programmed feed";
   case Limit::Air:
     return "air (programmed feed kept)";
+  case Limit::Ceiling:
+    return "feed ceiling";
   }
   return "";
 }
@@ -273,6 +276,10 @@ private:
         w = {s.fzTorque, Limit::Spindle};
       if (!allowIncrease_ && cm.fz <= w.fz)
         w = {cm.fz, Limit::Programmed};
+      // An increase stops at the fastest feed stepnc writes: a grazing
+      // sample's chip factor near 0 would otherwise ask for any feed at all.
+      if (const double ceiling = cm.fz * ir::kPlausibleMaxFeedMmPerMin / cm.move.feed; w.fz > std::max(cm.fz, ceiling))
+        w = {std::max(cm.fz, ceiling), Limit::Ceiling};
       wants.push_back(w);
     }
     const std::vector<Group> groups = groupSamples(cm, wants);

@@ -50,6 +50,14 @@ bool PassManager::run(ir::Module &module, DiagnosticEngine &diags) {
       options_.print(text);
     }
   }
+  // Without --verify-each the result is still verified once: what the
+  // backends write from is IR that holds its invariants (a cycle's bottom
+  // below its clearance, positive feeds), whatever a pass got wrong.
+  if (!verifyEach && !passes_.empty() && !ir::verifyModule(module, diags)) {
+    diags.error({}, "the IR the pass pipeline produced does not verify (a bug in stepnc); --verify-each names "
+                    "the pass that broke it");
+    return false;
+  }
   return true;
 }
 

@@ -91,10 +91,12 @@ TEST_CASE("adapt-feed: pocket corners get lower feeds than the walls", "[adapt-f
   Node &op = ir::test::find(p.module->root, "bottom_and_side_rough_milling");
   op.set("axial_depth", Value::length(10)).set("radial_depth", Value::length(3));
   Node &tech = op.add(Node(ir::Kind::Technology));
-  tech.set("feed", Value::feed(12000)).set("spindle", Value::spindle(-3000));
+  tech.set("feed", Value::feed(12000)).set("spindle", Value::spindle(-3000)).set("feed_reference", Value::word("tcp"));
   op.add(Node(ir::Kind::Strategy)).set("type", Value::word("contour_parallel"));
   std::vector<std::string> errors;
-  REQUIRE(test::runPipeline(*p.module, "expand-strategies,adapt-feed,verify-toolpaths", &errors));
+  const bool ran = test::runPipeline(*p.module, "expand-strategies,adapt-feed,verify-toolpaths", &errors);
+  INFO((errors.empty() ? std::string() : errors.front()));
+  REQUIRE(ran);
   const Node &moves = *ir::test::find(p.module->root, "@ws").child(ir::Kind::Moves);
   // The outermost ring at the floor: the tool centre runs round [35, 65] x
   // [15, 35]. Along the middles of its sides the tool takes the 3 mm left by

@@ -161,11 +161,11 @@ TEST_CASE("compensate-deflection: a finished pocket verifies on its predicted pa
       6, "    workingstep @rough \"ROUGH\" feature=%pocket secplane=20.0000mm\n"
          "      bottom_and_side_rough_milling \"ROUGH\" tool=%mill10 axial_depth=5.0000mm radial_depth=4.0000mm "
          "allowance_side=0.5000mm\n"
-         "        technology feed=1200.0mm/min spindle=-3000.0rev/min\n"
+         "        technology feed=1200.0mm/min spindle=-3000.0rev/min feed_reference=tcp\n"
          "        strategy type=contour_parallel\n"
          "    workingstep @ws \"WS\" feature=%pocket secplane=20.0000mm\n"
          "      side_finish_milling \"OP\" tool=%mill10 axial_depth=10.0000mm radial_depth=0.5000mm\n"
-         "        technology feed=1200.0mm/min spindle=-3000.0rev/min\n"));
+         "        technology feed=1200.0mm/min spindle=-3000.0rev/min feed_reference=tcp\n"));
   std::vector<std::string> errors;
   REQUIRE(test::runPipeline(*p.module, "expand-strategies", &errors));
   const ir::Module before = *p.module;

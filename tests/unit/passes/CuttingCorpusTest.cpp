@@ -147,7 +147,9 @@ void checkInvariants(const std::string &path, const cutting::CuttingData &data, 
   // else caps them.
   {
     ir::Module increased = programmed;
-    REQUIRE(test::runPipeline(increased, "adapt-feed<allow-increase=true>", &errors));
+    const bool ran = test::runPipeline(increased, "adapt-feed<allow-increase=true>", &errors);
+    INFO((errors.empty() ? std::string() : errors.front()));
+    REQUIRE(ran);
     const ChipFit fit = chipFit(programmed, increased, data);
     INFO(fit.limited << " samples limited by the chip, " << fit.under << " below 0.9 of the target, lowest "
                      << fit.lowest << ", " << fit.over << " above it");

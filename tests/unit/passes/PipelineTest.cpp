@@ -3,6 +3,9 @@
 
 #include <catch2/catch.hpp>
 
+#include <cstdlib>
+#include <string_view>
+
 using namespace stepnc::passes;
 
 TEST_CASE("pass pipelines parse into names and options", "[passes]") {
@@ -141,14 +144,21 @@ public:
   }
 };
 
-} // namespace
-
-TEST_CASE("a pass that breaks verification is named, and the IR before it printed", "[passes]") {
+/// A module of one 10 mm end mill, %t: what BreaksTheIR breaks.
+stepnc::ir::Module oneToolModule() {
   using namespace stepnc;
   ir::Module m;
   ir::Node &tool = m.root.add(ir::Node(ir::Kind::Tool));
   tool.symbol = "%t";
   tool.set("type", ir::Value::word("endmill")).set("diameter", ir::Value::length(10));
+  return m;
+}
+
+} // namespace
+
+TEST_CASE("a pass that breaks verification is named, and the IR before it printed", "[passes]") {
+  using namespace stepnc;
+  ir::Module m = oneToolModule();
   std::string printed;
   PassManagerOptions options;
   options.verifyEach = true;
@@ -167,4 +177,23 @@ TEST_CASE("a pass that breaks verification is named, and the IR before it printe
                    "; stepnc feature IR (lengths mm, angles deg, feeds mm/min, spindle rev/min, times s)\n"
                    "project\n"
                    "  tool %t type=endmill diameter=10.0000mm\n");
+}
+
+TEST_CASE("without verify-each, the pipeline's result is verified once", "[passes]") {
+  using namespace stepnc;
+  ir::Module m = oneToolModule();
+  PassManagerOptions options;
+  options.verifyEach = false;
+  PassManager manager(options);
+  manager.add(std::make_unique<BreaksTheIR>());
+  DiagnosticCollector sink;
+  DiagnosticEngine diags(sink);
+  if (const char *env = std::getenv("STEPNC_VERIFY_EACH"); env && std::string_view(env) == "1") {
+    WARN("STEPNC_VERIFY_EACH=1 is set: every pass is verified, the single final check is not tested");
+    return;
+  }
+  CHECK_FALSE(manager.run(m, diags));
+  REQUIRE(sink.diags.size() == 2);
+  CHECK(sink.diags[0].message == "tool %t: attribute 'diameter' must be positive, found -1.0000mm");
+  CHECK(sink.diags[1].message.find("the IR the pass pipeline produced does not verify (a bug in stepnc)") == 0);
 }
