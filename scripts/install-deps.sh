@@ -1,15 +1,22 @@
 #!/usr/bin/env bash
 # Installs every Debian package stepnc needs to build, test and benchmark.
+#   scripts/install-deps.sh          build, test, benchmark
+#   scripts/install-deps.sh --fuzz   and clang 16 for the libFuzzer build (tests/fuzz)
 # Idempotent and non-interactive: packages already present are left alone, and
 # apt-get is only called when something is missing. Run as root (or with sudo).
 # docs/dependencies.md says why each package is here.
 set -euo pipefail
 
+fuzz=0
+case "${1:-}" in
+  --fuzz) fuzz=1 ;;
+  "") ;;
+  *) echo "usage: $0 [--fuzz]" >&2; exit 2 ;;
+esac
+
 packages=(
   # toolchain
   build-essential cmake ninja-build python3 pkg-config
-  # fuzzing (libFuzzer ships with clang's runtime; 16, not 14, builds the ANTLR lexer)
-  clang-16 libclang-rt-16-dev
   # EXPRESS frontend: ANTLR 4.7.2 tool + 4.9 C++ runtime
   antlr4 libantlr4-runtime-dev
   # geometry
@@ -23,6 +30,11 @@ packages=(
   # benchmarks
   libbenchmark-dev
 )
+# fuzzing (libFuzzer ships with clang's runtime; 16, not 14, builds the ANTLR
+# lexer): only the fuzz build needs it, not the tests CI runs.
+if [ "$fuzz" = 1 ]; then
+  packages+=(clang-16 libclang-rt-16-dev)
+fi
 
 missing=()
 for p in "${packages[@]}"; do

@@ -25,6 +25,13 @@ for var in ("ASAN_OPTIONS", "UBSAN_OPTIONS"):
     if var in os.environ:
         config.environment[var] = os.environ[var]
 
+# The sanitizer build (scripts/build.sh --sanitize) runs every test but the
+# sweeps that put the whole corpus through the whole pipeline once more for
+# another reader or target: they say `UNSUPPORTED: sanitizer` and run in the
+# Release build only (docs/testing.md, "What the sanitizer build runs").
+if config.stepnc_sanitize == "ON":
+    config.available_features.add("sanitizer")
+
 corpus = os.path.abspath(os.environ.get("STEPNC_CORPUS") or config.corpus_dir)
 if os.path.isdir(corpus):
     config.available_features.add("corpus")

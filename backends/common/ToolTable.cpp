@@ -232,8 +232,9 @@ std::optional<ToolTable> ToolTable::parse(const SourceFile &file, DiagnosticEngi
         const std::string &f = fields[next].first;
         const size_t eq = f.find('=');
         const SourceLoc at{&file, fields[next].second};
-        const std::string key = eq == std::string::npos ? f : f.substr(0, eq);
-        std::optional<double> *slot = key == "holder" ? &e.holderDiameter : key == "stickout" ? &e.stickout : nullptr;
+        const std::string name = eq == std::string::npos ? f : f.substr(0, eq);
+        std::optional<double> *slot =
+            name == "holder" ? &e.holderDiameter : name == "stickout" ? &e.stickout : nullptr;
         if (eq == std::string::npos || !slot) {
           diags.error(at, "tool table: '" + f + "' is not a field of a tool's line (tool, number, length, then " +
                               "holder=<diameter mm>, stickout=<mm from the tip to the holder>)");
@@ -244,12 +245,12 @@ std::optional<ToolTable> ToolTable::parse(const SourceFile &file, DiagnosticEngi
         double value = 0;
         auto [p, ec] = std::from_chars(v.data(), v.data() + v.size(), value);
         if (ec != std::errc() || p != v.data() + v.size() || !(value > 0) || value > ir::kMaxLengthMm) {
-          diags.error(at.advanced(eq + 1), "tool table: '" + v + "' is not a positive length in mm for " + key);
+          diags.error(at.advanced(eq + 1), "tool table: '" + v + "' is not a positive length in mm for " + name);
           bad = true;
           break;
         }
         if (slot->has_value()) {
-          diags.error(at, "tool table: " + key + "= is given twice");
+          diags.error(at, "tool table: " + name + "= is given twice");
           bad = true;
           break;
         }

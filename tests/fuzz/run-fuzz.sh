@@ -39,6 +39,7 @@ stepnc=${STEPNC:-$root/build/bin/stepnc}
 
 # --- build -------------------------------------------------------------------
 if [[ ! -f $build/build.ninja ]]; then
+  "$root/scripts/install-deps.sh" --fuzz
   CC=${CC:-clang-16} CXX=${CXX:-clang++-16} cmake -S "$root" -B "$build" -G Ninja \
     -DSTEPNC_BUILD_FUZZ=ON -DSTEPNC_BUILD_TESTS=OFF -DSTEPNC_BUILD_BENCH=OFF \
     -DCMAKE_BUILD_TYPE=RelWithDebInfo
