@@ -278,8 +278,9 @@ private:
         w = {cm.fz, Limit::Programmed};
       // An increase stops at the fastest feed stepnc writes: a grazing
       // sample's chip factor near 0 would otherwise ask for any feed at all.
-      if (const double ceiling = cm.fz * ir::kPlausibleMaxFeedMmPerMin / cm.move.feed; w.fz > std::max(cm.fz, ceiling))
-        w = {std::max(cm.fz, ceiling), Limit::Ceiling};
+      if (const double ceiling = std::max(cm.fz, cm.fz * ir::kPlausibleMaxFeedMmPerMin / cm.move.feed);
+          w.fz > ceiling)
+        w = {ceiling, Limit::Ceiling};
       wants.push_back(w);
     }
     const std::vector<Group> groups = groupSamples(cm, wants);

@@ -196,13 +196,15 @@ private:
       if (basis->kind == ir::Kind::Helix) {
         // The angle travelled follows from the rise: |dz| / |pitch| turns.
         const double pitch = std::abs(*basis->number("pitch"));
-        const double total = pitch > 0 ? std::abs(b.z() - a.z()) / pitch * kTwoPi : 0;
-        if (!(total / kTwoPi <= kMaxHelixTurns)) {
-          fail("the trimmed helix rises " + formatFixed(std::abs(b.z() - a.z()), 3) + " mm at a pitch of " +
-               formatShortest(pitch) + " mm: " + formatFixed(total / kTwoPi, 0) + " turns, more than " +
-               formatFixed(kMaxHelixTurns, 0) + " (is the pitch in the file's length unit?)");
+        const double rise = std::abs(b.z() - a.z());
+        const double risen = pitch > 0 ? rise / pitch : 0;  // turns
+        if (!(risen <= kMaxHelixTurns)) {
+          fail("the trimmed helix rises " + formatFixed(rise, 3) + " mm at a pitch of " + formatShortest(pitch) +
+               " mm: " + formatFixed(risen, 0) + " turns, more than " + formatFixed(kMaxHelixTurns, 0) +
+               " (is the pitch in the file's length unit?)");
           return;
         }
+        const double total = risen * kTwoPi;
         // The last partial arc: a whole turn when the ends meet in the plane.
         double partial = ccwAngle(c, a, b);
         if (!ccw && partial > 0)

@@ -293,7 +293,7 @@ private:
   /// when the file gives none. One below the top would start them inside
   /// the material (a drilling cycle's R below its bottom, which controllers
   /// refuse): the default is assumed instead, and said.
-  double retractPlane(Node &ws, const Node &op) {
+  double retractPlane(const Node &ws, const Node &op) {
     const std::optional<double> given = op.number("retract_plane");
     if (!given)
       return kDefaultClearance;
