@@ -67,7 +67,8 @@ bool isRadius(std::string_view name) { return name == "radius" || name.ends_with
 /// Lengths that must be positive; radii may also be 0.
 bool isDimension(std::string_view name) {
   return isRadius(name) || name == "depth" || name == "diameter" || name == "width" || name == "length" ||
-         name == "pitch" || name == "travel" || name == "step" || name == "radial_step" || name == "holder_diameter";
+         name == "pitch" || name == "travel" || name == "step" || name == "radial_step" || name == "holder_diameter" ||
+         name == "overall_length" || name == "cutting_edge_length";
 }
 
 bool isNumber(ValueType t) {

@@ -54,8 +54,8 @@ bool PassManager::run(ir::Module &module, DiagnosticEngine &diags) {
   // backends write from is IR that holds its invariants (a cycle's bottom
   // below its clearance, positive feeds), whatever a pass got wrong.
   if (!verifyEach && !passes_.empty() && !ir::verifyModule(module, diags)) {
-    diags.error({}, "the IR the pass pipeline produced does not verify (a bug in stepnc); --verify-each names "
-                    "the pass that broke it");
+    diags.error({}, "the IR the pass pipeline produced does not verify (a bug in stepnc); `stepnc opt "
+                    "--verify-each` on the lowered IR names the pass that broke it");
     return false;
   }
   return true;

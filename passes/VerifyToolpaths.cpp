@@ -362,7 +362,7 @@ private:
     auto where = [](const Reach::Peak &p) {
       return " stands " + mm(p.engaged) + " above the tool's tip (at " + pointText(p.at) + ")";
     };
-    if (overall && r.flutes.engaged > *overall + s.tol) {
+    if (overall && r.flutes.move && r.flutes.engaged > *overall + s.tol) {
       report(s,
              {{r.flutes.move, "the material its tool " + s.tool->symbol + " meets" + where(r.flutes) +
                                   ", more than its overall length " + mm(*overall) +
@@ -376,7 +376,7 @@ private:
                                   ": the holder would hit the stock beside the tool; a longer tool or a slimmer "
                                   "holder reaches it"}},
              "holder collisions");
-    } else if (flutes && r.flutes.engaged > *flutes + s.tol) {
+    } else if (flutes && r.flutes.move && r.flutes.engaged > *flutes + s.tol) {
       report(s,
              {{r.flutes.move, "the material its tool " + s.tool->symbol + " meets" + where(r.flutes) +
                                   ", more than its cutting edge length " + mm(*flutes) +

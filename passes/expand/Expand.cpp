@@ -12,6 +12,7 @@
 // strategy it does not know. Warnings never change the moves.
 #include "passes/expand/Expand.h"
 
+#include "ir/Plausible.h"
 #include "support/Format.h"
 
 #include <algorithm>
@@ -284,8 +285,42 @@ private:
       p.clearanceZ = clearanceAbove(s.top);
       expanded = dispatch(*family, Step{ws, *op, sel.node, &s, nullptr, p, moves});
     }
-    if (expanded)
+    if (expanded && withinMachine(ws, *feature, moves))
       x_.attach(ws, std::move(moves));
+  }
+
+  /// True when every point and length of the expanded moves is one a
+  /// machine tool can go to (ir::kMaxLengthMm either way); else an error at
+  /// the workingstep naming the first coordinate beyond: a feature whose
+  /// dimensions run past it (a length in another unit, a typo) would make
+  /// IR the verifier refuses, and nothing is written.
+  bool withinMachine(const Node &ws, const Node &feature, const Node &moves) {
+    std::optional<double> beyond;
+    auto scan = [&](const Node &n, auto &self) -> void {
+      for (const ir::Attr &a : n.attrs) {
+        const ir::Value &v = a.value;
+        if (v.type == ir::ValueType::Point && v.vec.cwiseAbs().maxCoeff() > ir::kMaxLengthMm) {
+          Eigen::Index at = 0;
+          v.vec.cwiseAbs().maxCoeff(&at);
+          beyond = v.vec[at];
+        } else if (v.type == ir::ValueType::Length && std::abs(v.number) > ir::kMaxLengthMm) {
+          beyond = v.number;
+        }
+        if (beyond)
+          return;
+      }
+      for (const Node &c : n.children)
+        if (!beyond)
+          self(c, self);
+    };
+    scan(moves, scan);
+    if (!beyond)
+      return true;
+    x_.report(ws, ws,
+              "its toolpath for " + feature.symbol + " reaches " + formatShortest(*beyond) +
+                  " mm, beyond what a machine tool does (at most " + formatShortest(ir::kMaxLengthMm) +
+                  " mm either way): check the feature's placement and dimensions (a length in another unit?)");
+    return false;
   }
 
   /// The operation's retract plane: the height above the feature's top at
