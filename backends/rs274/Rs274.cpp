@@ -19,7 +19,7 @@ TargetDescriptor rs274Descriptor() {
   d.arcs = ArcForm::IncrementalCentre;
   d.helix = true;
   d.helixTurns = true;  // P: number of turns
-  // G81/G82 (dwell P), G83, G85/G89 (dwell P), G84.
+  // G81/G82 (dwell P), G83, G85/G89 (dwell P), G84 and G74 (left hand).
   d.cycles = {{CycleKind::Drill, {.dwell = true}},
               {CycleKind::Peck, {}},
               {CycleKind::Bore, {.dwell = true}},
@@ -79,11 +79,8 @@ private:
 
   /// G54..G59, G59.1..G59.3: the nine coordinate systems of LinuxCNC.
   std::string workOffsetWord(int n) const override {
-    if (n >= 1 && n <= 6)
-      return "G" + std::to_string(53 + n);
-    if (n >= 7 && n <= 9)
-      return "G59." + std::to_string(n - 6);
-    return "";
+    static constexpr const char *kOffsets[] = {"G54", "G55", "G56", "G57", "G58", "G59", "G59.1", "G59.2", "G59.3"};
+    return n >= 1 && n <= 9 ? kOffsets[n - 1] : "";
   }
 
   bool cycle(const Step &s, const HoleCycle &c) override {
@@ -127,10 +124,12 @@ private:
       if (std::abs(c.feedOut - c.feed) > 1e-9)
         return false;
       // LinuxCNC's G84 under G98 feeds out all the way to the first height:
-      // G99 stops at R, and the plan's rapid up follows the cycle.
-      words = "G99 G84 " + xyzr;
+      // G99 stops at R, and the plan's rapid up follows the cycle. G84
+      // taps a right-hand thread and needs the spindle clockwise (M3); a
+      // tap turning counterclockwise (M4) cuts a left-hand thread: G74.
+      words = std::string(s.spindle > 0 ? "G99 G74 " : "G99 G84 ") + xyzr;
       // LinuxCNC keeps P from an earlier cycle (G80 does not clear it), and
-      // its G84 dwells P at the bottom: a tap must not wait there.
+      // its G84 and G74 dwell P at the bottom: a tap must not wait there.
       if (stickyDwell_)
         words += " P0";
       stickyDwell_ = false;

@@ -317,7 +317,7 @@ private:
     if (!beyond)
       return true;
     x_.report(ws, ws,
-              "its toolpath for " + feature.symbol + " reaches " + formatShortest(*beyond) +
+              "its toolpath for " + feature.symbol + " reaches " + formatFixed(*beyond, 4) +
                   " mm, beyond what a machine tool does (at most " + formatShortest(ir::kMaxLengthMm) +
                   " mm either way): check the feature's placement and dimensions (a length in another unit?)");
     return false;
