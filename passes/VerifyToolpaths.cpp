@@ -39,6 +39,7 @@
 #include "ir/Program.h"
 #include "ir/geom/FeatureShape.h"
 #include "ir/geom/MoveWalk.h"
+#include "passes/FeatureWalls.h"
 #include "passes/InProcessStock.h"
 #include "support/Format.h"
 
@@ -227,13 +228,6 @@ std::vector<std::vector<const Cut *>> byLevel(std::vector<const Cut *> cuts) {
   return levels;
 }
 
-/// The area the regions cover together.
-double totalArea(const std::vector<Region> &regions) {
-  if (regions.size() <= 1)
-    return regions.empty() ? 0.0 : regions[0].area();
-  return geom::uniteAll(regions).area();
-}
-
 Region sweep(const std::vector<const Cut *> &cuts, double r) {
   std::vector<Seg> segs;
   for (const Cut *c : cuts)
@@ -245,6 +239,7 @@ Region sweep(const std::vector<const Cut *> &cuts, double r) {
 
 struct Figures {
   std::optional<double> swept, uncut, uncutPercent, gouge;
+  std::optional<double> wallDepth;  ///< mm: the deepest any move reaches into the walls (0: none)
   double path = 0;
   size_t moves = 0;
 };
@@ -609,7 +604,7 @@ private:
       checkSection(s, cuts);
       return;
     }
-    checkGouge(s, cuts);
+    checkWalls(s);
     if (s.op && isMilling(s.op->kind))
       checkUncut(s, cuts);
   }
@@ -684,58 +679,46 @@ private:
     return sweep >= 0 ? to <= sweep : (to == 0 || 2 * std::numbers::pi - to <= -sweep);
   }
 
-  // --- Gouge --------------------------------------------------------------------------
+  // --- Walls --------------------------------------------------------------------------
 
-  /// The part of the swept area outside where the tool may be.
-  Region gougeOf(const Step &s, const Region &swept, const std::vector<size_t> &idx) {
-    if (swept.empty())
-      return {};
-    if (s.shape->unbounded) {
-      const Region &isl = cache_.islands(*s.shape, idx, s.allowanceSide);
-      return isl.empty() ? Region{} : geom::intersect(swept, isl);
+  /// Every feed move below the top of the feature or of one of its islands,
+  /// against the walls as FeatureWalls reads them (by code of its own, not
+  /// ir::FeatureShape's): where the disc of the tool's radius plus the side
+  /// allowance reaches into a wall, a corner radius or an island by more
+  /// than the tolerance, the move gouges; it is reported at the move, with
+  /// how deep and where.
+  void checkWalls(Step &s) {
+    auto it = walls_.find(s.feature->symbol);
+    if (it == walls_.end()) {
+      std::string error;
+      std::optional<FeatureWalls> w = FeatureWalls::read(module_, *s.feature, error);
+      it = walls_.emplace(s.feature->symbol, std::pair(std::move(w), error)).first;
     }
-    return geom::subtract(swept, cache_.allowed(*s.shape, s.allowanceSide, idx));
-  }
-
-  /// True when every cut of the group keeps its centre inside the allowed
-  /// area at least the tool radius from its boundary (less kEps, rounding):
-  /// then no disc leaves the allowed area and the exact sweep is not needed.
-  bool clearlyInside(const Step &s, const std::vector<const Cut *> &cuts, const std::vector<size_t> &idx) {
-    const Region &walls = s.shape->unbounded ? cache_.islands(*s.shape, idx, s.allowanceSide)
-                                             : cache_.allowed(*s.shape, s.allowanceSide, idx);
-    if (walls.empty())
-      return s.shape->unbounded;
-    const geom::SegIndex &index = boundaries_.try_emplace(&walls, geom::SegIndex::of(walls)).first->second;
-    for (const Cut *c : cuts)
-      for (const Seg &seg : c->segs)
-        if (walls.contains(seg.a) == s.shape->unbounded || index.distance(seg) < s.radius - geom::kEps)
-          return false;
-    return true;
-  }
-
-  void checkGouge(Step &s, const std::vector<Cut> &cuts) {
-    // Cuts facing the same islands are checked together; a failing group is
-    // checked again level by level to say where the gouge is.
-    std::map<std::string, std::pair<std::vector<size_t>, std::vector<const Cut *>>> groups;
-    for (const Cut &c : cuts) {
-      std::vector<size_t> idx = islandsAbove(*s.shape, c.low, s.tol);
-      auto &g = groups[indexKey(idx)];
-      g.first = std::move(idx);
-      g.second.push_back(&c);
+    if (!it->second.first) {
+      diags_.warning(s.exec->origin.loc, s.name + ": not checked against the walls of " + s.feature->symbol + ": " +
+                                             it->second.second)
+          .entity(s.exec->origin.entityId);
+      ++stats_["workingsteps not checked against walls"];
+      return;
     }
-    std::vector<Region> gouges;
+    const FeatureWalls &walls = *it->second.first;
+    const std::vector<double> levels = walls.levels(s.tol);
+    const double highest = *std::max_element(levels.begin(), levels.end());
+    const double reach = s.radius + s.allowanceSide;
     std::vector<Offence> offences;
-    for (const auto &[key, group] : groups) {
-      if (clearlyInside(s, group.second, group.first))
+    double deepest = 0;
+    for (const ir::Move &m : s.moves) {
+      if (!m.isFeed() || !m.from || std::min(m.from->z(), m.to.z()) >= highest)
         continue;
-      Region g = gougeOf(s, sweep(group.second, s.radius), group.first);
-      if (g.empty())
-        continue;
-      if (g.area() > s.tol * s.tol)
-        locateGouges(s, group.first, group.second, g.area(), offences);
-      gouges.push_back(std::move(g));
+      const MoveContact c = deepestContact(walls, m, reach, s.tol);
+      deepest = std::max(deepest, c.contact.depth);
+      if (c.contact.depth > s.tol)
+        offences.push_back({m.node, m.node->kindName() + " to " + pointText(m.to) + " gouges " + c.contact.what +
+                                        " by " + mm(c.contact.depth) + " at " + pointText(c.at) + " (tool " + s.tool->symbol + ", radius " + mm(s.radius) +
+                                        ", allowance_side " + mm(s.allowanceSide) + ", tolerance " + mm(s.tol) +
+                                        ")"});
     }
-    s.figures.gouge = totalArea(gouges);
+    s.figures.wallDepth = deepest;
     // Required toolpaths run as the file writes them: where they enter a
     // wall (a finishing path compensated for tool deflection does, by its
     // offset), stepnc warns but does not refuse the file.
@@ -746,23 +729,6 @@ private:
       return;
     }
     report(s, offences, "gouge errors");
-  }
-
-  void locateGouges(const Step &s, const std::vector<size_t> &idx, const std::vector<const Cut *> &cuts,
-                    double total, std::vector<Offence> &offences) {
-    const size_t before = offences.size();
-    for (const auto &level : byLevel(cuts)) {
-      const double area = gougeOf(s, sweep(level, s.radius), idx).area();
-      if (area > s.tol * s.tol)
-        offences.push_back({s.exec, gougeText(s, area, "at depth level z=" + mm(level.front()->low))});
-    }
-    if (offences.size() == before)  // only the levels together exceed the tolerance
-      offences.push_back({s.exec, gougeText(s, total, "over several depth levels")});
-  }
-
-  static std::string gougeText(const Step &s, double area, const std::string &where) {
-    return "gouge of " + mm2(area) + " into " + s.shape->symbol + " " + where + " (tool " + s.tool->symbol +
-           ", radius " + mm(s.radius) + ", allowance_side " + mm(s.allowanceSide) + ")";
   }
 
   // --- Uncut ----------------------------------------------------------------------------
@@ -1144,6 +1110,8 @@ private:
           " %)");
     if (f.gouge)
       add("gouge " + formatFixed(*f.gouge, 3) + " mm2");
+    if (f.wallDepth)
+      add("gouge " + formatFixed(std::max(0.0, *f.wallDepth), 4) + " mm");
     add("path " + formatFixed(f.path, 1) + " mm");
     add(std::to_string(f.moves) + " moves");
     ir::replaceCommentPart(movesNode, {"swept ", "path "}, text);
@@ -1181,8 +1149,8 @@ private:
   std::map<std::string, ir::ShapeResult> shapes_;
   std::map<std::string, std::vector<Floor>> floors_;
   RegionCache cache_;
-  /// Distance indexes of cached regions' boundaries (the cache never moves its regions).
-  std::map<const Region *, geom::SegIndex> boundaries_;
+  /// Per feature, its walls as FeatureWalls reads them, or why it cannot.
+  std::map<std::string, std::pair<std::optional<FeatureWalls>, std::string>> walls_;
 };
 
 class VerifyToolpathsPass final : public Pass {

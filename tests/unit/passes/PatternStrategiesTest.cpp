@@ -221,7 +221,7 @@ TEST_CASE("pattern: a trochoidal slot is one smooth curve as wide as 2 (R_t + R)
   CHECK(errors.empty());
   const ir::Node &moves = movesOf(*l.module);
   CHECK(uncutPercent(moves) < 0.1);
-  CHECK(moves.comment.find("gouge 0.000 mm2") != std::string::npos);
+  CHECK(moves.comment.find("gouge 0.0000 mm") != std::string::npos);
 
   const std::vector<ir::Move> all = ir::walkMoves(moves);
   const std::vector<ir::Move> troch = trochoidRun(all);
@@ -264,7 +264,7 @@ TEST_CASE("pattern: a trochoidal pocket stays smooth across its rings and verifi
   CHECK(run(*l.module, "resolve-feeds,expand-strategies,verify-toolpaths").empty());
   const ir::Node &moves = movesOf(*l.module);
   CHECK(uncutPercent(moves) < 0.1);
-  CHECK(moves.comment.find("gouge 0.000 mm2") != std::string::npos);
+  CHECK(moves.comment.find("gouge 0.0000 mm") != std::string::npos);
   // One run through every ring and the links between them (about 190 loops).
   checkPocketTrochoid(moves, 9000);
 }
@@ -292,7 +292,7 @@ TEST_CASE("pattern: plunges go along the tool axis, link above the material, lea
     CHECK(run(*l.module, "resolve-feeds,expand-strategies,verify-toolpaths").empty());
     const ir::Node &moves = movesOf(*l.module);
     CHECK(uncutPercent(moves) < 0.1);
-    CHECK(moves.comment.find("gouge 0.000 mm2") != std::string::npos);
+    CHECK(moves.comment.find("gouge 0.0000 mm") != std::string::npos);
     const ir::Node *strategy = nullptr;
     for (const ir::Node *exec : ir::programOrder(*l.module))
       for (const ir::Node &c : exec->children)

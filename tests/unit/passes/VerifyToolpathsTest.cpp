@@ -228,7 +228,7 @@ TEST_CASE("verify-toolpaths: a path clearing the whole pocket passes, with its f
   // Path: down 18 + 12, ring 100, link 5 sqrt 2, stadium 40 + 10 pi, up 12 + 18.
   const double path = 18 + 12 + 100 + 5 * std::sqrt(2.0) + 40 + 10 * kPi + 12 + 18;
   CHECK(moves.comment == "swept " + formatFixed(kPocketArea, 2) +
-                             " mm2, uncut 0.00 mm2 (0.000 %), gouge 0.000 mm2, " + "path " +
+                             " mm2, uncut 0.00 mm2 (0.000 %), gouge 0.0000 mm, " + "path " +
                              formatFixed(path, 1) + " mm, 14 moves");
   CHECK(o.stats["workingsteps verified"] == 1);
   CHECK(o.stats["moves checked"] == 14);
@@ -247,20 +247,26 @@ TEST_CASE("verify-toolpaths: a move pushed 0.5 mm out of the pocket gouges", "[v
   Node &moves = attach(*p.module, "@ws", clearingPath(0.5));
   Outcome o = verify(*p.module);
   CHECK_FALSE(o.ok);
-  const std::string e = errorWith(o, "gouge of ");
-  CHECK(contains(e, "workingstep @ws: gouge of "));
-  CHECK(contains(e, " into %pocket at depth level z=-10.0000 mm (tool %mill10, radius 5.0000 mm"));
-  // A band 30 x 0.5 below the pocket, and at each lower corner the disc of
-  // radius 5 moved 0.5 down out of the corner arc: its chord 10 x 0.5 / 2.
-  const double gouge = numberAfter(e, "gouge of ");
-  CHECK(gouge == Approx(30 * 0.5 + 2 * 2.5).margin(0.0005));
-  CHECK(numberAfter(moves.comment, "gouge ") == Approx(gouge).margin(0.0005));
-  CHECK(o.stats["gouge errors"] == 1);
+  // The plunge at (-15, -10.5), the first side at y = -10.5 and the two
+  // moves that end or start on it: the tool's disc of radius 5 stands 4.5
+  // from the wall at y = -15. Three are reported, all five counted.
+  const std::vector<std::string> found = errorsWith(o, " gouges a wall of %pocket by ");
+  REQUIRE(found.size() == 3);
+  CHECK(contains(found[0], "workingstep @ws: linear to (-15.0000, -10.5000, -10.0000) gouges a wall of %pocket by "
+                           "0.5000 mm at (-15.0000, -10.5000, -10.0000) (tool %mill10, radius 5.0000 mm, "
+                           "allowance_side 0.0000 mm, tolerance 0.0100 mm)"));
+  for (const std::string &e : found)
+    CHECK(numberAfter(e, " by ") == Approx(0.5).margin(1e-9));
+  CHECK(numberAfter(moves.comment, "gouge ") == Approx(0.5).margin(1e-9));
+  CHECK(o.stats["gouge errors"] == 5);
 
-  // Below the tolerance squared, a gouge is not an error.
+  // Within the tolerance, a gouge is not an error.
   ir::test::Parsed q = parseModule(workingstep("@ws", "%pocket", kFinish));
   attach(*q.module, "@ws", clearingPath(0.5));
-  CHECK(verify(*q.module, "tolerance=5").errors.empty());
+  CHECK(verify(*q.module, "tolerance=0.6").errors.empty());
+  ir::test::Parsed r = parseModule(workingstep("@ws", "%pocket", kFinish));
+  attach(*r.module, "@ws", clearingPath(0.5));
+  CHECK(verify(*r.module, "tolerance=0.4").stats["gouge errors"] == 5);
 }
 
 TEST_CASE("verify-toolpaths: half a pocket cleared leaves the other half uncut", "[verify]") {
@@ -318,8 +324,10 @@ TEST_CASE("verify-toolpaths: a pocket with a boss", "[verify]") {
     path.enter(-15, 0).line(15, 0);
     attach(*p.module, "@ws", path.leave());
     Outcome o = verify(*p.module);
-    const std::string e = errorWith(o, "gouge of ");
-    CHECK(numberAfter(e, "gouge of ") == Approx(9 * kPi).margin(0.0005));
+    // Over the boss's centre the disc of radius 5 reaches 5 + 3 into it.
+    const std::string e = errorWith(o, " gouges island %boss by ");
+    CHECK(numberAfter(e, " by ") == Approx(8).margin(0.005));
+    CHECK(contains(e, " at (0.00"));
   }
   SECTION("without the island the same cut is fine") {
     ir::test::Parsed p = parseModule(workingstep("@ws", "%pocket", kFinish), false);
