@@ -1,8 +1,10 @@
 // verify-toolpaths: checks the moves of every workingstep against its feature,
-// independently of the code that generated them. It shares with strategy
-// expansion only the reading of the feature (ir::FeatureShape) and of the moves
-// (MoveWalk); every area is computed with the exact Booleans of geom/Boolean.h
-// (never with geom::offset or geom::clip, the generator's tools).
+// independently of the code that generated them. The gouge check reads the
+// feature's walls by code of its own (FeatureWalls); the uncut checks share
+// with strategy expansion the reading of the feature (ir::FeatureShape) and
+// compute every area with the exact Booleans of geom/Boolean.h (never with
+// geom::offset or geom::clip, the generator's tools). All read the moves
+// through MoveWalk.
 //
 // Per executable with moves (docs/toolpaths.md, "Verification", says the same
 // in prose):
@@ -18,9 +20,10 @@
 //           higher than the overall length either (error);
 //   depth   no move below the floor (bottom + allowance_bottom; through
 //           bottoms allow the tool's point and an overcut);
-//   gouge   the disc swept by feed moves below the feature's top stays in
-//           the limit shrunk by the side allowance and out of the islands
-//           grown by it (round holes: on the axis, tool no wider than the hole);
+//   gouge   no feed move below the feature's top takes the tool's disc,
+//           grown by the side allowance, more than the tolerance into a
+//           wall, a corner radius or an island (round holes made by hole
+//           making: on the axis, tool no wider than the hole);
 //   uncut   at the floor level the sweep covers what the tool can reach
 //           (the opening of the allowed area with the tool radius);
 //   slots with slanted or curved walls instead: the tool as a body (its
