@@ -5,6 +5,9 @@
 #include "ir/Program.h"
 #include "ir/motion/MotionIR.h"
 #include "runtime/NativeFormat.h"
+#include "support/SourceFile.h"
+
+#include <algorithm>
 
 namespace stepnc::backends {
 
@@ -37,7 +40,59 @@ public:
     auto trajectory = ir::readMotion(module, diags);
     if (!trajectory)
       return std::nullopt;
-    return runtime::writeNative(*trajectory, options.source);
+    std::string text = runtime::writeNative(*trajectory, options.source);
+    if (!readsBack(module, text, diags))
+      return std::nullopt;
+    return text;
+  }
+
+private:
+  /// What is written is what `stepnc sim` and every reader of the format
+  /// accept: the text is read back with the reader's own checks (profiles
+  /// that cover their segments and start where the one before ended, limits
+  /// held, finite numbers). A plan that fails them is stepnc's bug: an error
+  /// at the workingstep whose segment failed, and nothing written.
+  static bool readsBack(const ir::Module &module, const std::string &text, DiagnosticEngine &diags) {
+    std::unique_ptr<SourceFile> file = SourceFile::fromString("native output", text);
+    DiagnosticCollector collected;
+    DiagnosticEngine check(collected);
+    if (runtime::readNative(*file, check) && check.errorCount() == 0)
+      return true;
+    const auto failed = std::find_if(collected.diags.begin(), collected.diags.end(),
+                                     [](const Diagnostic &d) { return d.severity == Severity::Error; });
+    const std::string why = failed == collected.diags.end() ? std::string("no reason given") : failed->message;
+    // Segments are written one a line after the `segments` line, in program
+    // order, as the executables' motion nodes hold them.
+    std::optional<size_t> segment;
+    if (failed != collected.diags.end() && failed->loc.valid()) {
+      const size_t at = std::min<size_t>(failed->loc.offset, text.size());
+      const size_t first = text.find("\nsegments ");
+      if (first != std::string::npos && at > first) {
+        const auto lines = std::count(text.begin() + static_cast<std::ptrdiff_t>(first) + 1,
+                                      text.begin() + static_cast<std::ptrdiff_t>(at), '\n');
+        if (lines >= 1)
+          segment = static_cast<size_t>(lines - 1);
+      }
+    }
+    const ir::Node *owner = nullptr;
+    if (segment) {
+      size_t count = 0;
+      for (const ir::Node *e : ir::programOrder(module))
+        if (const ir::Node *motion = e->child(ir::Kind::Motion)) {
+          if (*segment < count + motion->children.size()) {
+            owner = e;
+            break;
+          }
+          count += motion->children.size();
+        }
+    }
+    const std::string where = owner ? owner->kindName() + " " + owner->symbol + ": " : std::string();
+    const std::string which = segment ? "segment " + std::to_string(*segment + 1) + " of " : std::string();
+    diags.error(owner ? owner->origin.loc : SourceLoc{},
+                where + "the native plan stepnc made does not read back (a bug in stepnc): " + which +
+                    "the plan: " + why)
+        .entity(owner ? owner->origin.entityId : 0);
+    return false;
   }
 };
 
