@@ -470,3 +470,35 @@ TEST_CASE("a blend's arc-length table is its curve's length", "[planner]") {
     CHECK(b.length == s);
   }
 }
+
+TEST_CASE("braking starts before segments too short to stop on", "[planner]") {
+  // A long fast line into a chain of 400 pieces 0.005 mm long (2 mm in all)
+  // that ends the program: no piece is long enough to stop on, so the speed
+  // must already be low where the chain begins.
+  for (const std::string name : {"hsc-3axis", "conventional-3axis"}) {
+    const Machine m = test::shippedMachine(name);
+    PathInput p;
+    p.moves.push_back(line(200, 0, 0, 12000));
+    for (int i = 1; i <= 400; ++i)
+      p.moves.push_back(line(200 + 0.005 * i, 0, 0, 12000));
+    INFO(name);
+    check(p, m);
+    const Trajectory t = plan(p, m);
+    REQUIRE(t.profiles.size() >= 2);
+    // Entering the chain no faster than a stop over 2 mm allows: v^2 <= 2 a s.
+    const double a = m.axes[0].acceleration;
+    CHECK(t.profiles[1].v0 <= std::sqrt(2 * a * 2.0) * (1 + 1e-9));
+  }
+}
+
+TEST_CASE("a chain of 20,000 pieces of 0.001 mm plays clean and ends at rest", "[planner]") {
+  const Machine m = test::shippedMachine("hsc-3axis");
+  PathInput p;
+  p.start = Vec3(0, 0, 0);
+  for (int i = 1; i <= 20000; ++i) {
+    const double s = 0.001 * i;
+    p.moves.push_back(line(s, 0.2 * std::sin(s * 0.5), 0, 6000));  // a gentle curve, 20 mm
+  }
+  const SimReport r = check(p, m);
+  CHECK(r.duration > 0);
+}

@@ -616,3 +616,60 @@ TEST_CASE("travel on an xyz machine is what the kinematics' path gives", "[playe
     }
   }
 }
+
+// Each limit the player checks, at 1 % either side of it: a trajectory that
+// asks 1.01 times the limit is a violation of that kind, one that asks 0.99
+// times it is clean.
+TEST_CASE("the player's limits hold at 1 % either side", "[player]") {
+  const Machine m = testMachine();  // 500 mm/s, 2000 mm/s^2, 20000 mm/s^3 per axis
+  auto play = [&](const Trajectory &t, const SimOptions &o = {}) {
+    const SimReport r = simulate(t, m, o);
+    INFO(formatReport(r, t, m));
+    return r;
+  };
+  for (const double f : {1.01, 0.99}) {
+    INFO("the limit times " << f);
+    const size_t expected = f > 1 ? 1 : 0;
+    {
+      // Jerk: the ramp's jerk at f x 20000, up to 250 mm/s.
+      Ramp r;
+      r.jerk = 20000 * f;
+      r.t1 = 0.05;
+      r.t2 = 250 / (r.jerk * r.t1) - r.t1;
+      const SimReport rep = play(oneLine(Vec3(0, 1, 0), 0.5, kV, r));
+      CHECK(std::min<size_t>(count(rep, ViolationKind::Jerk, 1), 1) == expected);
+      CHECK(rep.violations.size() == count(rep, ViolationKind::Jerk, 1));
+    }
+    {
+      // Acceleration: the ramp's plateau at f x 2000, up to 450 mm/s.
+      Ramp r;
+      r.jerk = 16000;
+      r.t1 = 2000 * f / r.jerk;
+      r.t2 = 450 / (r.jerk * r.t1) - r.t1;
+      const SimReport rep = play(oneLine(Vec3(1, 0, 0), 0.5, 450, r));
+      CHECK(std::min<size_t>(count(rep, ViolationKind::Acceleration, 0), 1) == expected);
+      CHECK(rep.violations.size() == count(rep, ViolationKind::Acceleration, 0));
+    }
+    {
+      // Velocity: cruising at f x 500 mm/s, programmed so.
+      Ramp r;
+      r.jerk = 16000;
+      r.t1 = 0.1;
+      r.t2 = 500 * f / (r.jerk * r.t1) - r.t1;
+      const SimReport rep = play(oneLine(Vec3(0, 0, 1), 0.5, 500 * f, r));
+      CHECK(std::min<size_t>(count(rep, ViolationKind::Velocity, 2), 1) == expected);
+      CHECK(rep.violations.size() == count(rep, ViolationKind::Velocity, 2));
+    }
+    {
+      // Deviation: the programmed line f x 0.01 mm beside the played one.
+      const Trajectory t = oneLine(Vec3(1, 0, 0));
+      PathInput off;
+      off.start = Vec3(0, 0.01 * f, 0);
+      off.moves.push_back({PathMove::Kind::Line, Vec3(218.75, 0.01 * f, 0)});
+      SimOptions o;
+      o.programmed = &off;
+      const SimReport rep = play(t, o);
+      CHECK(std::min<size_t>(count(rep, ViolationKind::Deviation), 1) == expected);
+    }
+  }
+}
