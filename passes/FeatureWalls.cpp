@@ -210,6 +210,15 @@ private:
     return out;
   }
 
+  /// The pieces of the feature's `path` (a slot's course of travel, a
+  /// step's boundary), mapped by its frame; `what` names it in messages.
+  std::optional<std::vector<WallPiece>> pathOf(const Node &feature, const Frame &f, const std::string &what) {
+    const Node *path = feature.child(ir::Kind::Path);
+    if (!path || path->children.empty())
+      return fail(feature.kindName() + " " + feature.symbol + " has no " + what);
+    return curve(path->children.front(), {f});
+  }
+
   /// The profile child of `owner` as a closed outline in workpiece
   /// coordinates; `sharp` tells whether it has corners (a rectangle or a
   /// general profile) for a corner radius to round.
@@ -358,10 +367,7 @@ private:
     const Node *profile = feature.child(ir::Kind::SquareUProfile);
     if (!profile)
       return failed("slot " + feature.symbol + " has walls that are not vertical (checked by its cross-section)");
-    const Node *path = feature.child(ir::Kind::Path);
-    if (!path || path->children.empty())
-      return failed("slot " + feature.symbol + " has no course of travel");
-    std::optional<std::vector<WallPiece>> course = curve(path->children.front(), {f});
+    std::optional<std::vector<WallPiece>> course = pathOf(feature, f, "course of travel");
     if (!course)
       return false;
     if (course->empty())
@@ -386,10 +392,7 @@ private:
   /// A step's only wall is its straight boundary; the material it removes
   /// lies on the side of it nearer the raw block's edge.
   bool step(const Node &feature, const Frame &f, FeatureWalls &w) {
-    const Node *path = feature.child(ir::Kind::Path);
-    if (!path || path->children.empty())
-      return failed("step " + feature.symbol + " has no boundary");
-    std::optional<std::vector<WallPiece>> pieces = curve(path->children.front(), {f});
+    std::optional<std::vector<WallPiece>> pieces = pathOf(feature, f, "boundary");
     if (!pieces)
       return false;
     if (pieces->size() != 1 || pieces->front().arc)
