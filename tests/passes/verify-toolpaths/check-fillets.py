@@ -11,8 +11,9 @@ corner radius, with plain geometry here (no code of stepnc's):
     centre lies within (corner radius - tool radius) of the fillet's centre
     (plus the tolerance): the fillet is left, not cut to the tool's radius.
 
-It prints, per workingstep, the number of centres checked and how close the
-tool came to each fillet (the smallest margin), and exits 1 on any offence.
+It prints, per workingstep, the number of centres checked, how close the
+tool came to each fillet (the smallest margin) and its offences, and exits 1
+on any offence.
 
     check-fillets.py IR --polygon "x,y x,y ..." --radius R --top Z
 """
@@ -99,7 +100,7 @@ def main():
             continue
         step = step_of_line[move["line"]]
         r = tool_radius[step[1]]
-        stats = per_step.setdefault(step[0], {"centres": 0, "fillets": fillets(poly, args.radius), "r": r})
+        stats = per_step.setdefault(step[0], {"centres": 0, "fillets": fillets(poly, args.radius), "r": r, "bad": 0})
         for p in samples(move):
             if p[2] >= args.top - 1e-9:
                 continue
@@ -107,6 +108,7 @@ def main():
             wall = min(segment_distance(p, poly[i - 1], poly[i]) for i in range(len(poly)))
             if wall < r - args.tol:
                 bad += 1
+                stats["bad"] += 1
                 if bad <= 10:
                     print("GOUGE %s line %d: centre (%.4f, %.4f) %.4f mm from a wall, tool radius %.4f"
                           % (step[0], move["line"], p[0], p[1], wall, r))
@@ -120,6 +122,7 @@ def main():
                 f["margin"] = min(f["margin"], margin)
                 if margin < -args.tol:
                     bad += 1
+                    stats["bad"] += 1
                     if bad <= 10:
                         print("FILLET %s line %d: centre (%.4f, %.4f) cuts the %.1f mm fillet at (%g, %g) by %.4f mm"
                               % (step[0], move["line"], p[0], p[1], args.radius, f["corner"][0], f["corner"][1],
@@ -128,8 +131,8 @@ def main():
         margins = ", ".join("(%g,%g) %s" % (f["corner"][0], f["corner"][1],
                                            "not reached" if f["margin"] == math.inf else "%.3f" % f["margin"])
                             for f in stats["fillets"])
-        print("%s: tool radius %.3f, %d centres; closest to each fillet (mm to spare): %s"
-              % (name, stats["r"], stats["centres"], margins))
+        print("%s: tool radius %.3f, %d centres; closest to each fillet (mm to spare): %s; offences %d"
+              % (name, stats["r"], stats["centres"], margins, stats["bad"]))
     print("ok" if not bad else "%d offences" % bad)
     return 1 if bad else 0
 
