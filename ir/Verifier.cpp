@@ -300,15 +300,11 @@ void Verifier::checkValue(const Node &n, const Attr &a) {
   auto attr = [&] { return attribute(a.name); };
   if (isNumber(v.type) && !std::isfinite(v.number))
     report(n, attr() + " must be a finite number, found " + formatShortest(v.number));
-  else if (const std::optional<double> bound = magnitudeBound(v.type);
-           bound && (std::abs(v.number) > *bound || v.vec.cwiseAbs().maxCoeff() > *bound)) {
-    Eigen::Index at = 0;
-    v.vec.cwiseAbs().maxCoeff(&at);
-    const double beyond = v.type == ValueType::Point ? v.vec[at] : v.number;
+  else if (const std::optional<double> beyond = beyondMachine(v)) {
     const std::string unit(unitOf(v.type));
     report(n, attr() + (v.type == ValueType::Point ? std::string(" has the coordinate ") : std::string(" is ")) +
-                  formatShortest(beyond) + " " + unit + ", beyond what a machine tool does (at most " +
-                  formatShortest(*bound) + " " + unit + " either way)");
+                  formatShortest(*beyond) + " " + unit + ", beyond what a machine tool does (at most " +
+                  formatShortest(*magnitudeBound(v.type)) + " " + unit + " either way)");
   }
   else if (v.type == ValueType::Time && (n.kind == Kind::Dwell || a.name.starts_with("dwell")) && v.number > 0 &&
            v.number < kMinDwellS)
@@ -384,8 +380,11 @@ void Verifier::checkChildren(const Node &n, const KindSpec &spec) {
     auto found = count([&](const Node &c) { return std::find(kinds.begin(), kinds.end(), c.kind) != kinds.end(); });
     if (found > 1) {
       std::string names;
-      for (Kind k : kinds)
-        names += (names.empty() ? "" : " ") + std::string(kindName(k));
+      for (Kind k : kinds) {
+        if (!names.empty())
+          names += ' ';
+        names += kindName(k);
+      }
       report(n, "expected at most one " + joinWords(names) + ", found " + std::to_string(found));
     }
   }
@@ -492,5 +491,16 @@ void Verifier::checkFlow(const Node &n, const KindSpec &spec) {
 } // namespace
 
 bool verifyModule(const Module &m, DiagnosticEngine &diags) { return Verifier(diags).run(m); }
+
+std::optional<double> beyondMachine(const Value &v) {
+  const std::optional<double> bound = magnitudeBound(v.type);
+  if (!bound)
+    return std::nullopt;
+  if (v.type == ValueType::Point) {
+    Eigen::Index at = 0;
+    return v.vec.cwiseAbs().maxCoeff(&at) > *bound ? std::optional(v.vec[at]) : std::nullopt;
+  }
+  return std::abs(v.number) > *bound ? std::optional(v.number) : std::nullopt;
+}
 
 } // namespace stepnc::ir

@@ -17,6 +17,7 @@
 #include "ir/Node.h"
 #include "support/Diagnostics.h"
 
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -25,5 +26,11 @@ namespace stepnc::ir {
 /// Reports every violation at the node's origin.loc (none when it is invalid),
 /// naming the node (`closed_pocket %pocket1: ...`). True when there was none.
 bool verifyModule(const Module &m, DiagnosticEngine &diags);
+
+/// The number of `v` beyond what a machine tool does (ir/Plausible.h: lengths
+/// and coordinates past kMaxLengthMm, angles, times, rates past theirs), the
+/// coordinate farthest out for a point; nullopt when it is within. What
+/// verifyModule refuses, for a pass that wants to say why first.
+std::optional<double> beyondMachine(const Value &v);
 
 } // namespace stepnc::ir

@@ -21,7 +21,6 @@ constexpr double kTwoPi = 2 * std::numbers::pi;
 /// How far open sides and open slot ends reach into the air: past any machine.
 constexpr double kAir = 1e6;
 
-double cross(const Vec2 &u, const Vec2 &v) { return u.x() * v.y() - u.y() * v.x(); }
 Vec2 left(const Vec2 &v) { return Vec2(-v.y(), v.x()); }
 double angleOf(const Vec2 &v) { return std::atan2(v.y(), v.x()); }
 Vec2 unitAt(double angle) { return Vec2(std::cos(angle), std::sin(angle)); }
@@ -128,7 +127,7 @@ bool Outline::contains(const Vec2 &p) const {
       continue;
     }
     const Vec2 mid = w.centre + w.radius * unitAt(angleOf(w.a - w.centre) + w.sweep / 2);
-    const double side = cross(w.b - w.a, p - w.a), arcSide = cross(w.b - w.a, mid - w.a);
+    const double side = geom::cross(w.b - w.a, p - w.a), arcSide = geom::cross(w.b - w.a, mid - w.a);
     if (side * arcSide > 0)
       in = !in;
   }
@@ -328,7 +327,7 @@ private:
     // Which side of the open side the pocket lies on: the sign of the area
     // the walls enclose with it (arcs by their chords and midpoints).
     double area = 0;
-    auto add = [&](const Vec2 &u, const Vec2 &v) { area += cross(u, v); };
+    auto add = [&](const Vec2 &u, const Vec2 &v) { area += geom::cross(u, v); };
     for (const WallPiece &piece : *walls) {
       if (piece.arc) {
         const Vec2 mid = piece.centre + piece.radius * unitAt(angleOf(piece.a - piece.centre) + piece.sweep / 2);
@@ -475,10 +474,10 @@ void offsetsOf(const WallPiece &w, double rho, std::vector<Offset> &out) {
 
 void intersect(const Offset &u, const Offset &v, std::vector<Vec2> &out) {
   if (!u.circle && !v.circle) {
-    const double den = cross(u.d, v.d);
+    const double den = geom::cross(u.d, v.d);
     if (std::abs(den) < 1e-12)
       return;
-    out.push_back(u.p + u.d * (cross(v.p - u.p, v.d) / den));
+    out.push_back(u.p + u.d * (geom::cross(v.p - u.p, v.d) / den));
     return;
   }
   if (u.circle && v.circle) {
@@ -556,20 +555,20 @@ double FeatureWalls::distanceToCentres(const Vec2 &p, double clearance) const {
 WallContact FeatureWalls::outlineContact(const Vec2 &p, double radius) const {
   const double c = outline_.clearance(p);
   if (fillet_ <= radius || c >= fillet_)
-    return {radius - c, "a wall of " + symbol_};
+    return {radius - c, WallContact::Where::Wall};
   // A tool smaller than the corner radius stays within a disc of that radius
   // inside the walls: it leaves the corners rounded.
   const double depth = distanceToCentres(p, c) - (fillet_ - radius);
   if (radius - c >= depth - 1e-12)
-    return {radius - c, "a wall of " + symbol_};
-  return {depth, "a corner of radius " + formatFixed(fillet_, 4) + " mm of " + symbol_};
+    return {radius - c, WallContact::Where::Wall};
+  return {depth, WallContact::Where::Corner};
 }
 
 WallContact FeatureWalls::tubeContact(const Vec2 &p, double radius) const {
   double d = std::numeric_limits<double>::infinity();
   for (const WallPiece &w : course_)
     d = std::min(d, w.distance(p));
-  WallContact out{radius - (halfWidth_ - d), "a wall of " + symbol_};
+  WallContact out{radius - (halfWidth_ - d), WallContact::Where::Wall};
   for (const FlatEnd &e : flatEnds_) {
     // The square past the end: along `out` from 0 to 1.5 half widths, across
     // 1.5 half widths either way; its signed distance (positive outside).
@@ -577,7 +576,7 @@ WallContact FeatureWalls::tubeContact(const Vec2 &p, double radius) const {
     const double qx = std::abs(s - 0.75 * e.half) - 0.75 * e.half, qy = std::abs(t) - 1.5 * e.half;
     const double outside = Vec2(std::max(qx, 0.0), std::max(qy, 0.0)).norm() + std::min(std::max(qx, qy), 0.0);
     if (radius - outside > out.depth)
-      out = {radius - outside, "the flat end of " + symbol_};
+      out = {radius - outside, WallContact::Where::FlatEnd};
   }
   return out;
 }
@@ -589,17 +588,28 @@ WallContact FeatureWalls::contact(const Vec2 &p, double z, double radius, double
     case Bound::None: break;
     case Bound::Outline: out = outlineContact(p, radius); break;
     case Bound::Tube: out = tubeContact(p, radius); break;
-    case Bound::HalfPlane: out = {radius - (p - planeAt_).dot(planeIn_), "the wall of " + symbol_}; break;
+    case Bound::HalfPlane: out = {radius - (p - planeAt_).dot(planeIn_), WallContact::Where::Wall}; break;
     }
   }
-  for (const Island &i : islands_) {
+  for (size_t k = 0; k < islands_.size(); ++k) {
+    const Island &i = islands_[k];
     if (z >= i.top - tol)
       continue;
     const double depth = radius + i.outline.clearance(p);
     if (depth > out.depth)
-      out = {depth, "island " + i.symbol};
+      out = {depth, WallContact::Where::Island, k};
   }
   return out;
+}
+
+std::string FeatureWalls::describe(const WallContact &c) const {
+  switch (c.where) {
+  case WallContact::Where::Wall: return (bound_ == Bound::HalfPlane ? "the wall of " : "a wall of ") + symbol_;
+  case WallContact::Where::Corner: return "a corner of radius " + formatFixed(fillet_, 4) + " mm of " + symbol_;
+  case WallContact::Where::FlatEnd: return "the flat end of " + symbol_;
+  case WallContact::Where::Island: return "island " + islands_.at(c.island).symbol;
+  }
+  return symbol_;
 }
 
 std::vector<double> FeatureWalls::levels(double tol) const {
@@ -643,7 +653,6 @@ MoveContact deepestContact(const FeatureWalls &walls, const ir::Move &m, double 
     const Vec2 q = a + (b - a) * t;
     return ir::Vec3(q.x(), q.y(), z);
   };
-  auto zAt = [&](double s) { return from.z() + (m.to.z() - from.z()) * (length > 0 ? s / length : 0); };
   // Stretches between the heights where the walls in force change.
   std::vector<double> cuts{0, length};
   if (length > 0 && std::abs(m.to.z() - from.z()) > 0)
@@ -675,7 +684,7 @@ MoveContact deepestContact(const FeatureWalls &walls, const ir::Move &m, double 
     const double s0 = cuts[k], s1 = cuts[k + 1];
     if (s1 <= s0)
       continue;
-    const double z = zAt((s0 + s1) / 2);  // the walls in force along the stretch
+    const double z = at((s0 + s1) / 2).z();  // the walls in force along the stretch
     for (double s = s0;;) {
       const double before = best.contact.depth;
       const double depth = sample(s, z);

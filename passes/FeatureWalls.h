@@ -50,10 +50,13 @@ struct Outline {
 };
 
 /// How a disc stands against the walls: how far it reaches into material
-/// (negative: the room it has to spare) and which wall that is.
+/// (negative: the room it has to spare) and which wall that is
+/// (FeatureWalls::describe says it in words).
 struct WallContact {
+  enum class Where : uint8_t { Wall, Corner, FlatEnd, Island };
   double depth = -1e300;
-  std::string what;
+  Where where = Where::Wall;
+  size_t island = 0;  ///< Where::Island: which of the feature's islands
 };
 
 class FeatureWalls {
@@ -71,6 +74,10 @@ public:
   /// The heights at which the walls in force change: the feature's top and
   /// the islands' tops, each less `tol`.
   std::vector<double> levels(double tol) const;
+
+  /// What a contact is against, for messages: "a wall of %pocket", "a corner
+  /// of radius 5.0000 mm of %pocket", "the flat end of %slot", "island %boss".
+  std::string describe(const WallContact &c) const;
 
 private:
   enum class Bound : uint8_t { None, Outline, Tube, HalfPlane };

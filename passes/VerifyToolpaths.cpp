@@ -716,7 +716,7 @@ private:
       const MoveContact c = deepestContact(walls, m, reach, s.tol);
       deepest = std::max(deepest, c.contact.depth);
       if (c.contact.depth > s.tol)
-        offences.push_back({m.node, m.node->kindName() + " to " + pointText(m.to) + " gouges " + c.contact.what +
+        offences.push_back({m.node, m.node->kindName() + " to " + pointText(m.to) + " gouges " + walls.describe(c.contact) +
                                         " by " + mm(c.contact.depth) + " at " + pointText(c.at) + " (tool " + s.tool->symbol + ", radius " + mm(s.radius) +
                                         ", allowance_side " + mm(s.allowanceSide) + ", tolerance " + mm(s.tol) +
                                         ")"});

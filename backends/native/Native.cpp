@@ -64,15 +64,11 @@ private:
     // Segments are written one a line after the `segments` line, in program
     // order, as the executables' motion nodes hold them.
     std::optional<size_t> segment;
-    if (failed != collected.diags.end() && failed->loc.valid()) {
-      const size_t at = std::min<size_t>(failed->loc.offset, text.size());
-      const size_t first = text.find("\nsegments ");
-      if (first != std::string::npos && at > first) {
-        const auto lines = std::count(text.begin() + static_cast<std::ptrdiff_t>(first) + 1,
-                                      text.begin() + static_cast<std::ptrdiff_t>(at), '\n');
-        if (lines >= 1)
-          segment = static_cast<size_t>(lines - 1);
-      }
+    if (const size_t header = text.find("\nsegments ");
+        failed != collected.diags.end() && failed->loc.valid() && header != std::string::npos) {
+      const uint32_t line = file->lineCol(failed->loc.offset).line, segments = file->lineCol(header + 1).line;
+      if (line > segments)
+        segment = line - segments - 1;
     }
     const ir::Node *owner = nullptr;
     if (segment) {

@@ -13,6 +13,7 @@
 #include "passes/expand/Expand.h"
 
 #include "ir/Plausible.h"
+#include "ir/Verifier.h"
 #include "support/Format.h"
 
 #include <algorithm>
@@ -297,18 +298,10 @@ private:
   bool withinMachine(const Node &ws, const Node &feature, const Node &moves) {
     std::optional<double> beyond;
     auto scan = [&](const Node &n, auto &self) -> void {
-      for (const ir::Attr &a : n.attrs) {
-        const ir::Value &v = a.value;
-        if (v.type == ir::ValueType::Point && v.vec.cwiseAbs().maxCoeff() > ir::kMaxLengthMm) {
-          Eigen::Index at = 0;
-          v.vec.cwiseAbs().maxCoeff(&at);
-          beyond = v.vec[at];
-        } else if (v.type == ir::ValueType::Length && std::abs(v.number) > ir::kMaxLengthMm) {
-          beyond = v.number;
-        }
-        if (beyond)
-          return;
-      }
+      for (const ir::Attr &a : n.attrs)
+        if (a.value.type == ir::ValueType::Point || a.value.type == ir::ValueType::Length)
+          if ((beyond = ir::beyondMachine(a.value)))
+            return;
       for (const Node &c : n.children)
         if (!beyond)
           self(c, self);
