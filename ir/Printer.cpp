@@ -21,9 +21,20 @@ int decimalsOf(ValueType t) {
   case ValueType::Time:
   case ValueType::MassFlow: return 3;
   case ValueType::Direction: return 6;
-  default: return 4;
+  default: return kLengthDecimals;
   }
 }
+
+} // namespace
+
+bool printsAsOnePoint(const Vec3 &a, const Vec3 &b) {
+  for (int k = 0; k < 3; ++k)
+    if (formatFixed(a[k], kLengthDecimals) != formatFixed(b[k], kLengthDecimals))
+      return false;
+  return true;
+}
+
+namespace {
 
 void appendVector(const Vec3 &v, ValueType t, std::string &out) {
   out += '(';

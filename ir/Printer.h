@@ -22,6 +22,14 @@
 
 namespace stepnc::ir {
 
+/// Digits after the decimal point of lengths and points.
+inline constexpr int kLengthDecimals = 4;
+
+/// True when `a` and `b` print as one point (kLengthDecimals). An arc whose
+/// ends do is a whole turn when read back: producers write an arc that
+/// turns less than that as the line it is within the printed resolution.
+bool printsAsOnePoint(const Vec3 &a, const Vec3 &b);
+
 struct PrintOptions {
   /// Print `loc(file:line:col #id)` on nodes whose origin has a valid location.
   bool locations = false;

@@ -1,10 +1,18 @@
 // The backend every target is: the program model built from the toolpath IR,
 // then written by the target's emitter (a class constructed from the
-// descriptor, options and diagnostics, with `run(const Program &)`).
+// descriptor, options and diagnostics, with `run(const Program &)` and
+// `stepLines()`), then read back by the dialect's reader (the emitter's
+// static `read(text, descriptor)`) and compared with the program model
+// (backends/common/ReadBack.h): a program that does not read back is a bug
+// in stepnc, reported at its workingstep, and is not returned.
 #pragma once
 
 #include "backends/Backend.h"
 #include "backends/common/Program.h"
+#include "backends/common/ReadBack.h"
+#include "support/Format.h"
+
+#include <cmath>
 
 namespace stepnc::backends {
 
@@ -14,10 +22,42 @@ public:
 
   std::optional<std::string> emit(const ir::Module &module, const EmitOptions &options,
                                   DiagnosticEngine &diags) override {
+    if (!holdsTolerance(options, diags))
+      return std::nullopt;
     std::optional<Program> program = buildProgram(module, options.toolTable, diags);
     if (!program)
       return std::nullopt;
-    return Emitter(descriptor(), options, diags).run(*program);
+    Emitter emitter(descriptor(), options, diags);
+    std::optional<std::string> text = emitter.run(*program);
+    if (!text)
+      return std::nullopt;
+    const double tolerance = options.tolerance.value_or(descriptor().tolerance);
+    if (!checkReadBack(*program, descriptor(), emitter.stepLines(), *text, Emitter::read(*text, descriptor()),
+                       tolerance, diags))
+      return std::nullopt;
+    return text;
+  }
+
+private:
+  /// Positions printed in steps coarser than half the contour tolerance
+  /// (--target-opt decimals=N) cannot keep the path within it: the ends of
+  /// a move move by half a step, an arc's centre by more. Refused, with the
+  /// decimals that would do.
+  bool holdsTolerance(const EmitOptions &options, DiagnosticEngine &diags) const {
+    const double tolerance = options.tolerance.value_or(descriptor().tolerance);
+    const double step = std::pow(10.0, -descriptor().coordDecimals);
+    if (step <= tolerance / 2 * (1 + 1e-9))
+      return true;
+    int enough = descriptor().coordDecimals;
+    while (std::pow(10.0, -enough) > tolerance / 2 * (1 + 1e-9))
+      ++enough;
+    diags.error(SourceLoc{}, "positions written with " + std::to_string(descriptor().coordDecimals) +
+                                 " decimals (steps of " + formatFixed(step, descriptor().coordDecimals) +
+                                 " mm) cannot keep the path within the contour tolerance " +
+                                 formatFixed(tolerance, 4) + " mm of " + descriptor().name + ": write " +
+                                 std::to_string(enough) + " decimals or more (--target-opt decimals=" +
+                                 std::to_string(enough) + "), or give a larger --tolerance");
+    return false;
   }
 };
 

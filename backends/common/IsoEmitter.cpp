@@ -9,6 +9,11 @@
 
 namespace stepnc::backends {
 
+namespace {
+/// The most an arc block in the radius form turns (radians).
+constexpr double kMaxRadiusArcSweep = 2 * std::numbers::pi / 3;
+} // namespace
+
 std::vector<std::string> headerLines(const Program &p, const EmitOptions &o, const TargetDescriptor &d) {
   std::vector<std::string> lines;
   lines.push_back("stepnc: " + p.name + " from " + o.source);
@@ -36,6 +41,7 @@ std::optional<std::string> IsoEmitter::run(const Program &p) {
   program_ = &p;
   header(p);
   for (const Step &s : p.steps) {
+    stepLines_.push_back(out_.lines() + 1);
     switch (s.kind) {
     case Step::Kind::Message:
       message(s.label);
@@ -243,12 +249,20 @@ void IsoEmitter::spline(const std::vector<Move> &moves, size_t begin, size_t end
 
 void IsoEmitter::arc(const Move &m) {
   const double sweep = m.sweep();
+  if (arcPrintsClosed(m.from.head<2>(), m.to.head<2>(), sweep, d_.coordDecimals)) {
+    Move line = m;
+    line.kind = Move::Kind::Linear;
+    move(line);
+    return;
+  }
   const Vec3 from(roundTo(m.from.x(), d_.coordDecimals), roundTo(m.from.y(), d_.coordDecimals), m.from.z());
-  // Pieces: the radius form takes less than half a turn per block; a target
-  // without multi-turn helices takes at most one turn per block.
+  // Pieces: the radius form takes at most a third of a turn per block (the
+  // controller finds the centre from R and the printed ends, which near half
+  // a turn moves it by many times the rounding); a target without multi-turn
+  // helices takes at most one turn per block.
   int pieces = 1;
   if (d_.arcs == ArcForm::Radius)
-    pieces = static_cast<int>(std::floor(sweep / std::numbers::pi + 1e-9)) + 1;
+    pieces = std::max(1, static_cast<int>(std::ceil(sweep / kMaxRadiusArcSweep - 1e-9)));
   else if (!d_.helixTurns && m.turns > 0)
     pieces = static_cast<int>(m.turns) + 1;
   const bool oneBlockTurns = pieces == 1 && m.turns > 0;

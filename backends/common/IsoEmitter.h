@@ -7,6 +7,7 @@
 
 #include "backends/Backend.h"
 #include "backends/common/Program.h"
+#include "backends/common/ReadBack.h"
 #include "backends/common/Words.h"
 
 #include <optional>
@@ -27,6 +28,8 @@ public:
 
   /// The program text; nullopt after reporting errors.
   std::optional<std::string> run(const Program &p);
+  /// Where each step of the program run() wrote starts in its text.
+  const StepLines &stepLines() const { return stepLines_; }
 
 protected:
   // --- The dialect's words -----------------------------------------------------
@@ -88,6 +91,7 @@ private:
   /// moves[begin, end) as a spline through their end points, in the
   /// descriptor's form.
   void spline(const std::vector<Move> &moves, size_t begin, size_t end);
+  StepLines stepLines_;
   int tool_ = -1;
   double spindle_ = 0;
   std::string coolant_ = "off";

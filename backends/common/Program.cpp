@@ -1,5 +1,6 @@
 #include "backends/common/Program.h"
 
+#include "backends/common/Words.h"
 #include "ir/Kinds.h"
 #include "ir/Printer.h"
 #include "ir/Program.h"
@@ -336,12 +337,7 @@ private:
 } // namespace
 
 double Move::sweep() const {
-  const geom::Vec2 a = from.head<2>() - centre, b = to.head<2>() - centre;
-  double angle = std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));  // ccw from a to b, (-pi, pi]
-  if (!ccw)
-    angle = -angle;
-  if (angle < 0)
-    angle += kTwoPi;
+  double angle = turnAngle(from.head<2>() - centre, to.head<2>() - centre, ccw);
   if ((to.head<2>() - from.head<2>()).norm() <= kSame)
     angle = kTwoPi;  // over the start: a whole turn
   return angle + kTwoPi * static_cast<double>(turns);

@@ -3,6 +3,7 @@
 #include "support/Format.h"
 
 #include <cmath>
+#include <numbers>
 
 namespace stepnc::backends {
 
@@ -84,6 +85,20 @@ geom::Vec2 roundedCentreOffset(const geom::Vec2 &from, const geom::Vec2 &to, con
       }
     }
   return best;
+}
+
+double turnAngle(const geom::Vec2 &a, const geom::Vec2 &b, bool ccw) {
+  double angle = std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));  // ccw from a to b, (-pi, pi]
+  if (!ccw)
+    angle = -angle;
+  if (angle < 0)
+    angle += 2 * std::numbers::pi;
+  return angle;
+}
+
+bool arcPrintsClosed(const geom::Vec2 &from, const geom::Vec2 &to, double sweep, int decimals) {
+  return sweep < std::numbers::pi && roundTo(from.x(), decimals) == roundTo(to.x(), decimals) &&
+         roundTo(from.y(), decimals) == roundTo(to.y(), decimals);
 }
 
 std::vector<geom::Vec2> arcSplitPoints(const geom::Vec2 &from, const geom::Vec2 &centre, bool ccw, double sweep,

@@ -43,6 +43,8 @@ public:
   const std::vector<size_t> &overlong() const { return overlong_; }
   const std::string &text() const { return text_; }
   int blocks() const { return blocks_; }
+  /// Lines written so far (blocks and raw lines).
+  size_t lines() const { return lines_; }
 
 private:
   void put(const std::string &line);
@@ -72,6 +74,16 @@ private:
 /// can leave them about 1.4 units of the last decimal apart, the best
 /// neighbour at most 1 unit (a half circle whose chord ends on half a unit).
 geom::Vec2 roundedCentreOffset(const geom::Vec2 &from, const geom::Vec2 &to, const geom::Vec2 &centre, int decimals);
+
+/// The angle (radians, in [0, 2 pi)) from direction `a` to direction `b`
+/// turning ccw or cw.
+double turnAngle(const geom::Vec2 &a, const geom::Vec2 &b, bool ccw);
+
+/// An arc of less than half a turn whose ends print as one point: a
+/// controller reads an arc that ends where it starts as a whole circle, so
+/// such an arc is written as the straight move it is within a unit of the
+/// last decimal.
+bool arcPrintsClosed(const geom::Vec2 &from, const geom::Vec2 &to, double sweep, int decimals);
 
 /// Points that cut an arc of `sweep` radians (turning ccw or cw about
 /// `centre` from `from`) into `pieces` equal parts: the end of each part.

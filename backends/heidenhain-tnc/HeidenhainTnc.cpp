@@ -5,13 +5,15 @@
 // with M99. Klartext is not ISO G-code, so this target has its own emitter
 // over the shared program model and word helpers; the facts it relies on,
 // and the conservative forms taken where a fact is unverified, are listed
-// in backends/heidenhain-tnc/README.md. The structural checker
-// tests/backends/check-heidenhain-tnc.py reads these programs back.
+// in backends/heidenhain-tnc/README.md. KlartextReader.cpp reads every
+// program back before it is written, as the structural checker
+// tests/backends/check-heidenhain-tnc.py does in the tests.
 #include "backends/Backend.h"
 #include "backends/common/EmitterBackend.h"
 #include "backends/common/IsoEmitter.h"
 #include "backends/common/Program.h"
 #include "backends/common/Words.h"
+#include "backends/heidenhain-tnc/KlartextReader.h"
 
 #include <algorithm>
 #include <array>
@@ -93,20 +95,16 @@ std::string trimmed(std::string text) {
   return text;
 }
 
-/// The angle (radians, in [0, 2 pi)) from `a` to `b` turning ccw or cw.
-double turnAngle(const geom::Vec2 &a, const geom::Vec2 &b, bool ccw) {
-  double angle = std::atan2(a.x() * b.y() - a.y() * b.x(), a.dot(b));
-  if (!ccw)
-    angle = -angle;
-  if (angle < 0)
-    angle += kTwoPi;
-  return angle;
-}
-
 class KlartextEmitter {
 public:
   KlartextEmitter(const TargetDescriptor &d, const EmitOptions &o, DiagnosticEngine &diags)
       : d_(d), o_(o), diags_(diags), out_(d) {}
+
+  /// Where each step of the program starts in its text (ReadBack.h).
+  const StepLines &stepLines() const { return stepLines_; }
+
+  /// The program as the TNC reads it back (KlartextReader.h).
+  static ProgramReading read(const std::string &text, const TargetDescriptor &d) { return readKlartext(text, d); }
 
   std::optional<std::string> run(const Program &p) {
     const std::string name = sanitizedName(o_.programName);
@@ -123,6 +121,7 @@ public:
     out_.block("CYCL DEF 32.0 TOLERANCE");
     out_.block("CYCL DEF 32.1 T" + formatNumber(tolerance(), {6, false, false}));
     for (const Step &s : p.steps) {
+      stepLines_.push_back(out_.lines() + 1);
       switch (s.kind) {
       case Step::Kind::Message:
         out_.block(comment("MESSAGE: " + s.label));
@@ -608,6 +607,7 @@ private:
   const EmitOptions &o_;
   DiagnosticEngine &diags_;
   BlockWriter out_;
+  StepLines stepLines_;
   ModalState modal_;
   /// Where the control has the tool, per axis, when known.
   std::array<std::optional<double>, 3> at_;

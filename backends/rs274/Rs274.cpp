@@ -4,6 +4,7 @@
 #include "backends/Backend.h"
 #include "backends/common/EmitterBackend.h"
 #include "backends/common/IsoEmitter.h"
+#include "backends/common/IsoReader.h"
 
 #include <cmath>
 
@@ -34,12 +35,11 @@ TargetDescriptor rs274Descriptor() {
   return d;
 }
 
-/// LinuxCNC's G83 backs off this far above the previous peck before feeding again (0.010 in).
-constexpr double kG83Delta = 0.254;
-
 class Rs274Emitter final : public IsoEmitter {
 public:
   using IsoEmitter::IsoEmitter;
+
+  static ProgramReading read(const std::string &text, const TargetDescriptor &d) { return readRs274(text, d); }
 
 private:
   std::string comment(const std::string &text) const override {
@@ -113,7 +113,7 @@ private:
         if (std::abs(expected - c.pecks[k]) > 1e-6)
           return false;
       }
-      if (std::abs(c.reapproach - kG83Delta) > 1e-6)
+      if (std::abs(c.reapproach - kLinuxCncG83Backoff) > 1e-6)
         return false;
       words = "G98 G83 " + xyzr + " Q" + num(q);
       break;

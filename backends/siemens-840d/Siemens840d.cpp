@@ -9,6 +9,7 @@
 #include "backends/Backend.h"
 #include "backends/common/EmitterBackend.h"
 #include "backends/common/IsoEmitter.h"
+#include "backends/common/IsoReader.h"
 
 #include <algorithm>
 #include <cctype>
@@ -187,6 +188,10 @@ public:
     return IsoEmitter::run(p);
   }
 
+  static ProgramReading read(const std::string &text, const TargetDescriptor &d) {
+    return readSiemens840d(text, d);
+  }
+
 private:
   /// A tap written as moves would feed out without reversing the spindle and
   /// break: every tapping step must be a CYCLE84, else nothing is written.
@@ -258,9 +263,9 @@ private:
   /// data MD28080 sets up).
   std::string workOffsetWord(int n) const override {
     if (n >= 1 && n <= 4)
-      return "G" + std::to_string(53 + n);
+      return word("G", std::to_string(53 + n));
     if (n >= 5 && n <= 99)
-      return "G" + std::to_string(500 + n);
+      return word("G", std::to_string(500 + n));
     return "";
   }
 

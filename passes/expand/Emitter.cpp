@@ -4,6 +4,8 @@
 // verifier would measure a zero-length sweep).
 #include "passes/expand/Emitter.h"
 
+#include "ir/Printer.h"
+
 namespace stepnc::passes::expand {
 
 using ir::Node;
@@ -47,6 +49,14 @@ void Emitter::linear(const Vec3 &to, double feed, const char *role, bool smooth)
 }
 
 void Emitter::arc(const Vec3 &to, const geom::Vec2 &centre, bool ccw, int64_t turns, double feed, const char *role) {
+  // An arc under half a turn whose ends print as one point would read back
+  // as a whole circle: it is the line it is within the printed resolution.
+  const geom::Vec2 a = pos_.head<2>() - centre, b = to.head<2>() - centre;
+  const bool underHalf = (ccw ? 1 : -1) * (a.x() * b.y() - a.y() * b.x()) > 0 && a.dot(b) > 0;
+  if (turns == 0 && underHalf && ir::printsAsOnePoint(Vec3(pos_.x(), pos_.y(), 0), Vec3(to.x(), to.y(), 0))) {
+    linear(to, feed, role);
+    return;
+  }
   Node &m = moves_.add(Node(ir::Kind::Arc));
   m.set("to", Value::point(to));
   m.set("center", Value::point(at(centre, pos_.z())));
