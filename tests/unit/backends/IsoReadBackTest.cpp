@@ -235,5 +235,32 @@ TEST_CASE("read-back: a program that does not make the plan's moves is an error 
   CHECK_THAT(error(replaced(w.text, "S3000 M3", "S3000 M3\nM5")), Catch::Contains("the spindle off"));
 }
 
+TEST_CASE("read-back: a sliver arc whose ends print as one point is written as a line, not a whole circle",
+          "[readback]") {
+  // 0.0004 mm long: two points in the IR's 4 decimals, one in the 840D's 3,
+  // where an arc over its start is a whole circle.
+  ir::test::Parsed p = test::parseModule(test::blockPocketModule(
+      5, test::oneStep("side_finish_milling \"OP\" tool=%mill10\n"
+                       "        technology feed=600.0mm/min spindle=-3000.0rev/min feed_reference=tcp") +
+             R"(      moves tool=%mill10 spindle=-3000.0rev/min coolant=flood setup=%s1 secplane=20.0000mm
+        rapid to=(55.0000,25.0000,20.0000)mm role=position
+        linear to=(55.0000,25.0000,-5.0000)mm feed=300.0mm/min role=plunge
+        arc to=(55.0004,25.0000,-5.0000)mm center=(55.0002,30.0000,-5.0000)mm dir=ccw feed=600.0mm/min role=cut
+        linear to=(60.0000,25.0000,-5.0000)mm feed=600.0mm/min role=cut
+        rapid to=(60.0000,25.0000,20.0000)mm role=retract
+)"));
+  DiagnosticCollector c;
+  DiagnosticEngine diags(c);
+  backends::EmitOptions options;
+  options.source = "sliver.ir";
+  options.programName = "SLIVER";
+  const std::optional<std::string> text = backends::createBackend("siemens-840d")->emit(*p.module, options, diags);
+  for (const Diagnostic &d : c.diags)
+    FAIL_CHECK(d.message);
+  REQUIRE(text);
+  CHECK(text->find("G3") == std::string::npos);
+  CHECK(text->find("G2") == std::string::npos);
+}
+
 } // namespace
 } // namespace stepnc
