@@ -704,10 +704,18 @@ private:
       r_.problem(n, std::string("a dwell of G4 ") + time + formatFixed(seen.at(time), 3));
       return;
     }
+    wait(n, seen.at(time), false);
+  }
+
+  /// A dwell of `seconds` where the tool is (none when not above 0).
+  void wait(size_t n, double seconds, bool cycle) {
+    if (seconds <= 0)
+      return;
     ReadMove m;
     m.kind = Move::Kind::Dwell;
     m.from = m.to = pos_;
-    m.dwell = seen.at(time);
+    m.dwell = seconds;
+    m.cycle = cycle;
     m.line = n;
     r_.moves.push_back(m);
   }
@@ -744,24 +752,13 @@ private:
     make(n, Move::Kind::Rapid, Vec3(x, y, pos_.z()), true);
     make(n, Move::Kind::Rapid, Vec3(x, y, r), true);
     auto at = [&](double z) { return Vec3(x, y, z); };
-    auto wait = [&](double seconds) {
-      if (seconds <= 0)
-        return;
-      ReadMove m;
-      m.kind = Move::Kind::Dwell;
-      m.from = m.to = pos_;
-      m.dwell = seconds;
-      m.cycle = true;
-      m.line = n;
-      r_.moves.push_back(m);
-    };
     switch (g) {
     case 810:
       make(n, Move::Kind::Linear, at(bottom), true);
       break;
     case 820:
       make(n, Move::Kind::Linear, at(bottom), true);
-      wait(stickyP_);
+      wait(n, stickyP_, true);
       break;
     case 830: {
       const double q = seen.count("Q") ? seen.at("Q") : 0;
@@ -786,7 +783,7 @@ private:
       if (!spindleOn_)
         r_.problem(n, name + " with the spindle off");
       make(n, Move::Kind::Linear, at(bottom), true);
-      wait(stickyP_);
+      wait(n, stickyP_, true);
       make(n, Move::Kind::Linear, at(r), true);
       break;
     case 850:
@@ -795,7 +792,7 @@ private:
       break;
     case 890:
       make(n, Move::Kind::Linear, at(bottom), true);
-      wait(stickyP_);
+      wait(n, stickyP_, true);
       make(n, Move::Kind::Linear, at(r), true);
       break;
     default:
@@ -975,15 +972,8 @@ private:
       feed_ = keep;
     } else {
       make(n, Move::Kind::Linear, at(c.depth), true);
-      if (c.name == "CYCLE82" && v[5].value_or(0) > 0) {
-        ReadMove m;
-        m.kind = Move::Kind::Dwell;
-        m.from = m.to = pos_;
-        m.dwell = *v[5];
-        m.cycle = true;
-        m.line = n;
-        r_.moves.push_back(m);
-      }
+      if (c.name == "CYCLE82")
+        wait(n, v[5].value_or(0), true);
     }
     make(n, Move::Kind::Rapid, at(c.rtp), true);
   }

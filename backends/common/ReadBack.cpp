@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
-#include <regex>
+#include <string_view>
 
 namespace stepnc::backends {
 
@@ -47,7 +47,7 @@ double feedTol(const TargetDescriptor &d) { return 0.5 * std::pow(10.0, -d.feedD
 
 std::string point(const Vec3 &p) {
   auto c = [](double v) { return std::isfinite(v) ? formatFixed(v, 4) : std::string("?"); };
-  return "(" + c(p.x()) + ", " + c(p.y()) + ", " + c(p.z()) + ")";
+  return word("(", c(p.x())) + ", " + c(p.y()) + ", " + c(p.z()) + ")";
 }
 
 const char *kindName(Move::Kind k) {
@@ -97,10 +97,10 @@ double toSegment(const geom::Vec2 &p, const geom::Vec2 &a, const geom::Vec2 &b) 
 /// The step of program `p` whose text holds `line`: the last that starts at
 /// or before it (none before the first step: the header).
 std::optional<size_t> stepAt(const StepLines &lines, size_t line) {
-  std::optional<size_t> at;
-  for (size_t i = 0; i < lines.size() && lines[i] <= line; ++i)
-    at = i;
-  return at;
+  const auto after = std::upper_bound(lines.begin(), lines.end(), line);  // the lines never decrease
+  if (after == lines.begin())
+    return std::nullopt;
+  return static_cast<size_t>(after - lines.begin() - 1);
 }
 
 class Comparison {
@@ -316,14 +316,9 @@ private:
     if (!w.from.head<2>().allFinite())
       return std::nullopt;
     const double radius = (m.from.head<2>() - m.centre).norm();
-    const geom::Vec2 r = w.from.head<2>() - w.centre;
-    double worst = 0;
-    for (int k = 0; k <= kArcSamples; ++k) {
-      const double a = (w.ccw ? 1 : -1) * w.sweep * k / kArcSamples;
-      const geom::Vec2 p = w.centre + geom::Vec2(r.x() * std::cos(a) - r.y() * std::sin(a),
-                                                 r.x() * std::sin(a) + r.y() * std::cos(a));
+    double worst = std::abs((w.from.head<2>() - m.centre).norm() - radius);
+    for (const geom::Vec2 &p : arcSplitPoints(w.from.head<2>(), w.centre, w.ccw, w.sweep, kArcSamples))
       worst = std::max(worst, std::abs((p - m.centre).norm() - radius));
-    }
     return worst;
   }
 
@@ -406,12 +401,16 @@ bool checkReadBack(const Program &p, const TargetDescriptor &d, const StepLines 
 double arcRadiusTolerance(const TargetDescriptor &d) { return std::max(1e-3, unitOf(d)) + 1e-9; }
 
 bool wellFormedNumber(const std::string &text, bool needPoint, std::string &why) {
-  static const std::regex number(R"([-+]?(\d+\.?\d*|\.\d+))");
   if (text.find_first_of("eE") != std::string::npos) {
     why = "'" + text + "' is in exponent notation";
     return false;
   }
-  if (!std::regex_match(text, number)) {
+  // An optional sign, then digits with at most one point, at least one digit.
+  std::string_view body(text);
+  if (!body.empty() && (body.front() == '-' || body.front() == '+'))
+    body.remove_prefix(1);
+  if (body.empty() || body.find_first_not_of("0123456789.") != std::string_view::npos ||
+      std::count(body.begin(), body.end(), '.') > 1 || body == ".") {
     why = "'" + text + "' is not a number";
     return false;
   }
