@@ -43,9 +43,9 @@ const express::Schema *SchemaSelection::select(const p21::Part21File &file, Diag
                           "; checking against schema '" + first->name + "' given with --schema");
     return first;
   }
-  if (const express::Schema *s = express::builtinSchemaFor(names)) {
-    model = &express::builtinModel();
-    return s;
+  if (const express::BuiltinSchema b = express::findBuiltinSchema(names)) {
+    model = b.model;
+    return b.schema;
   }
   diags.warning(at, names.empty() ? "FILE_SCHEMA names no schema; checked for Part 21 syntax only"
                                   : "schema " + listed +
@@ -59,9 +59,9 @@ const express::Schema *SchemaSelection::selectToCompile(const p21::Part21File &f
   if (opts_.none || !opts_.files.empty())
     return select(file, diags, model);
   const std::vector<std::string> names = file.schemaNames();
-  if (const express::Schema *s = express::builtinSchemaFor(names)) {
-    model = &express::builtinModel();
-    return s;
+  if (const express::BuiltinSchema b = express::findBuiltinSchema(names)) {
+    model = b.model;
+    return b.schema;
   }
   // Not a STEP-NC file as far as stepnc knows: say what the file declares
   // and what would be compiled, at the declaration.
@@ -75,8 +75,6 @@ const express::Schema *SchemaSelection::selectToCompile(const p21::Part21File &f
                                        : "FILE_SCHEMA names " + listed +
                                              (names.size() == 1 ? ", which is not" : ", none of which is") +
                                              " a schema stepnc compiles";
-  if (names.size() == 1 && express::upper(names[0]) == "INTEGRATED_CNC_SCHEMA")
-    declared += " (it is the AP238 AIM, the mapped form; stepnc reads the ARM)";
   diags.error(file.loc(header ? header->begin : 0),
               declared + ": stepnc compiles ISO 14649 / AP238 STEP-NC files, whose FILE_SCHEMA names " + known +
                   "; 'stepnc check --schema FILE.exp' checks a file against another EXPRESS schema");
@@ -94,8 +92,10 @@ const express::Schema *SchemaSelection::find(const std::vector<std::string> &nam
         return s;
     return loaded_.schemas().empty() ? nullptr : &loaded_.schemas().front();
   }
-  model = &express::builtinModel();
-  return express::builtinSchemaFor(names.empty() ? std::vector<std::string>{"ISO14649_ARM"} : names);
+  const express::BuiltinSchema b =
+      express::findBuiltinSchema(names.empty() ? std::vector<std::string>{"ISO14649_ARM"} : names);
+  model = b.model;
+  return b.schema;
 }
 
 bool SchemaSelection::readAsPart21(std::unique_ptr<SourceFile> &source, DiagnosticEngine &diags) const {

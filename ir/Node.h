@@ -146,6 +146,9 @@ struct SourceFix {
 struct Module {
   Node root{Kind::Project};
   std::string sourceName;
+  /// The EXPRESS schema lowering read the source through (lower case):
+  /// iso14649_arm, or an AP238 AIM's name. Not part of the IR text.
+  std::string sourceSchema;
   /// Set by lowering; not part of the IR text (IR read from text has the
   /// standard's units).
   SourceUnits sourceUnits;

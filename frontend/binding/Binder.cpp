@@ -103,7 +103,12 @@ private:
   EntityId lookup(std::string_view upperName, uint64_t offset);
   void reportUnknown(size_t index, std::string_view name, uint64_t at);
   void checkInstance(size_t index, const p21::ValueArena &values);
-  void checkRecord(size_t index, const p21::Record &rec, EntityId entity, bool partial);
+  /// Checks one record: a whole instance's (`members` empty) or the record of
+  /// `entity` in a complex instance of `members`.
+  void checkRecord(size_t index, const p21::Record &rec, EntityId entity,
+                   const std::vector<EntityId> *members = nullptr);
+  const express::Slot &effectiveSlot(EntityId entity, uint32_t ownIndex, const std::vector<EntityId> &members,
+                                     EntityId &derivedBy) const;
   void checkComplex(size_t index, const std::vector<EntityId> &set, uint64_t at);
   bool checkValue(const Value &v, TypeId type, const Context &ctx, bool optionalAllowed);
   bool checkNamed(const Value &v, const TypeExpr &t, const Context &ctx);
@@ -607,7 +612,36 @@ bool Binder::checkValue(const Value &v, TypeId type, const Context &ctx, bool op
   }
 }
 
-void Binder::checkRecord(size_t index, const p21::Record &rec, EntityId entity, bool partial) {
+// In a complex instance a subtype may redeclare an attribute of a supertype's
+// record as DERIVE (si_unit derives named_unit.dimensions): the supertype's
+// record then writes it `*`. The k-th attribute `entity` declares is the k-th
+// slot it owns in every subtype's list, whatever the subtype renamed.
+const express::Slot &Binder::effectiveSlot(EntityId entity, uint32_t ownIndex, const std::vector<EntityId> &members,
+                                           EntityId &derivedBy) const {
+  const express::Entity &e = model_.entity(entity);
+  const express::Slot &own = e.slots[e.ownSlots[ownIndex]];
+  derivedBy = entity;
+  for (EntityId m : members) {
+    if (m == entity || !model_.isSubtypeOf(m, entity))
+      continue;
+    uint32_t k = 0;
+    for (const express::Slot &s : model_.entity(m).slots) {
+      if (s.owner != entity)
+        continue;
+      if (k++ == ownIndex) {
+        if (s.derived) {
+          derivedBy = m;
+          return s;
+        }
+        break;
+      }
+    }
+  }
+  return own;
+}
+
+void Binder::checkRecord(size_t index, const p21::Record &rec, EntityId entity, const std::vector<EntityId> *members) {
+  const bool partial = members != nullptr;
   const express::Entity &e = model_.entity(entity);
   auto params = arena_->params(rec);
   std::vector<uint32_t> positions;
@@ -633,12 +667,15 @@ void Binder::checkRecord(size_t index, const p21::Record &rec, EntityId entity, 
     return;
   }
   for (size_t i = 0; i < params.size(); ++i) {
-    const express::Slot &slot = e.slots[positions[i]];
+    EntityId derivedBy = entity;
+    const express::Slot &slot =
+        partial ? effectiveSlot(entity, static_cast<uint32_t>(i), *members, derivedBy) : e.slots[positions[i]];
     Context ctx{index, &slot, i + 1, {}};
     const Value &v = params[i];
     if (slot.derived) {
       if (v.kind != ValueKind::Derived)
-        error(ctx, v, "the attribute is derived in '" + e.name + "' and must be written '*', found " + describe(v));
+        error(ctx, v, "the attribute is derived in '" + model_.entity(derivedBy).name +
+                          "' and must be written '*', found " + describe(v));
       continue;
     }
     checkValue(v, slot.type, ctx, slot.optional);
@@ -741,7 +778,7 @@ void Binder::checkInstance(size_t index, const p21::ValueArena &values) {
       }
       diags_.assumption(at, message + " (read as written)").entity(en.id, entityName(index));
     }
-    checkRecord(index, records[0], e, false);
+    checkRecord(index, records[0], e);
     return;
   }
   std::vector<EntityId> members;
@@ -753,7 +790,7 @@ void Binder::checkInstance(size_t index, const p21::ValueArena &values) {
   }
   checkComplex(index, members, en.begin());
   for (size_t k = 0; k < records.size(); ++k)
-    checkRecord(index, records[k], members[k], true);
+    checkRecord(index, records[k], members[k], &members);
 }
 
 void Binder::run() {

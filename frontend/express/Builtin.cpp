@@ -8,61 +8,115 @@
 namespace stepnc::embedded {
 extern const char iso14649_arm_schema[];
 extern const unsigned long iso14649_arm_schema_size;
+extern const char ap238_aim_e1_schema[];
+extern const unsigned long ap238_aim_e1_schema_size;
+extern const char ap238_aim_e3_schema[];
+extern const unsigned long ap238_aim_e3_schema_size;
 } // namespace stepnc::embedded
 
 namespace stepnc::express {
 
-const Model &builtinModel() {
-  static const Model model = [] {
-    Model m;
-    std::string error;
-    DiagnosticCollector collector;
-    DiagnosticEngine diags(collector);
-    if (!deserializeModel({embedded::iso14649_arm_schema, embedded::iso14649_arm_schema_size}, m, error) ||
-        !m.resolve(diags)) {
-      // The build compiled and checked this text; failing here is a bug.
-      std::cerr << "stepnc: internal error: built-in schema: "
-                << (error.empty() && !collector.diags.empty() ? collector.diags[0].message : error) << '\n';
-      std::abort();
-    }
-    return m;
-  }();
+namespace {
+
+Model load(std::string_view text) {
+  Model m;
+  std::string error;
+  DiagnosticCollector collector;
+  DiagnosticEngine diags(collector);
+  if (!deserializeModel(text, m, error) || !m.resolve(diags)) {
+    // The build compiled and checked this text; failing here is a bug.
+    std::cerr << "stepnc: internal error: built-in schema: "
+              << (error.empty() && !collector.diags.empty() ? collector.diags[0].message : error) << '\n';
+    std::abort();
+  }
+  return m;
+}
+
+const Model &aimEdition1() {
+  static const Model model = load({embedded::ap238_aim_e1_schema, embedded::ap238_aim_e1_schema_size});
   return model;
 }
 
-namespace {
+const Model &aimEdition3() {
+  static const Model model = load({embedded::ap238_aim_e3_schema, embedded::ap238_aim_e3_schema_size});
+  return model;
+}
 
 constexpr std::string_view kExtensionName = "STEPNC_PATTERN_STRATEGIES";
+constexpr std::string_view kAimEdition1 = "INTEGRATED_CNC_SCHEMA";
+constexpr std::string_view kAimEdition3 = "MODEL_BASED_INTEGRATED_MANUFACTURING_SCHEMA";
+
+/// A FILE_SCHEMA name without the object identifier some writers append
+/// ('AUTOMOTIVE_DESIGN { 1 0 10303 214 1 1 1 1 }'), upper case.
+std::string schemaKey(std::string_view name) {
+  if (size_t brace = name.find('{'); brace != std::string_view::npos)
+    name = name.substr(0, brace);
+  while (!name.empty() && (name.back() == ' ' || name.back() == '\t'))
+    name.remove_suffix(1);
+  while (!name.empty() && (name.front() == ' ' || name.front() == '\t'))
+    name.remove_prefix(1);
+  return upper(name);
+}
 
 } // namespace
 
+const Model &builtinModel() {
+  static const Model model = load({embedded::iso14649_arm_schema, embedded::iso14649_arm_schema_size});
+  return model;
+}
+
 const std::vector<std::string_view> &builtinSchemaNames() {
   // ISO 14649 names its schemas per part; files name one or several of them,
-  // or the merged schema's name; stepnc's extension goes beside them.
+  // or the merged schema's name; stepnc's extension goes beside them. AP238
+  // AIM files name the AIM.
   static const std::vector<std::string_view> names = {
       "MACHINING_SCHEMA",    "MILLING_SCHEMA",  "TURNING_SCHEMA", "MILLING_TOOL_SCHEMA",
-      "TURNING_TOOL_SCHEMA", "COMBINED_SCHEMA", "ISO14649_ARM",   kExtensionName};
+      "TURNING_TOOL_SCHEMA", "COMBINED_SCHEMA", "ISO14649_ARM",   kExtensionName,
+      kAimEdition1,          kAimEdition3};
   return names;
 }
 
-const Schema *builtinSchemaFor(std::string_view name) {
-  const std::string wanted = upper(name);
+BuiltinSchema findBuiltinSchema(std::string_view name) {
+  const std::string wanted = schemaKey(name);
+  if (wanted == kAimEdition1)
+    return {&aimEdition1(), aimEdition1().findSchema(kAimEdition1)};
+  if (wanted == kAimEdition3)
+    return {&aimEdition3(), aimEdition3().findSchema(kAimEdition3)};
   if (wanted == kExtensionName)
-    return builtinModel().findSchema(kExtensionName);
+    return {&builtinModel(), builtinModel().findSchema(kExtensionName)};
   for (std::string_view n : builtinSchemaNames())
     if (n == wanted)
-      return builtinModel().findSchema("iso14649_arm");
-  return nullptr;
+      return {&builtinModel(), builtinModel().findSchema("iso14649_arm")};
+  return {};
+}
+
+BuiltinSchema findBuiltinSchema(const std::vector<std::string> &names) {
+  // The extension interfaces the whole ARM: when a file lists it, it is the
+  // schema that sees every entity the file may use.
+  BuiltinSchema chosen;
+  for (const std::string &n : names) {
+    const bool extension = schemaKey(n) == kExtensionName;
+    if (chosen && !extension)
+      continue;
+    if (BuiltinSchema s = findBuiltinSchema(n))
+      chosen = s;
+  }
+  return chosen;
+}
+
+const Schema *builtinSchemaFor(std::string_view name) {
+  BuiltinSchema s = findBuiltinSchema(name);
+  return s.model == &builtinModel() ? s.schema : nullptr;
 }
 
 const Schema *builtinSchemaFor(const std::vector<std::string> &names) {
-  // The extension interfaces the whole ARM: when a file lists it, it is the
-  // schema that sees every entity the file may use.
-  const Schema *chosen = nullptr;
-  for (const std::string &n : names)
-    if (const Schema *s = builtinSchemaFor(n); s && (!chosen || upper(n) == kExtensionName))
-      chosen = s;
-  return chosen;
+  BuiltinSchema s = findBuiltinSchema(names);
+  return s.model == &builtinModel() ? s.schema : nullptr;
+}
+
+bool isAimSchema(const Schema &schema) {
+  const std::string key = upper(schema.name);
+  return key == kAimEdition1 || key == kAimEdition3;
 }
 
 } // namespace stepnc::express

@@ -1,5 +1,6 @@
 // Lowering of the program structure: project, workpieces, setups, workplans,
 // workingsteps and NC functions, plus the helpers every lowering file uses.
+#include "frontend/express/Builtin.h"
 #include "frontend/lowering/Lowerer.h"
 #include "frontend/part21/Writer.h"
 #include "ir/Plausible.h"
@@ -787,8 +788,13 @@ std::unique_ptr<ir::Module> Lowerer::run() {
 
 std::unique_ptr<ir::Module> lowerToFeatureIR(const binding::BoundFile &bound, DiagnosticEngine &diags,
                                              const LowerOptions &options) {
+  if (express::isAimSchema(bound.schema()))
+    return lowerAimToFeatureIR(bound, diags, options);
   Lowerer lowerer(bound, diags, options);
-  return lowerer.run();
+  auto module = lowerer.run();
+  if (module)
+    module->sourceSchema = bound.schema().name;
+  return module;
 }
 
 } // namespace stepnc::lowering

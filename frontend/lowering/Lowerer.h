@@ -282,4 +282,9 @@ private:
   double writtenAngleToDeg_ = 1.0;
 };
 
+/// Lowers an AP238 AIM file (LowerAim.cpp): the same IR from the ARM's
+/// mapped form.
+std::unique_ptr<ir::Module> lowerAimToFeatureIR(const binding::BoundFile &bound, DiagnosticEngine &diags,
+                                                const LowerOptions &options);
+
 } // namespace stepnc::lowering

@@ -602,6 +602,10 @@ double cornerRadius(const ir::Node &tool) {
 }
 
 ShapeResult featureShape(const ir::Module &module, const ir::Node &feature) {
+  if (feature.kind == ir::Kind::ToolpathFeature)
+    return {std::nullopt, "toolpath_feature " + feature.symbol +
+                              " has no shape (the file gives only its toolpaths): its moves are checked for the "
+                              "safety rules only"};
   const Node *workpiece = workpieceOf(module, feature);
   FrameResult fr = planeFrame(feature);
   if (!fr.frame)

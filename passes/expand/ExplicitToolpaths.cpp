@@ -102,6 +102,12 @@ bool expandExplicitToolpaths(Expander &x, const Step &step) {
     const Node *tech = tp->child(ir::Kind::Technology);
     const double feed = tech && tech->number("feed") ? *tech->number("feed") : p.feed;
     const ExplicitKind kind = explicitKind(*tp);
+    if (auto dwell = tp->number("dwell")) {
+      // A feedstop waits where the path before it ended.
+      if (e.positioned())
+        e.dwell(*dwell);
+      continue;
+    }
     for (const Node &curve : tp->children) {
       if (curve.category() != ir::Category::Curve)
         continue;

@@ -206,21 +206,12 @@ def run(cmd, **kw):
     return subprocess.run(cmd, capture_output=True, text=True, **kw)
 
 
-def check(stepnc, path, cycles, extra, workdir, program=None):
-    base = os.path.join(workdir, "prog")
-    ir_path, ngc_path, canon_path = base + ".ir", base + ".ngc", base + ".canon"
-    r = run([stepnc, "compile", path, "--emit=toolpath-ir", "-o", ir_path] + extra)
-    if r.returncode != 0:
-        return ["stepnc could not make the toolpath IR:\n" + r.stderr]
-    if program:
-        ngc_path = program
-    else:
-        opts = ([] if cycles else ["--no-cycles"]) + extra
-        r = run([stepnc, "compile", path, "--target=rs274", "-o", ngc_path] + opts)
-        if r.returncode != 0:
-            return ["stepnc could not write the rs274 program:\n" + r.stderr]
-    # The tool table: every T number the program calls, length 0, with the
-    # diameter the header gives (0.25 in otherwise), in inches.
+def run_rs274(ngc_path, workdir):
+    """Runs LinuxCNC's rs274 on a program: (the canonical moves file, None),
+    or (None, why) when rs274 rejects it. The tool table has every T number
+    the program calls, length 0, with the diameter its header gives (0.25 in
+    otherwise), in inches; arcs are checked to 0.001 mm."""
+    canon_path = os.path.join(workdir, "prog.canon")
     tools, diameters = {}, {}
     with open(ngc_path) as f:
         for line in f:
@@ -245,7 +236,26 @@ def check(stepnc, path, cycles, extra, workdir, program=None):
         r = run(["rs274", "-g", "-t", table, "-i", ini, "-v", os.path.join(workdir, "vars.var"), ngc_path,
                  canon_path], cwd=workdir, stdin=subprocess.DEVNULL)
     if r.returncode != 0:
-        return ["rs274 rejected the program (exit %d):\n%s%s" % (r.returncode, r.stdout, r.stderr)]
+        return None, "rs274 rejected the program (exit %d):\n%s%s" % (r.returncode, r.stdout, r.stderr)
+    return canon_path, None
+
+
+def check(stepnc, path, cycles, extra, workdir, program=None):
+    base = os.path.join(workdir, "prog")
+    ir_path, ngc_path = base + ".ir", base + ".ngc"
+    r = run([stepnc, "compile", path, "--emit=toolpath-ir", "-o", ir_path] + extra)
+    if r.returncode != 0:
+        return ["stepnc could not make the toolpath IR:\n" + r.stderr]
+    if program:
+        ngc_path = program
+    else:
+        opts = ([] if cycles else ["--no-cycles"]) + extra
+        r = run([stepnc, "compile", path, "--target=rs274", "-o", ngc_path] + opts)
+        if r.returncode != 0:
+            return ["stepnc could not write the rs274 program:\n" + r.stderr]
+    canon_path, error = run_rs274(ngc_path, workdir)
+    if error:
+        return [error]
     problems, n = compare(toolpath_ir.read_moves(ir_path), canon_moves(canon_path, ngc_path), cycles, 0.05 + 1e-9)
     problems += clearance_problems(canon_path)
     if not problems:

@@ -63,7 +63,7 @@ const express::Schema *checkFile(const p21::Part21File &file, const driver::Sche
   }
   // The bind includes the Part 21 reference check.
   auto bound = binding::bind(file, *model, *schema, diags, driver::bindOptions(diags));
-  if (bound && !diags.hasErrors() && schema == express::builtinSchemaFor(file.schemaNames()))
+  if (bound && !diags.hasErrors() && schema == express::findBuiltinSchema(file.schemaNames()).schema)
     lowering::lowerToFeatureIR(*bound, diags, lowering::LowerOptions{opts.units.conventions()});
   return schema;
 }

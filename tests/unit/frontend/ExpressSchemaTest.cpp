@@ -167,16 +167,7 @@ TEST_CASE("the built-in ARM matches the corpus ARM schema slot by slot", "[expre
     EntityId oid = ours.findEntity(os, re.name);
     INFO("entity " << re.name);
     REQUIRE(oid != kNone);
-    const Entity &oe = ours.entity(oid);
-    CHECK(oe.abstract == re.abstract);
-    REQUIRE(oe.slots.size() == re.slots.size());
-    for (size_t i = 0; i < re.slots.size(); ++i) {
-      INFO("slot " << i + 1 << " " << re.slots[i].name);
-      CHECK(oe.slots[i].name == re.slots[i].name);
-      CHECK(oe.slots[i].optional == re.slots[i].optional);
-      CHECK(oe.slots[i].derived == re.slots[i].derived);
-      CHECK(ours.typeText(oe.slots[i].type) == ref.typeText(re.slots[i].type));
-    }
+    test::checkSameSlots(ours, ours.entity(oid), ref, re);
     ++compared;
   }
   CHECK(compared >= 490);

@@ -3,6 +3,8 @@
 
 #include "frontend/express/SchemaReader.h"
 
+#include <catch2/catch.hpp>
+
 #include <memory>
 #include <string_view>
 
@@ -22,6 +24,22 @@ inline std::unique_ptr<LoadedExpress> loadExpress(std::string_view text) {
   if (l->ok)
     l->ok = l->model.resolve(engine);
   return l;
+}
+
+/// Checks that entity `oe` of `ours` has the Part 21 slots of `re` of `ref`:
+/// name, optional, derived and type, in order (a built-in schema against the
+/// published text it was written from).
+inline void checkSameSlots(const express::Model &ours, const express::Entity &oe, const express::Model &ref,
+                           const express::Entity &re) {
+  CHECK(oe.abstract == re.abstract);
+  REQUIRE(oe.slots.size() == re.slots.size());
+  for (size_t i = 0; i < re.slots.size(); ++i) {
+    INFO("slot " << i + 1 << " " << re.slots[i].name);
+    CHECK(oe.slots[i].name == re.slots[i].name);
+    CHECK(oe.slots[i].optional == re.slots[i].optional);
+    CHECK(oe.slots[i].derived == re.slots[i].derived);
+    CHECK(ours.typeText(oe.slots[i].type) == ref.typeText(re.slots[i].type));
+  }
 }
 
 } // namespace stepnc::test
