@@ -146,9 +146,9 @@ struct SourceFix {
 struct Module {
   Node root{Kind::Project};
   std::string sourceName;
-  /// The EXPRESS schema lowering read the source through (lower case):
-  /// iso14649_arm, or an AP238 AIM's name. Not part of the IR text.
-  std::string sourceSchema;
+  /// The AP238 AIM schema the source was read through (lower case), empty
+  /// for an ISO 14649 ARM file or IR text. Not part of the IR text.
+  std::string aimSchema;
   /// Set by lowering; not part of the IR text (IR read from text has the
   /// standard's units).
   SourceUnits sourceUnits;

@@ -79,6 +79,31 @@ bool isDigits(std::string_view s) {
 
 bool startsWith(const std::string &text, std::string_view prefix) { return text.rfind(prefix, 0) == 0; }
 
+/// The words of an arc block after its keyword (C, CP), read in the order
+/// the block writes them: each optional word taken when it comes next.
+class ArcWords {
+public:
+  explicit ArcWords(const std::vector<std::string> &words) : w_(words) {}
+  /// The value of the next word when it starts with `address` (taken).
+  std::optional<std::string> take(std::string_view address) {
+    if (k_ < w_.size() && startsWith(w_[k_], address))
+      return w_[k_++].substr(address.size());
+    return std::nullopt;
+  }
+  /// DR+ (true, counterclockwise) or DR- (false) when it comes next (taken).
+  std::optional<bool> direction() {
+    if (k_ < w_.size() && (w_[k_] == "DR+" || w_[k_] == "DR-"))
+      return w_[k_++] == "DR+";
+    return std::nullopt;
+  }
+  /// Every word was taken.
+  bool done() const { return k_ == w_.size(); }
+
+private:
+  const std::vector<std::string> &w_;
+  size_t k_ = 1;  // after the keyword
+};
+
 std::string withoutTrailingSpaces(std::string text) {
   while (!text.empty() && (text.back() == ' ' || text.back() == '\t' || text.back() == '\r'))
     text.pop_back();
@@ -586,19 +611,11 @@ private:
 
   /// C [X..] [Y..] DR+/- [F..]: an arc about the pole to the end point.
   void arcBlock(const Block &b, const std::vector<std::string> &w) {
-    size_t k = 1;
-    std::optional<std::string> x, y, f;
-    if (k < w.size() && startsWith(w[k], "X"))
-      x = w[k++].substr(1);
-    if (k < w.size() && startsWith(w[k], "Y"))
-      y = w[k++].substr(1);
-    const bool dr = k < w.size() && (w[k] == "DR+" || w[k] == "DR-");
-    const bool ccw = dr && w[k] == "DR+";
-    if (dr)
-      ++k;
-    if (k < w.size() && startsWith(w[k], "F"))
-      f = w[k++].substr(1);
-    if (!dr || k != w.size() || (!x && !y) || (x && x->empty()) || (y && y->empty()) || (f && f->empty())) {
+    ArcWords a(w);
+    const std::optional<std::string> x = a.take("X"), y = a.take("Y");
+    const std::optional<bool> ccw = a.direction();
+    const std::optional<std::string> f = a.take("F");
+    if (!ccw || !a.done() || (!x && !y) || (x && x->empty()) || (y && y->empty()) || (f && f->empty())) {
       r_.problem(b.line, "C not of the form 'C X.. Y.. DR+/- [F..]'");
       return;
     }
@@ -609,28 +626,21 @@ private:
       endY = signedNumber(b.line, *y, "coordinate Y");
     if (f)
       feed = positiveFeed(b.line, *f);
-    arc(b.line, endX, endY, ccw, feed);
+    arc(b.line, endX, endY, *ccw, feed);
   }
 
   /// CP IPA.. [IZ..] DR+/- [F..]: the start turned about the pole by the
   /// incremental angle (full turns included), rising by IZ.
   void polarArcBlock(const Block &b, const std::vector<std::string> &w) {
-    size_t k = 1;
-    std::optional<std::string> ipa, iz, f;
-    if (k < w.size() && startsWith(w[k], "IPA"))
-      ipa = w[k++].substr(3);
-    if (k < w.size() && startsWith(w[k], "IZ"))
-      iz = w[k++].substr(2);
-    const bool dr = k < w.size() && (w[k] == "DR+" || w[k] == "DR-");
-    const bool ccw = dr && w[k] == "DR+";
-    if (dr)
-      ++k;
-    if (k < w.size() && startsWith(w[k], "F"))
-      f = w[k++].substr(1);
-    if (!ipa || !dr || k != w.size() || ipa->empty() || (iz && iz->empty()) || (f && f->empty())) {
+    ArcWords a(w);
+    const std::optional<std::string> ipa = a.take("IPA"), iz = a.take("IZ");
+    const std::optional<bool> direction = a.direction();
+    const std::optional<std::string> f = a.take("F");
+    if (!ipa || !direction || !a.done() || ipa->empty() || (iz && iz->empty()) || (f && f->empty())) {
       r_.problem(b.line, "CP not of the form 'CP IPA.. [IZ..] DR+/- [F..]' (IPA and DR are needed)");
       return;
     }
+    const bool ccw = *direction;
     const std::optional<double> angle = signedNumber(b.line, *ipa, "IPA");
     const std::optional<double> rise = iz ? signedNumber(b.line, *iz, "IZ") : std::optional<double>(0.0);
     std::optional<double> feed;

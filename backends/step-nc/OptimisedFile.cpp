@@ -686,12 +686,11 @@ std::unique_ptr<p21::Part21File> buildOptimisedFile(const p21::Part21File &input
                                                     std::unique_ptr<SourceFile> &text, DiagnosticEngine &diags) {
   if (!ir::requireThreeAxisMilling(module, "the STEP-NC writer", diags))
     return nullptr;
-  if (module.sourceSchema != "iso14649_arm" && module.sourceSchema != "stepnc_pattern_strategies" &&
-      !module.sourceSchema.empty()) {
+  if (!module.aimSchema.empty()) {
     // The writer patches the source file's own ARM instances; an AIM file's
     // write-back has to be AIM, which is not written yet (docs/ap238.md).
     diags.error(input.loc(0), "machine-optimised STEP-NC is written for ISO 14649 ARM files; this file is an AP238 "
-                              "AIM file (" + module.sourceSchema +
+                              "AIM file (" + module.aimSchema +
                                   "), whose write-back stepnc does not write yet (docs/ap238.md)");
     return nullptr;
   }

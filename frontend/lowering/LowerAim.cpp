@@ -82,7 +82,6 @@ struct Measure {
   std::string name;  ///< the item's name, normalised
   double value = 0;  ///< in stepnc's base units (UnitValue::factor applied)
   Dims dims;
-  Instance item;
 };
 
 } // namespace
@@ -109,23 +108,25 @@ private:
   UnitValue unit(const Instance &u);
   /// A measure_representation_item (or measure_with_unit) in base units.
   std::optional<Measure> measure(const Instance &item);
-  /// The length unit of a representation's context (mm when it says none).
+  /// The factor of the unit of dimensions `dims` that a representation's
+  /// context assigns; nullopt when it assigns none.
+  std::optional<double> contextFactor(const Instance &representation, const Dims &dims);
+  /// The length unit of a representation's context (mm when it says none: an assumption).
   double lengthFactor(const Instance &representation);
-  double angleFactor(const Instance &representation);
   /// The first descriptive item's text of a property, lower case.
   std::optional<std::string> word(const Instance &of, std::string_view property);
 
   // --- the program ----------------------------------------------------------------
   Instance mainWorkplan();
   void workpiece();
-  bool executable(const Instance &exe, Node &parent);
+  void executable(const Instance &exe, Node &parent);
   std::optional<Node> workplan(const Instance &wp);
   std::optional<Node> workingstep(const Instance &ws);
   std::optional<Node> rapidMovement(const Instance &rm);
   std::optional<Node> operation(const Instance &op, const Instance &ws);
   std::optional<std::string> tool(const Instance &tool);
-  std::optional<Node> technology(const Instance &tech);
-  std::optional<Node> machineFunctions(const Instance &mf);
+  Node technology(const Instance &tech);
+  Node machineFunctions(const Instance &mf);
   void toolpaths(const Instance &owner, Node &parent);
   std::optional<Node> toolpath(const Instance &tp);
   std::string toolpathFeature(const Instance &ws);
@@ -142,21 +143,27 @@ private:
   static std::string entityUpper(const Instance &inst) { return express::upper(inst.entityName()); }
   /// `rep` and the representations representation_relationships tie to it.
   std::vector<Instance> withRelated(const Instance &rep) const;
+  Instance at(size_t index) const { return Instance(bound_, index); }
 
   const binding::BoundFile &bound_;
   DiagnosticEngine &diags_;
   Lowerer base_;  ///< the ARM lowering's geometry and helpers (curves, symbols, reports)
   std::unique_ptr<ir::Module> module_;
 
-  std::map<size_t, std::vector<Instance>> byRelating_;       ///< action_method_relationships by relating_method
-  std::set<size_t> sequenced_;                               ///< executables some workplan sequences
-  std::map<size_t, std::vector<Instance>> actionProps_;      ///< action_property by definition
-  std::map<size_t, std::vector<Instance>> resourceProps_;    ///< resource_property by resource
-  std::map<size_t, std::vector<Instance>> propReps_;         ///< *_property_representation by property
-  std::map<size_t, std::vector<Instance>> repRelated_;       ///< representations related to one, both ways
-  std::map<size_t, Instance> toolOf_;                        ///< machining_tool by operation (usage)
-  std::map<size_t, std::vector<Instance>> componentsOf_;     ///< resources an action_resource_relationship ties to a tool
-  std::map<size_t, Instance> featureOfProcess_;              ///< feature by machining_feature_process
+  // The indexes hold instance indices, not decoded instances: an index entry
+  // is decoded again when lowering follows it, and a large file's indexes
+  // stay small.
+  using Index = std::map<size_t, std::vector<size_t>>;
+  Index byRelating_;                         ///< action_method_relationships by relating_method
+  std::set<size_t> sequenced_;               ///< executables some workplan sequences
+  Index actionProps_;                        ///< action_property by definition
+  Index resourceProps_;                      ///< resource_property by resource
+  Index propReps_;                           ///< *_property_representation by property
+  Index repRelated_;                         ///< representations related to one, both ways
+  Index componentsOf_;                       ///< resources an action_resource_relationship ties to a tool
+  std::map<size_t, size_t> toolOf_;          ///< machining_tool by operation (usage)
+  std::map<size_t, size_t> featureOfProcess_;  ///< feature by machining_feature_process
+  std::set<size_t> workplansOnStack_;        ///< cycle guard for nested workplans
   std::vector<Instance> projects_, workplanProcesses_, projectWorkpieces_;
   std::map<size_t, UnitValue> units_;
   std::map<size_t, std::string> lowered_;  ///< instance -> symbol (tools, features)
@@ -186,32 +193,32 @@ void AimLowerer::index() {
     if (is(i, relationship)) {
       const Instance r(bound_, i);
       if (Instance from = r.ref("relating_method"))
-        byRelating_[from.index()].push_back(r);
+        byRelating_[from.index()].push_back(i);
       if (is(i, sequence))
         if (Instance to = r.ref("related_method"))
           sequenced_.insert(to.index());
     } else if (is(i, actionProperty)) {
       const Instance p(bound_, i);
       if (Instance of = p.ref("definition"))
-        actionProps_[of.index()].push_back(p);
+        actionProps_[of.index()].push_back(i);
     } else if (is(i, resourceProperty)) {
       const Instance p(bound_, i);
       if (Instance of = p.ref("resource"))
-        resourceProps_[of.index()].push_back(p);
+        resourceProps_[of.index()].push_back(i);
     } else if (is(i, actionPropRep) || is(i, resourcePropRep)) {
       const Instance r(bound_, i);
       if (Instance p = r.ref("property"))
-        propReps_[p.index()].push_back(r);
+        propReps_[p.index()].push_back(i);
     } else if (is(i, machiningTool)) {
       const Instance t(bound_, i);
       for (const Instance &use : t.refs("usage"))
-        toolOf_.emplace(use.index(), t);
+        toolOf_.emplace(use.index(), i);
     } else if (is(i, association)) {
       const Instance a(bound_, i);
       if (Instance process = a.ref("process"))
         if (Instance method = process.ref("chosen_method"))
           if (Instance feature = a.ref("property_or_shape"))
-            featureOfProcess_.emplace(method.index(), feature);
+            featureOfProcess_.emplace(method.index(), feature.index());
     } else if (is(i, project)) {
       projects_.emplace_back(bound_, i);
     } else if (is(i, pdProcess)) {
@@ -224,13 +231,13 @@ void AimLowerer::index() {
       const Instance r(bound_, i);
       if (Instance from = r.ref("relating_resource"))
         if (Instance to = r.ref("related_resource"))
-          componentsOf_[from.index()].push_back(to);
+          componentsOf_[from.index()].push_back(to.index());
     } else if (is(i, repRelationship)) {
       const Instance r(bound_, i);
       const Instance a = r.ref("rep_1"), b = r.ref("rep_2");
       if (a && b) {
-        repRelated_[a.index()].push_back(b);
-        repRelated_[b.index()].push_back(a);
+        repRelated_[a.index()].push_back(b.index());
+        repRelated_[b.index()].push_back(a.index());
       }
     }
   }
@@ -239,8 +246,8 @@ void AimLowerer::index() {
 std::vector<Instance> AimLowerer::related(const Instance &from, std::string_view kind) const {
   std::vector<std::pair<double, Instance>> found;
   if (auto it = byRelating_.find(from.index()); it != byRelating_.end())
-    for (const Instance &r : it->second)
-      if (r.isA(kind))
+    for (size_t i : it->second)
+      if (const Instance r = at(i); r.isA(kind))
         if (Instance to = r.ref("related_method"))
           found.emplace_back(r.real("sequence_position").value_or(0), to);
   std::stable_sort(found.begin(), found.end(), [](const auto &a, const auto &b) { return a.first < b.first; });
@@ -256,11 +263,13 @@ std::vector<std::pair<std::string, Instance>> AimLowerer::properties(const Insta
   auto it = table.find(of.index());
   if (it == table.end())
     return out;
-  for (const Instance &p : it->second)
-    if (auto reps = propReps_.find(p.index()); reps != propReps_.end())
-      for (const Instance &r : reps->second)
-        if (Instance rep = r.ref("representation"))
-          out.emplace_back(normalName(p.string("name").value_or("")), rep);
+  for (size_t p : it->second)
+    if (auto reps = propReps_.find(p); reps != propReps_.end()) {
+      const std::string name = normalName(at(p).string("name").value_or(""));
+      for (size_t r : reps->second)
+        if (Instance rep = at(r).ref("representation"))
+          out.emplace_back(name, rep);
+    }
   return out;
 }
 
@@ -278,9 +287,9 @@ std::vector<Instance> AimLowerer::withRelated(const Instance &rep) const {
   std::set<size_t> seen{rep.index()};
   for (size_t k = 0; k < out.size(); ++k)
     if (auto it = repRelated_.find(out[k].index()); it != repRelated_.end())
-      for (const Instance &r : it->second)
-        if (seen.insert(r.index()).second)
-          out.push_back(r);
+      for (size_t r : it->second)
+        if (seen.insert(r).second)
+          out.push_back(at(r));
   return out;
 }
 
@@ -365,7 +374,6 @@ std::optional<Measure> AimLowerer::measure(const Instance &item) {
   }
   Measure m;
   m.name = normalName(item.string("name").value_or(""));
-  m.item = item;
   const Instance u = item.ref("unit_component");
   UnitValue v = unit(u);
   if (!v.error.empty()) {
@@ -379,24 +387,22 @@ std::optional<Measure> AimLowerer::measure(const Instance &item) {
   return m;
 }
 
-double AimLowerer::lengthFactor(const Instance &representation) {
+std::optional<double> AimLowerer::contextFactor(const Instance &representation, const Dims &dims) {
   const Instance context = representation.ref("context_of_items");
   if (context.isA("global_unit_assigned_context"))
     for (const Instance &u : context.refs("units"))
-      if (UnitValue v = unit(u); v.error.empty() && v.dims == kLength)
+      if (UnitValue v = unit(u); v.error.empty() && v.dims == dims)
         return v.factor;
+  return std::nullopt;
+}
+
+double AimLowerer::lengthFactor(const Instance &representation) {
+  if (std::optional<double> f = contextFactor(representation, kLength))
+    return *f;
+  const Instance context = representation.ref("context_of_items");
   if (context && reported_.insert(context.index()).second)
     base_.assumed(context, "units", "gives no length unit; assumed mm");
   return 1;
-}
-
-double AimLowerer::angleFactor(const Instance &representation) {
-  const Instance context = representation.ref("context_of_items");
-  if (context.isA("global_unit_assigned_context"))
-    for (const Instance &u : context.refs("units"))
-      if (UnitValue v = unit(u); v.error.empty() && v.dims == kAngle)
-        return v.factor;
-  return 180 / std::numbers::pi;  // ISO 10303-41's default, the radian
 }
 
 std::optional<std::string> AimLowerer::word(const Instance &of, std::string_view property) {
@@ -412,7 +418,7 @@ std::optional<std::string> AimLowerer::word(const Instance &of, std::string_view
 
 Instance AimLowerer::mainWorkplan() {
   // The workplan a product_definition_process names and that is no other
-  // workplan's element; with a project, the one its product definition has.
+  // workplan's element.
   std::vector<Instance> tops;
   for (const Instance &p : workplanProcesses_) {
     const Instance wp = p.ref("chosen_method");
@@ -459,7 +465,7 @@ std::unique_ptr<ir::Module> AimLowerer::run() {
   index();
   module_ = std::make_unique<ir::Module>();
   module_->sourceName = std::string(bound_.file().source().name());
-  module_->sourceSchema = bound_.schema().name;
+  module_->aimSchema = bound_.schema().name;
   if (!projects_.empty()) {
     const Instance &p = projects_.front();
     std::optional<std::string> name = p.string("name");
@@ -474,9 +480,9 @@ std::unique_ptr<ir::Module> AimLowerer::run() {
   workpiece();
   if (auto wp = workplan(main))
     module_->root.add(std::move(*wp));
-  // The security plane: the file gives none (AP238 toolpath files seldom
-  // do); the highest point of the file's toolpaths is where its own rapids
-  // travel, so stepnc's links between steps travel there too.
+  // Steps whose file gives no security plane: the highest point of the
+  // file's toolpaths is where its own rapids travel, so stepnc's links
+  // between steps travel there too.
   const double z = highestZ_.value_or(0);
   bool assumed = false;
   auto secplanes = [&](Node &n, auto &self) -> void {
@@ -496,7 +502,7 @@ std::unique_ptr<ir::Module> AimLowerer::run() {
   return std::move(module_);
 }
 
-bool AimLowerer::executable(const Instance &exe, Node &parent) {
+void AimLowerer::executable(const Instance &exe, Node &parent) {
   std::optional<Node> n;
   if (exe.isA("machining_workingstep"))
     n = workingstep(exe);
@@ -506,14 +512,12 @@ bool AimLowerer::executable(const Instance &exe, Node &parent) {
     n = rapidMovement(exe);
   else
     base_.unsupported(exe, "executable");
-  if (!n)
-    return false;
-  parent.add(std::move(*n));
-  return true;
+  if (n)
+    parent.add(std::move(*n));
 }
 
 std::optional<Node> AimLowerer::workplan(const Instance &wp) {
-  if (!reported_.insert(wp.index()).second) {
+  if (!workplansOnStack_.insert(wp.index()).second) {
     base_.missing(wp, "elements", "the workplan is an element of itself");
     return std::nullopt;
   }
@@ -522,6 +526,7 @@ std::optional<Node> AimLowerer::workplan(const Instance &wp) {
   n.symbol = base_.symbolFor('@', wp.string("name"), "workplan");
   for (const Instance &exe : related(wp, "machining_process_sequence_relationship"))
     executable(exe, n);
+  workplansOnStack_.erase(wp.index());
   return n;
 }
 
@@ -529,7 +534,7 @@ std::string AimLowerer::toolpathFeature(const Instance &ws) {
   Instance feature;
   for (const Instance &process : related(ws, "machining_feature_relationship"))
     if (auto it = featureOfProcess_.find(process.index()); it != featureOfProcess_.end())
-      feature = it->second;
+      feature = at(it->second);
   const size_t key = feature ? feature.index() : ws.index();
   if (auto it = lowered_.find(key); it != lowered_.end())
     return it->second;
@@ -627,24 +632,18 @@ std::optional<Node> AimLowerer::operation(const Instance &op, const Instance &ws
     base_.missing(op, "tool", "no machining_tool names the operation in its usage");
     return std::nullopt;
   }
-  if (auto symbol = tool(t->second))
+  if (auto symbol = tool(at(t->second)))
     n.set("tool", Value::ref(*symbol));
   else
     return std::nullopt;
-  for (const Instance &tech : related(op, "machining_technology_relationship"))
-    if (auto tn = technology(tech)) {
-      n.add(std::move(*tn));
-      break;
-    }
-  if (!n.child(ir::Kind::Technology)) {
+  const std::vector<Instance> techs = related(op, "machining_technology_relationship");
+  if (techs.empty()) {
     base_.missing(op, "technology", "no machining_technology_relationship gives the operation its feed and speed");
     return std::nullopt;
   }
-  for (const Instance &mf : related(op, "machining_functions_relationship"))
-    if (auto fn = machineFunctions(mf)) {
-      n.add(std::move(*fn));
-      break;
-    }
+  n.add(technology(techs.front()));
+  if (const std::vector<Instance> functions = related(op, "machining_functions_relationship"); !functions.empty())
+    n.add(machineFunctions(functions.front()));
   toolpaths(op, n);
   if (!n.child(ir::Kind::Toolpath)) {
     report(op, op.loc(),
@@ -692,8 +691,8 @@ std::optional<std::string> AimLowerer::tool(const Instance &t) {
   std::vector<Instance> reps;
   std::vector<std::pair<std::string, Instance>> props = properties(t, true);
   if (auto it = componentsOf_.find(t.index()); it != componentsOf_.end())
-    for (const Instance &component : it->second)
-      for (auto &p : properties(component, true))
+    for (size_t component : it->second)
+      for (auto &p : properties(at(component), true))
         props.push_back(p);
   for (auto &[property, rep] : props)
     for (const Instance &r : withRelated(rep))
@@ -750,14 +749,12 @@ std::optional<std::string> AimLowerer::tool(const Instance &t) {
     n.set("offset_length", Value::length(*n.number("overall_length")));
   const std::string symbol = n.symbol;
   lowered_[t.index()] = symbol;
-  // Tools go before the workplans, after the workpieces.
-  auto at = std::find_if(module_->root.children.begin(), module_->root.children.end(),
-                         [](const Node &c) { return c.kind == ir::Kind::Workplan; });
-  module_->root.children.insert(at, std::move(n));
+  // After the workpiece; the workplan that uses the tool is added after it.
+  module_->root.add(std::move(n));
   return symbol;
 }
 
-std::optional<Node> AimLowerer::technology(const Instance &tech) {
+Node AimLowerer::technology(const Instance &tech) {
   Node n(ir::Kind::Technology);
   base_.stamp(n, tech, "");
   for (auto &[property, rep] : properties(tech, false)) {
@@ -812,7 +809,7 @@ std::optional<Node> AimLowerer::technology(const Instance &tech) {
   return n;
 }
 
-std::optional<Node> AimLowerer::machineFunctions(const Instance &mf) {
+Node AimLowerer::machineFunctions(const Instance &mf) {
   Node n(ir::Kind::MachineFunctions);
   base_.stamp(n, mf, "");
   if (auto coolant = word(mf, "coolant")) {
@@ -857,24 +854,16 @@ std::optional<Node> AimLowerer::toolpath(const Instance &tp) {
   }
   n.set("role", Value::word(role));
   n.set("required", Value::boolean(word(tp, "priority").value_or("required") != "suggested"));
-  if (auto speed = word(tp, "speed profile"); speed == "rapid")
-    n.set("rapid", Value::boolean(true));
   for (const Instance &rep : propertyRepresentations(tp, "speed profile", false))
     for (const Instance &item : rep.refs("items"))
       if (item.isA("descriptive_representation_item") && normalName(item.string("description").value_or("")) == "rapid")
         n.set("rapid", Value::boolean(true));
   if (auto direction = word(tp, "direction"); direction && direction->find("end to beginning") != std::string::npos)
     n.set("reversed", Value::boolean(true));
-  for (const Instance &tech : related(tp, "machining_technology_relationship"))
-    if (auto t = technology(tech)) {
-      n.add(std::move(*t));
-      break;
-    }
-  for (const Instance &mf : related(tp, "machining_functions_relationship"))
-    if (auto f = machineFunctions(mf)) {
-      n.add(std::move(*f));
-      break;
-    }
+  if (const std::vector<Instance> techs = related(tp, "machining_technology_relationship"); !techs.empty())
+    n.add(technology(techs.front()));
+  if (const std::vector<Instance> functions = related(tp, "machining_functions_relationship"); !functions.empty())
+    n.add(machineFunctions(functions.front()));
   if (normalName(tp.string("description").value_or("")) == "feedstop") {
     // A dwell: the time of its 'dwell' property.
     for (const Instance &rep : propertyRepresentations(tp, "dwell", false))
@@ -931,8 +920,10 @@ void AimLowerer::trimByPoints(Node &n, double angleToRad) {
 }
 
 void AimLowerer::highest(const Node &curve) {
+  // Points the tool passes: polyline points and trimming points; not the
+  // origins (`at`) of circles, lines and helices.
   for (const ir::Attr &a : curve.attrs)
-    if (a.value.type == ir::ValueType::Point && (a.name == "at" ? curve.kind == ir::Kind::Point : true))
+    if (a.value.type == ir::ValueType::Point && (a.name != "at" || curve.kind == ir::Kind::Point))
       highestZ_ = std::max(highestZ_.value_or(a.value.vec.z()), a.value.vec.z());
   for (const Node &c : curve.children)
     highest(c);
@@ -955,7 +946,8 @@ std::optional<Node> AimLowerer::basicCurve(const Instance &tp) {
   std::optional<Node> c = base_.curve(items.front());
   if (!c)
     return std::nullopt;
-  trimByPoints(*c, angleFactor(rep) * std::numbers::pi / 180);
+  // Angles in the context's unit; ISO 10303-41's default is the radian.
+  trimByPoints(*c, contextFactor(rep, kAngle).value_or(180 / std::numbers::pi) * std::numbers::pi / 180);
   if (const double f = lengthFactor(rep); f != 1)
     scaleLengths(*c, f);
   highest(*c);

@@ -791,10 +791,7 @@ std::unique_ptr<ir::Module> lowerToFeatureIR(const binding::BoundFile &bound, Di
   if (express::isAimSchema(bound.schema()))
     return lowerAimToFeatureIR(bound, diags, options);
   Lowerer lowerer(bound, diags, options);
-  auto module = lowerer.run();
-  if (module)
-    module->sourceSchema = bound.schema().name;
-  return module;
+  return lowerer.run();
 }
 
 } // namespace stepnc::lowering

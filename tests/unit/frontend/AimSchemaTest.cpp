@@ -2,7 +2,6 @@
 // write, and equal, slot by slot and type by type, to the published long
 // forms in the sample corpus they were written from (docs/ap238.md).
 #include "frontend/express/Builtin.h"
-#include "frontend/express/SchemaReader.h"
 #include "../TestSupport.h"
 #include "ExpressTestSupport.h"
 
@@ -43,14 +42,9 @@ namespace {
 /// optional, derived), every type's underlying type, SELECT list and
 /// ENUMERATION values.
 void compareWithCorpus(const std::string &path, const BuiltinSchema &ours, size_t minEntities) {
-  std::string error;
-  auto file = SourceFile::open(path, error);
-  REQUIRE(file);
-  Model ref;
-  DiagnosticCollector c;
-  DiagnosticEngine engine(c);
-  REQUIRE(readExpress(std::move(file), ref, engine));
-  REQUIRE(ref.resolve(engine));
+  const auto loaded = test::loadExpressFile(path);
+  REQUIRE(loaded->ok);
+  const Model &ref = loaded->model;
   const Schema &rs = ref.schemas().front();
   CHECK(rs.entities.size() == ours.schema->entities.size());
   CHECK(rs.types.size() == ours.schema->types.size());

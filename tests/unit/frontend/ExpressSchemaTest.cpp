@@ -148,14 +148,9 @@ TEST_CASE("the built-in ARM matches the corpus ARM schema slot by slot", "[expre
     WARN("sample corpus not found (set STEPNC_CORPUS): ARM cross-check skipped");
     return;
   }
-  std::string error;
-  auto file = SourceFile::open(corpus + "/johnmichaloski__STEPNCpp/machinetool_resource_schema9_exp.txt", error);
-  REQUIRE(file);
-  Model ref;
-  DiagnosticCollector c;
-  DiagnosticEngine engine(c);
-  REQUIRE(readExpress(std::move(file), ref, engine));
-  REQUIRE(ref.resolve(engine));
+  const auto loaded = test::loadExpressFile(corpus + "/johnmichaloski__STEPNCpp/machinetool_resource_schema9_exp.txt");
+  REQUIRE(loaded->ok);
+  const Model &ref = loaded->model;
   const Model &ours = builtinModel();
   const Schema &rs = ref.schemas().front();
   const Schema &os = ours.schemas().front();

@@ -17,13 +17,24 @@ struct LoadedExpress {
   bool ok = false;  ///< read and resolved without errors
 };
 
-inline std::unique_ptr<LoadedExpress> loadExpress(std::string_view text) {
+inline std::unique_ptr<LoadedExpress> loadExpress(std::unique_ptr<SourceFile> file) {
   auto l = std::make_unique<LoadedExpress>();
   DiagnosticEngine engine(l->diags);
-  l->ok = express::readExpress(SourceFile::fromString("t.exp", text), l->model, engine);
+  l->ok = file && express::readExpress(std::move(file), l->model, engine);
   if (l->ok)
     l->ok = l->model.resolve(engine);
   return l;
+}
+
+inline std::unique_ptr<LoadedExpress> loadExpress(std::string_view text) {
+  return loadExpress(SourceFile::fromString("t.exp", text));
+}
+
+/// An EXPRESS file (a corpus schema) read and resolved; `ok` false when it
+/// cannot be opened or has errors.
+inline std::unique_ptr<LoadedExpress> loadExpressFile(const std::string &path) {
+  std::string error;
+  return loadExpress(SourceFile::open(path, error));
 }
 
 /// Checks that entity `oe` of `ours` has the Part 21 slots of `re` of `ref`:
