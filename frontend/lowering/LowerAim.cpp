@@ -538,10 +538,15 @@ std::string AimLowerer::toolpathFeature(const Instance &ws) {
   const size_t key = feature ? feature.index() : ws.index();
   if (auto it = lowered_.find(key); it != lowered_.end())
     return it->second;
+  // A toolpath-only feature is an instanced_feature described 'toolpath'
+  // (its first description, the characterized_object's); any other is a
+  // machining feature, whose shape is not read yet.
   if (feature && !(feature.isA("instanced_feature") &&
-                   normalName(feature.string("feature_type").value_or("toolpath")) == "toolpath"))
-    base_.assumed(feature, "", "is not lowered yet (AP238 machining features: docs/ap238.md); the step's "
-                               "toolpaths are followed as the file gives them, without the feature's shape");
+                   normalName(feature.string("description").value_or("")) == "toolpath"))
+    diags_.assumption(feature.loc(), "the feature '" + feature.string("description").value_or("") +
+                                         "' is not lowered yet (AP238 machining features: docs/ap238.md); the "
+                                         "step's toolpaths are followed as the file gives them, without its shape")
+        .entity(feature.id(), entityUpper(feature));
   Node f(ir::Kind::ToolpathFeature);
   base_.stamp(f, feature ? feature : ws, "");
   std::optional<std::string> label = feature ? feature.string("name") : std::nullopt;
@@ -850,7 +855,9 @@ std::optional<Node> AimLowerer::toolpath(const Instance &tp) {
         known = true;
       }
     if (!known)
-      base_.assumed(tp, "", "its trajectory type '" + *type + "' is not one of ISO 14649's; read as a trajectory path");
+      diags_.assumption(tp.loc(), "its trajectory type '" + *type +
+                                      "' is not one of ISO 14649's; read as a trajectory path")
+          .entity(tp.id(), entityUpper(tp));
   }
   n.set("role", Value::word(role));
   n.set("required", Value::boolean(word(tp, "priority").value_or("required") != "suggested"));
