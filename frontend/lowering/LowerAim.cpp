@@ -141,6 +141,9 @@ private:
   /// An error about `inst` at `at` ("#64 CONTOURING_TURNING_OPERATION: ...").
   void report(const Instance &inst, SourceLoc at, std::string message);
   static std::string entityUpper(const Instance &inst) { return express::upper(inst.entityName()); }
+  /// Says which executables, operations and toolpaths of the file the
+  /// program leaves out because no relationship holds them.
+  void reportUnreached();
   /// `rep` and the representations representation_relationships tie to it.
   std::vector<Instance> withRelated(const Instance &rep) const;
   Instance at(size_t index) const { return Instance(bound_, index); }
@@ -164,6 +167,9 @@ private:
   std::map<size_t, size_t> toolOf_;          ///< machining_tool by operation (usage)
   std::map<size_t, size_t> featureOfProcess_;  ///< feature by machining_feature_process
   std::set<size_t> workplansOnStack_;        ///< cycle guard for nested workplans
+  std::set<size_t> reached_;                 ///< executables, operations and toolpaths the program reaches
+  std::set<size_t> held_;                    ///< action methods some relationship relates to another
+  std::vector<size_t> methods_;              ///< every executable, operation and toolpath of the file
   std::vector<Instance> projects_, workplanProcesses_, projectWorkpieces_;
   std::map<size_t, UnitValue> units_;
   std::map<size_t, std::string> lowered_;  ///< instance -> symbol (tools, features)
@@ -186,14 +192,20 @@ void AimLowerer::index() {
                           projectWorkpiece = entity("machining_project_workpiece_relationship"),
                           repRelationship = entity("representation_relationship"),
                           resourceRelationship = entity("action_resource_relationship"),
-                          sequence = entity("machining_process_sequence_relationship");
+                          sequence = entity("machining_process_sequence_relationship"),
+                          executableEntity = entity("machining_process_executable"),
+                          operationEntity = entity("machining_operation"), toolpathEntity = entity("machining_toolpath");
   auto is = [&](size_t i, express::EntityId e) { return e != express::kNone && bound_.isA(i, e); };
   const size_t n = bound_.file().entries().size();
   for (size_t i = 0; i < n; ++i) {
+    if (is(i, executableEntity) || is(i, operationEntity) || is(i, toolpathEntity))
+      methods_.push_back(i);
     if (is(i, relationship)) {
       const Instance r(bound_, i);
       if (Instance from = r.ref("relating_method"))
         byRelating_[from.index()].push_back(i);
+      if (Instance to = r.ref("related_method"))
+        held_.insert(to.index());
       if (is(i, sequence))
         if (Instance to = r.ref("related_method"))
           sequenced_.insert(to.index());
@@ -293,6 +305,21 @@ std::vector<Instance> AimLowerer::withRelated(const Instance &rep) const {
   return out;
 }
 
+void AimLowerer::reportUnreached() {
+  // Only what nothing holds: what an unreached method holds goes with it.
+  for (size_t i : methods_) {
+    if (reached_.count(i) || held_.count(i))
+      continue;
+    const Instance m = at(i);
+    const char *why = m.isA("machining_toolpath")
+                          ? "no machining_toolpath_sequence_relationship gives it to an operation"
+                      : m.isA("machining_operation")
+                          ? "no machining_operation_relationship gives it to a workingstep"
+                          : "no machining_process_sequence_relationship puts it in a workplan";
+    diags_.assumption(m.loc(), std::string(why) + "; left out of the program").entity(m.id(), entityUpper(m));
+  }
+}
+
 void AimLowerer::report(const Instance &inst, SourceLoc at, std::string message) {
   diags_.error(at, std::move(message)).entity(inst.id(), entityUpper(inst));
 }
@@ -369,7 +396,7 @@ UnitValue AimLowerer::unit(const Instance &u) {
 std::optional<Measure> AimLowerer::measure(const Instance &item) {
   const std::optional<double> value = item.real("value_component");
   if (!value) {
-    base_.missing(item, "value_component", "a number");
+    base_.missing(item, "value_component", "is not a number");
     return std::nullopt;
   }
   Measure m;
@@ -401,7 +428,7 @@ double AimLowerer::lengthFactor(const Instance &representation) {
     return *f;
   const Instance context = representation.ref("context_of_items");
   if (context && reported_.insert(context.index()).second)
-    base_.assumed(context, "units", "gives no length unit; assumed mm");
+    base_.assumed(context, "units", "give no length unit; assumed mm");
   return 1;
 }
 
@@ -478,8 +505,10 @@ std::unique_ptr<ir::Module> AimLowerer::run() {
   if (!main)
     return nullptr;
   workpiece();
+  reached_.insert(main.index());
   if (auto wp = workplan(main))
     module_->root.add(std::move(*wp));
+  reportUnreached();
   // Steps whose file gives no security plane: the highest point of the
   // file's toolpaths is where its own rapids travel, so stepnc's links
   // between steps travel there too.
@@ -503,6 +532,7 @@ std::unique_ptr<ir::Module> AimLowerer::run() {
 }
 
 void AimLowerer::executable(const Instance &exe, Node &parent) {
+  reached_.insert(exe.index());
   std::optional<Node> n;
   if (exe.isA("machining_workingstep"))
     n = workingstep(exe);
@@ -518,7 +548,7 @@ void AimLowerer::executable(const Instance &exe, Node &parent) {
 
 std::optional<Node> AimLowerer::workplan(const Instance &wp) {
   if (!workplansOnStack_.insert(wp.index()).second) {
-    base_.missing(wp, "elements", "the workplan is an element of itself");
+    base_.missing(wp, "elements", "make a cycle: the workplan is an element of itself");
     return std::nullopt;
   }
   Node n(ir::Kind::Workplan);
@@ -572,9 +602,10 @@ std::optional<Node> AimLowerer::workingstep(const Instance &ws) {
   const std::vector<Instance> ops = related(ws, "machining_operation_relationship");
   if (ops.size() != 1) {
     base_.missing(ws, "operation",
-                  ops.empty() ? "no machining_operation_relationship relates the workingstep to its operation"
-                              : std::to_string(ops.size()) + " machining_operation_relationships relate it to "
-                                                             "operations; a workingstep has one");
+                  ops.empty() ? std::string("is not given: no machining_operation_relationship relates the "
+                                            "workingstep to an operation")
+                              : "is not one: " + std::to_string(ops.size()) +
+                                  " machining_operation_relationships relate the workingstep to operations");
     return std::nullopt;
   }
   std::optional<Node> op = operation(ops.front(), ws);
@@ -618,6 +649,7 @@ std::optional<Node> AimLowerer::rapidMovement(const Instance &rm) {
 }
 
 std::optional<Node> AimLowerer::operation(const Instance &op, const Instance &ws) {
+  reached_.insert(op.index());
   if (op.isA("turning_type_operation")) {
     report(op, op.loc(),
            "a lathe operation: not supported yet (stepnc's targets are milling targets until turning lands; "
@@ -634,7 +666,7 @@ std::optional<Node> AimLowerer::operation(const Instance &op, const Instance &ws
   base_.stamp(n, op, "name");
   auto t = toolOf_.find(op.index());
   if (t == toolOf_.end()) {
-    base_.missing(op, "tool", "no machining_tool names the operation in its usage");
+    base_.missing(op, "tool", "is not given: no machining_tool names the operation in its usage");
     return std::nullopt;
   }
   if (auto symbol = tool(at(t->second)))
@@ -643,7 +675,8 @@ std::optional<Node> AimLowerer::operation(const Instance &op, const Instance &ws
     return std::nullopt;
   const std::vector<Instance> techs = related(op, "machining_technology_relationship");
   if (techs.empty()) {
-    base_.missing(op, "technology", "no machining_technology_relationship gives the operation its feed and speed");
+    base_.missing(op, "technology",
+                  "is not given: no machining_technology_relationship gives the operation its feed and speed");
     return std::nullopt;
   }
   n.add(technology(techs.front()));
@@ -687,7 +720,7 @@ std::optional<std::string> AimLowerer::tool(const Instance &t) {
       type = irType;
   if (type.empty()) {
     type = "cutting_tool";
-    base_.assumed(t, "kind", "'" + kind + "' names no kind of tool stepnc knows; read as a cutting tool of the "
+    base_.assumed(t, "kind", "is '" + kind + "', no kind of tool stepnc knows; read as a cutting tool of the "
                                             "diameter the file gives");
   }
   n.set("type", Value::word(std::string(type)));
@@ -747,7 +780,7 @@ std::optional<std::string> AimLowerer::tool(const Instance &t) {
             .entity(item.id(), entityUpper(item));
     }
   if (!n.has("diameter")) {
-    base_.missing(t, "diameter", "no resource property of the tool gives a 'diameter' measure");
+    base_.missing(t, "diameter", "is not given: no resource property of the tool has a 'diameter' measure");
     return std::nullopt;
   }
   if (n.has("overall_length") && !n.has("offset_length"))
@@ -837,6 +870,7 @@ void AimLowerer::toolpaths(const Instance &owner, Node &parent) {
 }
 
 std::optional<Node> AimLowerer::toolpath(const Instance &tp) {
+  reached_.insert(tp.index());
   if (!tp.isA("machining_toolpath")) {
     base_.unsupported(tp, "toolpath");
     return std::nullopt;
@@ -879,7 +913,7 @@ std::optional<Node> AimLowerer::toolpath(const Instance &tp) {
           if (std::optional<Measure> m = measure(item); m && m->dims == kTime && m->value >= 0)
             n.set("dwell", Value::time(m->value));
     if (!n.has("dwell")) {
-      base_.missing(tp, "dwell", "a feedstop toolpath needs a 'dwell' property with a time");
+      base_.missing(tp, "dwell", "is not given: a feedstop toolpath needs a 'dwell' property with a time");
       return std::nullopt;
     }
     return n;
@@ -940,14 +974,14 @@ std::optional<Node> AimLowerer::basicCurve(const Instance &tp) {
   const std::vector<Instance> reps = propertyRepresentations(tp, "basic curve", false);
   if (reps.size() != 1) {
     base_.missing(tp, "basic curve",
-                  reps.empty() ? "no action_property 'basic curve' gives the toolpath's curve"
-                               : "several 'basic curve' properties; a toolpath has one");
+                  reps.empty() ? "is not given: no action_property 'basic curve' gives the toolpath's curve"
+                               : "is not one: the toolpath has several 'basic curve' properties");
     return std::nullopt;
   }
   const Instance &rep = reps.front();
   const std::vector<Instance> items = rep.refs("items");
   if (items.size() != 1) {
-    base_.missing(rep, "items", "the basic curve's representation must hold one curve");
+    base_.missing(rep, "items", "must be one curve (the representation of a toolpath's basic curve)");
     return std::nullopt;
   }
   std::optional<Node> c = base_.curve(items.front());
