@@ -129,6 +129,16 @@ const Node *operationOf(const Node &step) { return step.childIn(Category::Operat
 
 Node *operationOf(Node &step) { return const_cast<Node *>(step.childIn(Category::Operation)); }
 
+bool toolpathsGiveFeeds(const Node &op) {
+  const std::vector<const Node *> toolpaths = op.childrenOf(Kind::Toolpath);
+  return !toolpaths.empty() && std::all_of(toolpaths.begin(), toolpaths.end(), [](const Node *tp) {
+    if (tp->flag("rapid").value_or(false) || tp->has("dwell"))
+      return true;
+    const Node *tech = tp->child(Kind::Technology);
+    return tech && tech->number("feed").value_or(0) > 0;
+  });
+}
+
 const Node *findResource(const Module &module, Kind kind, std::string_view symbol) {
   for (const Node &n : module.root.children)
     if (n.kind == kind && n.symbol == symbol)

@@ -56,6 +56,12 @@ const Node *findFeature(const Module &module, std::string_view symbol);
 /// The workpiece that holds `feature`, or null.
 const Node *workpieceOf(const Module &module, const Node &feature);
 
+/// Whether `op` has explicit toolpaths and each that moves at feed gives its
+/// own feed (a technology with a positive feed; rapids and dwells need
+/// none): then the operation's own feed is used by no move (AP238 files
+/// from CAM systems give feeds per toolpath).
+bool toolpathsGiveFeeds(const Node &op);
+
 /// Whether an executable's moves are its operation's explicit toolpaths,
 /// every one of them required (ISO 14649 `its_priority`): they run as the
 /// file writes them: no pass changes their path, and adapt-feed changes a

@@ -149,7 +149,10 @@ private:
     const double n = spindle ? std::abs(*spindle) : 0.0;
     // A feed of 0 moves nothing: generators write it for "not given".
     const bool zeroFeed = tech->number("feed") == 0.0;
-    if (!tech->has("feed") || zeroFeed) {
+    if ((!tech->has("feed") || zeroFeed) && ir::toolpathsGiveFeeds(op)) {
+      // Every toolpath moving at feed gives its own: no move uses the
+      // operation's, there is nothing to resolve.
+    } else if (!tech->has("feed") || zeroFeed) {
       std::string why;
       if (auto fz = tech->number("feed_per_tooth"); fz && *fz > 0 && flutes > 0 && n > 0) {
         tech->set("feed", ir::Value::feed(*fz * static_cast<double>(flutes) * n));

@@ -215,7 +215,7 @@ private:
     p.plungeFeed = p.feed;
     p.allowanceSide = op->number("allowance_side").value_or(0);
     p.allowanceBottom = op->number("allowance_bottom").value_or(0);
-    if (p.feed <= 0) {
+    if (p.feed <= 0 && !ir::toolpathsGiveFeeds(*op)) {
       x_.report(ws, tech && tech->has("feed") ? "its operation's feed is 0 mm/min"
                                               : "has no feed for its moves (run resolve-feeds first, or give the "
                                                 "operation a feed)");
