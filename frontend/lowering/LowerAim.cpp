@@ -21,35 +21,17 @@
 // Every value is read in its own unit (a measure item's unit, a geometric
 // representation's context) and converted to the IR's once. What is not
 // mapped is a located "not supported", never dropped. docs/ap238.md.
+#include "frontend/lowering/LowerAim.h"
 #include "frontend/express/Builtin.h"
-#include "frontend/lowering/Lowerer.h"
 #include "support/Format.h"
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <numbers>
-#include <set>
 
 namespace stepnc::lowering {
 
-namespace {
-
-/// The dimensions of a unit, in the base quantities AP238 files use.
-struct Dims {
-  int length = 0, time = 0, angle = 0, revolution = 0;
-  bool operator==(const Dims &) const = default;
-};
-
-/// A unit as a factor to stepnc's base units (mm, s, deg, rev) and its dimensions.
-struct UnitValue {
-  double factor = 1;
-  Dims dims;
-  std::string error;  ///< why the unit could not be read (empty when it could)
-};
-
-constexpr Dims kLength{1, 0, 0, 0}, kTime{0, 1, 0, 0}, kAngle{0, 0, 1, 0}, kRevolution{0, 0, 0, 1};
-constexpr Dims kFeed{1, -1, 0, 0}, kFeedPerRev{1, 0, 0, -1}, kRotation{0, -1, 0, 1};
+namespace aim {
 
 std::string dimsText(const Dims &d) {
   if (d == kLength)
@@ -70,7 +52,6 @@ std::string dimsText(const Dims &d) {
          std::to_string(d.angle) + " rev^" + std::to_string(d.revolution);
 }
 
-/// A name as AP238 writers spell property and item names: lower case, '_' as ' '.
 std::string normalName(std::string_view s) {
   std::string out;
   for (char c : s)
@@ -78,105 +59,9 @@ std::string normalName(std::string_view s) {
   return out;
 }
 
-struct Measure {
-  std::string name;  ///< the item's name, normalised
-  double value = 0;  ///< in stepnc's base units (UnitValue::factor applied)
-  Dims dims;
-};
+} // namespace aim
 
-} // namespace
-
-class AimLowerer {
-public:
-  AimLowerer(const binding::BoundFile &bound, DiagnosticEngine &diags, const LowerOptions &options)
-      : bound_(bound), diags_(diags), base_(bound, diags, options) {}
-
-  std::unique_ptr<ir::Module> run();
-
-private:
-  // --- the file's relationships, indexed once ---------------------------------
-  void index();
-  /// The related_method of every action_method_relationship of entity `kind`
-  /// whose relating_method is `from`, in sequence order when sequenced.
-  std::vector<Instance> related(const Instance &from, std::string_view kind) const;
-  /// The representations of the properties named `property` of `of`.
-  std::vector<Instance> propertyRepresentations(const Instance &of, std::string_view property, bool resource) const;
-  /// Every property of `of` with its representation: (property name, representation).
-  std::vector<std::pair<std::string, Instance>> properties(const Instance &of, bool resource) const;
-
-  // --- units and values ---------------------------------------------------------
-  UnitValue unit(const Instance &u);
-  /// A measure_representation_item (or measure_with_unit) in base units.
-  std::optional<Measure> measure(const Instance &item);
-  /// The factor of the unit of dimensions `dims` that a representation's
-  /// context assigns; nullopt when it assigns none.
-  std::optional<double> contextFactor(const Instance &representation, const Dims &dims);
-  /// The length unit of a representation's context (mm when it says none: an assumption).
-  double lengthFactor(const Instance &representation);
-  /// The first descriptive item's text of a property, lower case.
-  std::optional<std::string> word(const Instance &of, std::string_view property);
-
-  // --- the program ----------------------------------------------------------------
-  Instance mainWorkplan();
-  void workpiece();
-  void executable(const Instance &exe, Node &parent);
-  std::optional<Node> workplan(const Instance &wp);
-  std::optional<Node> workingstep(const Instance &ws);
-  std::optional<Node> rapidMovement(const Instance &rm);
-  std::optional<Node> operation(const Instance &op, const Instance &ws);
-  std::optional<std::string> tool(const Instance &tool);
-  Node technology(const Instance &tech);
-  Node machineFunctions(const Instance &mf);
-  void toolpaths(const Instance &owner, Node &parent);
-  std::optional<Node> toolpath(const Instance &tp);
-  std::string toolpathFeature(const Instance &ws);
-  /// The curve of a toolpath's 'basic curve' representation, in mm.
-  std::optional<Node> basicCurve(const Instance &tp);
-  void scaleLengths(Node &n, double factor);
-  void trimByPoints(Node &n, double angleToRad);
-  void highest(const Node &curve);
-  /// The height (mm) of a workingstep's 'security plane' property: a plane
-  /// whose placement's location gives it; nullopt when there is none.
-  std::optional<double> securityPlane(const Instance &ws);
-  /// An error about `inst` at `at` ("#64 CONTOURING_TURNING_OPERATION: ...").
-  void report(const Instance &inst, SourceLoc at, std::string message);
-  static std::string entityUpper(const Instance &inst) { return express::upper(inst.entityName()); }
-  /// Says which executables, operations and toolpaths of the file the
-  /// program leaves out because no relationship holds them.
-  void reportUnreached();
-  /// `rep` and the representations representation_relationships tie to it.
-  std::vector<Instance> withRelated(const Instance &rep) const;
-  Instance at(size_t index) const { return Instance(bound_, index); }
-
-  const binding::BoundFile &bound_;
-  DiagnosticEngine &diags_;
-  Lowerer base_;  ///< the ARM lowering's geometry and helpers (curves, symbols, reports)
-  std::unique_ptr<ir::Module> module_;
-
-  // The indexes hold instance indices, not decoded instances: an index entry
-  // is decoded again when lowering follows it, and a large file's indexes
-  // stay small.
-  using Index = std::map<size_t, std::vector<size_t>>;
-  Index byRelating_;                         ///< action_method_relationships by relating_method
-  std::set<size_t> sequenced_;               ///< executables some workplan sequences
-  Index actionProps_;                        ///< action_property by definition
-  Index resourceProps_;                      ///< resource_property by resource
-  Index propReps_;                           ///< *_property_representation by property
-  Index repRelated_;                         ///< representations related to one, both ways
-  Index componentsOf_;                       ///< resources an action_resource_relationship ties to a tool
-  std::map<size_t, size_t> toolOf_;          ///< machining_tool by operation (usage)
-  std::map<size_t, size_t> featureOfProcess_;  ///< feature by machining_feature_process
-  std::set<size_t> workplansOnStack_;        ///< cycle guard for nested workplans
-  std::set<size_t> reached_;                 ///< executables, operations and toolpaths the program reaches
-  std::set<size_t> held_;                    ///< action methods some relationship relates to another
-  std::vector<size_t> methods_;              ///< every executable, operation and toolpath of the file
-  std::vector<Instance> projects_, workplanProcesses_, projectWorkpieces_;
-  std::map<size_t, UnitValue> units_;
-  std::map<size_t, std::string> lowered_;  ///< instance -> symbol (tools, features)
-  std::set<size_t> reported_;
-  std::string workpieceSymbol_;
-  std::optional<double> highestZ_;  ///< the highest point of any toolpath (mm)
-};
+using namespace aim;
 
 // --- index ---------------------------------------------------------------------
 
@@ -194,12 +79,18 @@ void AimLowerer::index() {
                           resourceRelationship = entity("action_resource_relationship"),
                           sequence = entity("machining_process_sequence_relationship"),
                           executableEntity = entity("machining_process_executable"),
-                          operationEntity = entity("machining_operation"), toolpathEntity = entity("machining_toolpath");
+                          operationEntity = entity("machining_operation"), toolpathEntity = entity("machining_toolpath"),
+                          propertyDefinition = entity("property_definition"),
+                          definitionRep = entity("property_definition_representation"),
+                          shapeAspect = entity("shape_aspect"), aspectRelationship = entity("shape_aspect_relationship");
   auto is = [&](size_t i, express::EntityId e) { return e != express::kNone && bound_.isA(i, e); };
   const size_t n = bound_.file().entries().size();
   for (size_t i = 0; i < n; ++i) {
     if (is(i, executableEntity) || is(i, operationEntity) || is(i, toolpathEntity))
       methods_.push_back(i);
+    if (is(i, shapeAspect))
+      if (Instance of = Instance(bound_, i).ref("of_shape"))
+        aspectsOf_[of.index()].push_back(i);
     if (is(i, relationship)) {
       const Instance r(bound_, i);
       if (Instance from = r.ref("relating_method"))
@@ -244,6 +135,15 @@ void AimLowerer::index() {
       if (Instance from = r.ref("relating_resource"))
         if (Instance to = r.ref("related_resource"))
           componentsOf_[from.index()].push_back(to.index());
+    } else if (is(i, propertyDefinition)) {
+      if (Instance of = Instance(bound_, i).ref("definition"))
+        propertyDefs_[of.index()].push_back(i);
+    } else if (is(i, definitionRep)) {
+      if (Instance of = Instance(bound_, i).ref("definition"))
+        definitionReps_[of.index()].push_back(i);
+    } else if (is(i, aspectRelationship)) {
+      if (Instance to = Instance(bound_, i).ref("related_shape_aspect"))
+        aspectRelationsTo_[to.index()].push_back(i);
     } else if (is(i, repRelationship)) {
       const Instance r(bound_, i);
       const Instance a = r.ref("rep_1"), b = r.ref("rep_2");
@@ -255,11 +155,11 @@ void AimLowerer::index() {
   }
 }
 
-std::vector<Instance> AimLowerer::related(const Instance &from, std::string_view kind) const {
+std::vector<Instance> AimLowerer::related(const Instance &from, std::string_view kind, std::string_view name) const {
   std::vector<std::pair<double, Instance>> found;
   if (auto it = byRelating_.find(from.index()); it != byRelating_.end())
     for (size_t i : it->second)
-      if (const Instance r = at(i); r.isA(kind))
+      if (const Instance r = at(i); r.isA(kind) && (name.empty() || normalName(r.string("name").value_or("")) == name))
         if (Instance to = r.ref("related_method"))
           found.emplace_back(r.real("sequence_position").value_or(0), to);
   std::stable_sort(found.begin(), found.end(), [](const auto &a, const auto &b) { return a.first < b.first; });
@@ -322,6 +222,14 @@ void AimLowerer::reportUnreached() {
 
 void AimLowerer::report(const Instance &inst, SourceLoc at, std::string message) {
   diags_.error(at, std::move(message)).entity(inst.id(), entityUpper(inst));
+}
+
+void AimLowerer::wrongUnit(const Instance &inst, SourceLoc at, std::string_view what, const Dims &expected,
+                           const Dims &found) {
+  std::string message = "'";
+  message += what;
+  message += "': expected " + dimsText(expected) + ", its unit is " + dimsText(found);
+  report(inst, at, std::move(message));
 }
 
 // --- units ----------------------------------------------------------------------
@@ -560,23 +468,42 @@ std::optional<Node> AimLowerer::workplan(const Instance &wp) {
   return n;
 }
 
-std::string AimLowerer::toolpathFeature(const Instance &ws) {
+std::optional<std::string> AimLowerer::stepFeature(const Instance &ws, bool followsToolpaths) {
   Instance feature;
   for (const Instance &process : related(ws, "machining_feature_relationship"))
     if (auto it = featureOfProcess_.find(process.index()); it != featureOfProcess_.end())
       feature = at(it->second);
-  const size_t key = feature ? feature.index() : ws.index();
-  if (auto it = lowered_.find(key); it != lowered_.end())
-    return it->second;
   // A toolpath-only feature is an instanced_feature described 'toolpath'
-  // (its first description, the characterized_object's); any other is a
-  // machining feature, whose shape is not read yet.
-  if (feature && !(feature.isA("instanced_feature") &&
-                   normalName(feature.string("description").value_or("")) == "toolpath"))
+  // (its first description, the characterized_object's).
+  const bool toolpathOnly =
+      !feature || (feature.isA("instanced_feature") &&
+                   normalName(feature.string("description").value_or("")) == "toolpath");
+  if (!toolpathOnly && isLoweredFeature(feature))
+    return machiningFeature(feature);
+  if (!followsToolpaths) {
+    if (!feature)
+      base_.missing(ws, "feature",
+                    "is not given: no machining_feature_relationship and process_property_association give the "
+                    "workingstep a feature, and its operation has no toolpaths to follow");
+    else if (reported_.insert(feature.index()).second)
+      report(feature, feature.loc(),
+             "the feature '" + feature.string("description").value_or("") +
+                 "' is not one stepnc lowers yet (round holes and closed rectangular pockets; docs/ap238.md), and "
+                 "the operation of workingstep " + hashId(ws.id()) + " has no toolpaths to follow");
+    return std::nullopt;
+  }
+  if (!toolpathOnly)
     diags_.assumption(feature.loc(), "the feature '" + feature.string("description").value_or("") +
                                          "' is not lowered yet (AP238 machining features: docs/ap238.md); the "
                                          "step's toolpaths are followed as the file gives them, without its shape")
         .entity(feature.id(), entityUpper(feature));
+  return toolpathFeature(ws, feature);
+}
+
+std::string AimLowerer::toolpathFeature(const Instance &ws, const Instance &feature) {
+  const size_t key = feature ? feature.index() : ws.index();
+  if (auto it = lowered_.find(key); it != lowered_.end())
+    return it->second;
   Node f(ir::Kind::ToolpathFeature);
   base_.stamp(f, feature ? feature : ws, "");
   std::optional<std::string> label = feature ? feature.string("name") : std::nullopt;
@@ -608,10 +535,13 @@ std::optional<Node> AimLowerer::workingstep(const Instance &ws) {
                                   " machining_operation_relationships relate the workingstep to operations");
     return std::nullopt;
   }
-  std::optional<Node> op = operation(ops.front(), ws);
+  std::optional<Node> op = operation(ops.front());
   if (!op)
     return std::nullopt;
-  n.set("feature", Value::ref(toolpathFeature(ws)));
+  const std::optional<std::string> feature = stepFeature(ws, op->child(ir::Kind::Toolpath) != nullptr);
+  if (!feature)
+    return std::nullopt;
+  n.set("feature", Value::ref(*feature));
   if (auto z = securityPlane(ws))
     n.set("secplane", Value::length(*z));
   n.add(std::move(*op));
@@ -648,7 +578,7 @@ std::optional<Node> AimLowerer::rapidMovement(const Instance &rm) {
   return n;
 }
 
-std::optional<Node> AimLowerer::operation(const Instance &op, const Instance &ws) {
+std::optional<Node> AimLowerer::operation(const Instance &op) {
   reached_.insert(op.index());
   if (op.isA("turning_type_operation")) {
     report(op, op.loc(),
@@ -660,9 +590,18 @@ std::optional<Node> AimLowerer::operation(const Instance &op, const Instance &ws
     base_.unsupported(op, "operation");
     return std::nullopt;
   }
-  // AP238 toolpath files give every operation's path: lowered as the
-  // freeform operation of ISO 14649-11, which follows its toolpaths exactly.
+  // An operation with toolpaths (what CAM systems write) is lowered as the
+  // freeform operation of ISO 14649-11, which follows them exactly; one
+  // without is the ARM operation its entity and description name, whose
+  // path stepnc's strategies make.
+  const bool followsToolpaths = !related(op, "machining_toolpath_sequence_relationship").empty();
   Node n(ir::Kind::FreeformOperation);
+  if (!followsToolpaths) {
+    if (std::optional<ir::Kind> kind = strategyOperationKind(op))
+      n.kind = *kind;
+    else
+      return std::nullopt;
+  }
   base_.stamp(n, op, "name");
   auto t = toolOf_.find(op.index());
   if (t == toolOf_.end()) {
@@ -682,13 +621,13 @@ std::optional<Node> AimLowerer::operation(const Instance &op, const Instance &ws
   n.add(technology(techs.front()));
   if (const std::vector<Instance> functions = related(op, "machining_functions_relationship"); !functions.empty())
     n.add(machineFunctions(functions.front()));
-  toolpaths(op, n);
-  if (!n.child(ir::Kind::Toolpath)) {
-    report(op, op.loc(),
-           "the operation of workingstep " + hashId(ws.id()) +
-               " has no toolpath (machining_toolpath_sequence_relationship): AIM operations that leave the path to "
-               "a strategy are not supported yet (docs/ap238.md)");
-    return std::nullopt;
+  operationParameters(op, n);
+  if (followsToolpaths) {
+    toolpaths(op, n);
+    if (!n.child(ir::Kind::Toolpath))
+      return std::nullopt;  // each toolpath said why it was not lowered
+  } else {
+    strategies(op, n);
   }
   return n;
 }
@@ -764,8 +703,7 @@ std::optional<std::string> AimLowerer::tool(const Instance &t) {
           continue;
         used = true;
         if (!(m->dims == r.dims)) {
-          report(item, item.loc(),
-                 "'" + m->name + "': expected " + dimsText(r.dims) + ", its unit is " + dimsText(m->dims));
+          wrongUnit(item, item.loc(), m->name, r.dims, m->dims);
           continue;
         }
         if (std::string_view(r.attribute) == "flutes")
