@@ -54,6 +54,9 @@ struct TargetDescriptor {
   ArcForm arcs = ArcForm::IncrementalCentre;
   bool helix = true;         ///< helical arcs (a z change along an arc) in one block
   bool helixTurns = true;    ///< several turns of a helix in one block
+  /// Arcs in the ZX and YZ planes (G18, G19) as well as XY; without, they are
+  /// written as lines along their chords (within ir::kOutOfPlaneArcChord).
+  bool arcPlanes = false;
   /// Canned cycles used when they make the planned moves, and what each can do.
   std::map<CycleKind, CycleForm> cycles;
   SplineForm splines = SplineForm::None;

@@ -1,6 +1,7 @@
 #include "ir/Program.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace stepnc::ir {
 
@@ -35,7 +36,7 @@ const Node *findIn(const Node &n, std::string_view symbol, const Node **parent) 
 std::string quotedKind(const Node &n) { return "'" + n.kindName() + "'"; }
 
 /// What of `n` itself (not its subtree) a 3-axis milling reader cannot take.
-std::optional<std::string> beyond(const Node &n) {
+std::optional<std::string> beyond(const Node &n, ArcPlanes planes) {
   if (n.is(Trait::ControlFlow))
     return "control flow (" + quotedKind(n) + ")";
   if (n.category() == Category::Operation && !n.spec().isAny(Trait::Milling | Trait::HoleMaking))
@@ -55,29 +56,39 @@ std::optional<std::string> beyond(const Node &n) {
       return std::string("a tool axis per move");
     if (n.has("feed_per_rev"))
       return std::string("a feed per revolution");
-    if (auto normal = n.vec("normal"); normal && *normal != Vec3::UnitZ())
-      return std::string("an arc out of the XY plane");
+    if (auto normal = n.vec("normal"); normal && *normal != Vec3::UnitZ()) {
+      const bool principal = std::abs(std::abs(normal->x()) - 1) <= 1e-9 ||
+                             std::abs(std::abs(normal->y()) - 1) <= 1e-9 ||
+                             std::abs(std::abs(normal->z()) - 1) <= 1e-9;
+      if (!principal)
+        return std::string("an arc about an axis along none of x, y and z");
+      if (planes == ArcPlanes::XYOnly)
+        return std::string("an arc out of the XY plane");
+    }
     break;
   default: break;
   }
   return std::nullopt;
 }
 
-std::optional<Beyond> firstBeyond(const Node &n) {
-  if (auto what = beyond(n))
+std::optional<Beyond> firstBeyond(const Node &n, ArcPlanes planes) {
+  if (auto what = beyond(n, planes))
     return Beyond{&n, *what};
   for (const Node &c : n.children)
-    if (auto found = firstBeyond(c))
+    if (auto found = firstBeyond(c, planes))
       return found;
   return std::nullopt;
 }
 
 } // namespace
 
-std::optional<Beyond> beyondThreeAxisMilling(const Module &module) { return firstBeyond(module.root); }
+std::optional<Beyond> beyondThreeAxisMilling(const Module &module, ArcPlanes planes) {
+  return firstBeyond(module.root, planes);
+}
 
-bool requireThreeAxisMilling(const Module &module, std::string_view consumer, DiagnosticEngine &diags) {
-  const std::optional<Beyond> b = beyondThreeAxisMilling(module);
+bool requireThreeAxisMilling(const Module &module, std::string_view consumer, DiagnosticEngine &diags,
+                             ArcPlanes planes) {
+  const std::optional<Beyond> b = beyondThreeAxisMilling(module, planes);
   if (!b)
     return true;
   std::string subject = b->node->kindName();

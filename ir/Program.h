@@ -69,6 +69,10 @@ bool toolpathsGiveFeeds(const Node &op);
 /// the machine does).
 bool runsAsWritten(const Node &executable);
 
+/// Which arcs a reader of the IR takes: in the XY plane only, or in any of
+/// the principal planes XY, ZX and YZ (an arc `normal` along x, y or z).
+enum class ArcPlanes : uint8_t { XYOnly, Principal };
+
 /// A construct that a consumer of straight 3-axis milling programs does not
 /// take yet, and the node that has it.
 struct Beyond {
@@ -83,11 +87,16 @@ struct Beyond {
 /// an arc out of the XY plane, a feed per revolution, a change of process
 /// state, a lathe's X mode. (Dwells and canned cycles they all take.) The IR expresses all of them
 /// (docs/ir.md); each reader takes them as it learns to.
-std::optional<Beyond> beyondThreeAxisMilling(const Module &module);
+/// A consumer that takes arcs in the ZX and YZ planes too (`planes`
+/// Principal: it walks moves with ir::walkMoves, which gives them as chords,
+/// or writes them itself) is not stopped by them; an arc about any other
+/// axis stops every consumer.
+std::optional<Beyond> beyondThreeAxisMilling(const Module &module, ArcPlanes planes = ArcPlanes::XYOnly);
 
 /// Reports the first construct `consumer` cannot take as an error at its
 /// node ("<consumer> cannot take <what> yet") and returns false; true when
 /// there is none.
-bool requireThreeAxisMilling(const Module &module, std::string_view consumer, DiagnosticEngine &diags);
+bool requireThreeAxisMilling(const Module &module, std::string_view consumer, DiagnosticEngine &diags,
+                             ArcPlanes planes = ArcPlanes::XYOnly);
 
 } // namespace stepnc::ir

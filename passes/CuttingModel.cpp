@@ -197,7 +197,9 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
     const double spindle = p.moves->number("spindle").value_or(0);
     step.spindle = std::abs(spindle);
     step.setup = p.setup;
-    for (const ir::Move &m : ir::walkMoves(*p.moves, position)) {
+    // One cut move per move of the IR (an arc out of the XY plane too: its
+    // feed is kept as programmed, and the stock cut along its chords).
+    for (const ir::Move &m : ir::walkMoves(*p.moves, position, ir::PathKind::Programmed, ir::OutOfPlaneArcs::Exact)) {
       CutMove cm;
       cm.move = m;
       step.moves.push_back(std::move(cm));
@@ -233,7 +235,7 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
       if (!m.isFeed() || !m.from || radius <= 0)
         continue;
       const std::vector<geom::Seg> segs = m.planar();
-      if (model && !step.asWritten && !m.changesHeight() && !segs.empty()) {
+      if (model && !step.asWritten && !m.changesHeight() && !segs.empty() && m.plane.isXY()) {
         cm.measured = true;
         cm.fz = m.feed / (cutter.flutes * step.spindle);
         const cutting::CuttingCoefficients k = material->coefficients();

@@ -94,6 +94,18 @@ void InProcessStock::cut(cutting::HeightMap &stock, const ir::Move &m, double ra
   if (!m.isFeed() || !m.from || radius <= 0)
     return;
   const double cutStep = std::max(stock.cell(), 0.05);
+  if (m.kind == ir::MoveKind::Arc && !m.plane.isXY()) {
+    // An arc in the ZX or YZ plane: along its chords, each at the heights of its ends.
+    const std::vector<ir::Vec3> points = m.chordPoints(ir::kOutOfPlaneArcChord);
+    for (size_t k = 1; k < points.size(); ++k) {
+      const Vec2 a = points[k - 1].head<2>(), b = points[k].head<2>();
+      if ((b - a).norm() <= 1e-9)
+        stock.cutDisc(b, radius, std::min(points[k - 1].z(), points[k].z()) + point);
+      else
+        stock.cutAlong(geom::Seg::line(a, b), radius, points[k - 1].z() + point, points[k].z() + point, cutStep);
+    }
+    return;
+  }
   const std::vector<geom::Seg> segs = m.planar();
   if (segs.empty()) {
     stock.cutDisc(m.to.head<2>(), radius, std::min(m.from->z(), m.to.z()) + point);

@@ -18,7 +18,7 @@ public:
   std::string_view name() const override { return "plan-motion"; }
 
   PassResult run(ir::Module &module, DiagnosticEngine &diags, PassStats &stats) override {
-    if (!ir::requireThreeAxisMilling(module, "plan-motion", diags))
+    if (!ir::requireThreeAxisMilling(module, "plan-motion", diags, ir::ArcPlanes::Principal))
       return {false, false};
     // Kept for the life of the pass: diagnostics point into it.
     const auto machine = runtime::loadMachine(machinePath_, machineFile_, diags);

@@ -1163,7 +1163,7 @@ public:
   std::string_view name() const override { return "verify-toolpaths"; }
 
   PassResult run(ir::Module &module, DiagnosticEngine &diags, PassStats &stats) override {
-    if (!ir::requireThreeAxisMilling(module, "verify-toolpaths", diags))
+    if (!ir::requireThreeAxisMilling(module, "verify-toolpaths", diags, ir::ArcPlanes::Principal))
       return {false, false};
     return ToolpathChecker(module, diags, stats, tolerance_).run();
   }

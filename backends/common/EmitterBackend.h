@@ -24,7 +24,9 @@ public:
                                   DiagnosticEngine &diags) override {
     if (!holdsTolerance(options, diags))
       return std::nullopt;
-    std::optional<Program> program = buildProgram(module, options.toolTable, diags);
+    std::optional<Program> program =
+        buildProgram(module, options.toolTable, diags,
+                     descriptor().arcPlanes ? ir::OutOfPlaneArcs::Exact : ir::OutOfPlaneArcs::Chords);
     if (!program)
       return std::nullopt;
     Emitter emitter(descriptor(), options, diags);

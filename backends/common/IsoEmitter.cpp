@@ -104,6 +104,8 @@ std::optional<std::string> IsoEmitter::run(const Program &p) {
         move(s.moves[i++]);
       }
     }
+    if (const std::string g17 = selectPlane(geom::ArcPlane::xy()); !g17.empty())
+      out_.block(g17.substr(0, g17.size() - 1));
   }
   footer(p);
   for (size_t line : out_.overlong())
@@ -136,12 +138,12 @@ void IsoEmitter::beforeReclamp() {
   coolant_ = "off";
 }
 
-std::string IsoEmitter::axes(const Vec3 &to, bool forceXY) {
+std::string IsoEmitter::axes(const Vec3 &to, std::optional<geom::ArcPlane> force) {
   std::string words;
   const char *names[3] = {"X", "Y", "Z"};
   for (int k = 0; k < 3; ++k) {
     const std::string v = num(to[k]);
-    if (modal_.change(names[k], v) || (forceXY && k < 2)) {
+    if (modal_.change(names[k], v) || (force && k != force->normal)) {
       if (!words.empty())
         words += ' ';
       words += names[k] + v;
@@ -247,15 +249,27 @@ void IsoEmitter::spline(const std::vector<Move> &moves, size_t begin, size_t end
   modal_.change("G", "CSPLINE");
 }
 
+std::string IsoEmitter::selectPlane(geom::ArcPlane p) {
+  if (p == plane_)
+    return {};
+  plane_ = p;
+  modal_.forget("G");  // G2/G3 are written again in the new plane
+  return p.isXY() ? "G17 " : p.normal == 1 ? "G18 " : "G19 ";
+}
+
 void IsoEmitter::arc(const Move &m) {
+  // In the plane's coordinates (x, y for XY; geom/ArcPlane.h): the same
+  // rules in every plane, the normal's coordinate as the helix's axis.
+  const geom::ArcPlane &plane = m.plane;
   const double sweep = m.sweep();
-  if (arcPrintsClosed(m.from.head<2>(), m.to.head<2>(), sweep, d_.coordDecimals)) {
+  if (arcPrintsClosed(m.fromInPlane(), m.toInPlane(), sweep, d_.coordDecimals)) {
     Move line = m;
     line.kind = Move::Kind::Linear;
     move(line);
     return;
   }
-  const Vec3 from(roundTo(m.from.x(), d_.coordDecimals), roundTo(m.from.y(), d_.coordDecimals), m.from.z());
+  const Vec3 localFrom = plane.local(m.from), localTo = plane.local(m.to);
+  const Vec3 from(roundTo(localFrom.x(), d_.coordDecimals), roundTo(localFrom.y(), d_.coordDecimals), localFrom.z());
   // Pieces: the radius form takes at most a third of a turn per block (the
   // controller finds the centre from R and the printed ends, which near half
   // a turn moves it by many times the rounding); a target without multi-turn
@@ -266,18 +280,21 @@ void IsoEmitter::arc(const Move &m) {
   else if (!d_.helixTurns && m.turns > 0)
     pieces = static_cast<int>(m.turns) + 1;
   const bool oneBlockTurns = pieces == 1 && m.turns > 0;
-  std::vector<geom::Vec2> ends = arcSplitPoints(m.from.head<2>(), m.centre, m.ccw, sweep, pieces);
-  ends.back() = m.to.head<2>();
+  std::vector<geom::Vec2> ends = arcSplitPoints(m.fromInPlane(), m.centre, m.ccw, sweep, pieces);
+  ends.back() = m.toInPlane();
   geom::Vec2 start = from.head<2>();
+  // I J K: the offsets along the plane's first and second axes.
+  const std::string firstOffset(1, "IJK"[plane.first()]), secondOffset(1, "IJK"[plane.second()]);
   for (int k = 0; k < pieces; ++k) {
-    const double z = m.from.z() + (m.to.z() - m.from.z()) * (k + 1) / pieces;
+    const double z = localFrom.z() + (localTo.z() - localFrom.z()) * (k + 1) / pieces;
     const Vec3 to(ends[k].x(), ends[k].y(), z);
     const geom::Vec2 printedTo(roundTo(to.x(), d_.coordDecimals), roundTo(to.y(), d_.coordDecimals));
     const std::string g = m.ccw ? "G3" : "G2";
-    std::string text = modal_.change("G", g) ? g + " " : "";
-    text += axes(to, /*forceXY=*/true);
+    std::string text = selectPlane(plane);
+    text += modal_.change("G", g) ? g + " " : "";
+    text += axes(plane.world(to), plane);
     if (d_.arcs == ArcForm::Radius) {
-      const double r = (m.centre - m.from.head<2>()).norm();
+      const double r = (m.centre - m.fromInPlane()).norm();
       const double pieceSweep = sweep / pieces;
       text += ' ';
       text += radiusWord(pieceSweep > std::numbers::pi ? -r : r);
@@ -294,7 +311,9 @@ void IsoEmitter::arc(const Move &m) {
       const bool shortChord = (printedTo - start).norm() < 0.1 * (m.centre - start).norm();
       const geom::Vec2 centre = agrees && shortChord ? m.centre : geom::balancedCentre(start, printedTo, m.centre);
       const geom::Vec2 ij = roundedCentreOffset(start, printedTo, centre, d_.coordDecimals);
-      text += word(" I", num(ij.x())) + word(" J", num(ij.y()));
+      // Written I, J, K in that order (ZX: I then K).
+      const std::string a = word(" " + firstOffset, num(ij.x())), b = word(" " + secondOffset, num(ij.y()));
+      text += plane.normal == 1 ? b + a : a + b;
     }
     if (oneBlockTurns) {
       const std::string w = turnsWord(m.turns);

@@ -62,8 +62,9 @@ protected:
 
   // --- Shared machinery ------------------------------------------------------------
   void move(const Move &m);
-  /// Axis words for the coordinates that changed, e.g. "X10.5 Z-2.".
-  std::string axes(const Vec3 &to, bool forceXY = false);
+  /// Axis words for the coordinates that changed, e.g. "X10.5 Z-2.", and
+  /// always those of the plane `force` when given (an arc's end).
+  std::string axes(const Vec3 &to, std::optional<geom::ArcPlane> force = std::nullopt);
   std::string num(double v) const { return formatNumber(v, {d_.coordDecimals, false, true}); }
   std::string feedWord(double feed);
   /// Tells the modal state where the tool is after something it did not see
@@ -95,6 +96,11 @@ private:
   int tool_ = -1;
   double spindle_ = 0;
   std::string coolant_ = "off";
+  /// The plane G17/G18/G19 selects: XY from the header on; an arc in another
+  /// plane selects its own, and the step ends back in XY (cycles drill along z).
+  geom::ArcPlane plane_ = geom::ArcPlane::xy();
+  /// The word that selects `p` when it is not the plane in force ("G18 "), else "".
+  std::string selectPlane(geom::ArcPlane p);
 };
 
 } // namespace stepnc::backends

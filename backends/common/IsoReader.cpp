@@ -31,15 +31,15 @@ int gKey(double value) { return static_cast<int>(std::lround(value * 10)); }
 const std::set<int> &allowedG(Dialect dialect) {
   static const std::set<int> rs274 = [] {
     std::set<int> s;
-    for (int g : {0, 1, 2, 3, 4, 5, 17, 21, 40, 43, 49, 54, 55, 56, 57, 58, 59, 64, 74, 80, 81, 82, 83, 84, 85, 89,
-                  90, 94, 98, 99})
+    for (int g : {0, 1, 2, 3, 4, 5, 17, 18, 19, 21, 40, 43, 49, 54, 55, 56, 57, 58, 59, 64, 74, 80, 81, 82, 83, 84,
+                  85, 89, 90, 94, 98, 99})
       s.insert(g * 10);
     s.insert({591, 592, 593});
     return s;
   }();
   static const std::set<int> siemens = [] {
     std::set<int> s;
-    for (int g : {0, 1, 2, 3, 4, 17, 40, 64, 71, 90, 94, 642, 54, 55, 56, 57})
+    for (int g : {0, 1, 2, 3, 4, 17, 18, 19, 40, 64, 71, 90, 94, 642, 54, 55, 56, 57})
       s.insert(g * 10);
     for (int g = 505; g < 600; ++g)
       s.insert(g * 10);
@@ -264,11 +264,11 @@ private:
   /// Checks how each word's number is written and takes its value; false
   /// (reported) when one is wrong.
   bool numbers(size_t n, std::vector<Word> &ws) {
-    static const std::set<std::string> rs274Words = {"G", "M", "X", "Y", "Z", "I", "J", "P", "Q", "R", "F", "S",
-                                                     "T", "H"};
-    static const std::set<std::string> siemensWords = {"G", "M", "X", "Y", "Z", "I", "J", "F", "S", "T", "D", "CR",
-                                                       "TURN"};
-    static const std::set<std::string> lengths = {"X", "Y", "Z", "I", "J", "R", "Q", "F", "CR"};
+    static const std::set<std::string> rs274Words = {"G", "M", "X", "Y", "Z", "I", "J", "K", "P", "Q", "R", "F",
+                                                     "S", "T", "H"};
+    static const std::set<std::string> siemensWords = {"G", "M", "X", "Y", "Z", "I", "J", "K", "F", "S", "T", "D",
+                                                       "CR", "TURN"};
+    static const std::set<std::string> lengths = {"X", "Y", "Z", "I", "J", "K", "R", "Q", "F", "CR"};
     static const std::set<std::string> wholes = {"M", "S", "T", "D", "H", "TURN"};
     bool ok = true;
     for (Word &w : ws) {
@@ -400,7 +400,7 @@ private:
     if (dialect_ == Dialect::Rs274 && cycleCode_ && seen.count("P"))
       stickyP_ = seen["P"];
     const bool axes = seen.count("X") || seen.count("Y") || seen.count("Z") || seen.count("I") || seen.count("J") ||
-                      seen.count("CR") || (seen.count("R") && !has(43));
+                      seen.count("K") || seen.count("CR") || (seen.count("R") && !has(43));
     if (!axes) {
       if (seen.count("TURN") || (seen.count("Q") && !cycleCode_))
         r_.problem(n, "TURN=, K or Q without a move");
@@ -428,7 +428,13 @@ private:
       motion_ = g / 10;
       return;
     case 170:
-      plane_ = true;
+      plane_ = geom::ArcPlane{2};
+      return;
+    case 180:
+      plane_ = geom::ArcPlane{1};
+      return;
+    case 190:
+      plane_ = geom::ArcPlane{0};
       return;
     case 210:
     case 710:
@@ -560,7 +566,7 @@ private:
       return;
     }
     const bool xyMoves = seen.count("X") || seen.count("Y") || seen.count("I") || seen.count("J") ||
-                         seen.count("CR") || seen.count("R") || seen.count("TURN");
+                         seen.count("K") || seen.count("CR") || seen.count("R") || seen.count("TURN");
     upFirst(n, *motion_ == 0 && !xyMoves);
     if (mcall_) {
       cyclePosition(n, seen);
@@ -579,7 +585,7 @@ private:
       spline(n, seen, to);
       return;
     }
-    for (const char *bad : {"I", "J", "R", "CR", "TURN", "P", "Q"})
+    for (const char *bad : {"I", "J", "K", "R", "CR", "TURN", "P", "Q"})
       if (seen.count(bad)) {
         r_.problem(n, std::string(bad) + " on a straight move");
         return;
@@ -619,9 +625,22 @@ private:
 
   void arc(size_t n, const std::map<std::string, double> &seen) {
     if (!plane_)
-      r_.problem(n, "an arc before G17 (the XY plane)");
-    const geom::Vec2 start = pos_.head<2>();
-    const geom::Vec2 end(seen.count("X") ? seen.at("X") : pos_.x(), seen.count("Y") ? seen.at("Y") : pos_.y());
+      r_.problem(n, "an arc before G17, G18 or G19 (its plane)");
+    // In the plane's coordinates (geom/ArcPlane.h): the first and second
+    // axes' words, the centre offsets of the same axes (I J K).
+    const geom::ArcPlane plane = plane_.value_or(geom::ArcPlane::xy());
+    Vec3 to = pos_;
+    for (int k = 0; k < 3; ++k)
+      if (const auto v = seen.find(std::string(1, "XYZ"[k])); v != seen.end())
+        to[k] = v->second;
+    const std::string firstOffset(1, "IJK"[plane.first()]), secondOffset(1, "IJK"[plane.second()]);
+    const std::string normalOffset(1, "IJK"[plane.normal]);
+    if (seen.count(normalOffset)) {
+      r_.problem(n, "an arc in the " + std::string(plane.name()) + " plane with " + normalOffset);
+      return;
+    }
+    const geom::Vec2 start = plane.local(pos_).head<2>();
+    const geom::Vec2 end = plane.local(to).head<2>();
     const bool ccw = *motion_ == 3;
     const char *radiusWord = dialect_ == Dialect::Rs274 ? "R" : "CR";
     const char *turnsWord = dialect_ == Dialect::Rs274 ? "P" : "TURN";
@@ -632,13 +651,15 @@ private:
     geom::Vec2 centre;
     int64_t turns = 0;
     if (seen.count(radiusWord)) {
-      if (seen.count("I") || seen.count("J") || seen.count(turnsWord)) {
-        r_.problem(n, std::string("an arc with ") + radiusWord + " and I, J or turns");
+      if (seen.count(firstOffset) || seen.count(secondOffset) || seen.count(turnsWord)) {
+        r_.problem(n, std::string("an arc with ") + radiusWord + " and " + firstOffset + ", " + secondOffset +
+                          " or turns");
         return;
       }
       const double cr = seen.at(radiusWord), r = std::abs(cr), chord = (end - start).norm();
       if (chord < 1e-9) {
-        r_.problem(n, std::string("a whole circle with ") + radiusWord + " (it needs I and J)");
+        r_.problem(n, std::string("a whole circle with ") + radiusWord + " (it needs " + firstOffset + " and " +
+                          secondOffset + ")");
         return;
       }
       if (r == 0 || r < chord / 2 - arcRadiusTolerance(d_)) {
@@ -652,8 +673,9 @@ private:
       const geom::Vec2 left(-(end.y() - start.y()) / chord, (end.x() - start.x()) / chord);
       const double side = (ccw ? 1 : -1) * (cr > 0 ? 1 : -1);
       centre = (start + end) / 2 + side * h * left;
-    } else if (seen.count("I") || seen.count("J")) {
-      centre = start + geom::Vec2(seen.count("I") ? seen.at("I") : 0, seen.count("J") ? seen.at("J") : 0);
+    } else if (seen.count(firstOffset) || seen.count(secondOffset)) {
+      centre = start + geom::Vec2(seen.count(firstOffset) ? seen.at(firstOffset) : 0,
+                                  seen.count(secondOffset) ? seen.at(secondOffset) : 0);
       const double r0 = (start - centre).norm(), r1 = (end - centre).norm();
       if (r0 < 1e-9) {
         r_.problem(n, "an arc of radius 0");
@@ -674,22 +696,20 @@ private:
         }
       }
     } else {
-      r_.problem(n, std::string("an arc with neither I, J nor ") + radiusWord);
+      r_.problem(n, "an arc with neither " + firstOffset + ", " + secondOffset + " nor " + radiusWord);
       return;
     }
-    Vec3 to = pos_;
-    for (int k = 0; k < 3; ++k)
-      if (const auto v = seen.find(std::string(1, "XYZ"[k])); v != seen.end())
-        to[k] = v->second;
     Move planned;  // Move::sweep() is the arc rule of the toolpath IR
     planned.from = pos_;
     planned.to = to;
     planned.centre = centre;
     planned.ccw = ccw;
     planned.turns = turns;
+    planned.plane = plane;
     make(n, Move::Kind::Arc, to);
     ReadMove &m = r_.moves.back();
     m.centre = centre;
+    m.plane = plane;
     m.ccw = ccw;
     m.sweep = planned.sweep();
   }
@@ -735,8 +755,8 @@ private:
       }
     upFirst(n, false);
     ready(n, true);
-    if (!plane_)
-      r_.problem(n, name + " before G17 (the XY plane)");
+    if (!plane_ || !plane_->isXY())
+      r_.problem(n, name + " outside G17 (the XY plane)");
     if (!known(pos_.z())) {
       r_.problem(n, name + " from an unknown height");
       return;
@@ -1026,7 +1046,8 @@ private:
   ProgramReading r_;
   Vec3 pos_ = Vec3(kNaN, kNaN, kNaN);
   std::optional<int> motion_;  ///< 0 1 2 3, 5 (G5), kCspline
-  bool absolute_ = false, metric_ = false, plane_ = false;
+  bool absolute_ = false, metric_ = false;
+  std::optional<geom::ArcPlane> plane_;  ///< G17, G18, G19; none before the program selects one
   double feed_ = 0, speed_ = 0;
   bool spindleOn_ = false;
   std::optional<int> selected_, inSpindle_, offset_, pendingOffset_;

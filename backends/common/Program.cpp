@@ -11,8 +11,8 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <set>
 #include <numbers>
+#include <set>
 
 namespace stepnc::backends {
 
@@ -58,8 +58,8 @@ HoleCycle holeCycle(const ir::Node &cycle, double secplane) {
 
 class Builder {
 public:
-  Builder(const ir::Module &m, const ToolTable *table, DiagnosticEngine &diags)
-      : module_(m), table_(table), diags_(diags) {}
+  Builder(const ir::Module &m, const ToolTable *table, DiagnosticEngine &diags, ir::OutOfPlaneArcs arcs)
+      : module_(m), table_(table), diags_(diags), arcs_(arcs) {}
 
   std::optional<Program> build() {
     program_.name = module_.root.label.empty() ? module_.root.symbol : module_.root.label;
@@ -134,7 +134,10 @@ private:
     s.coolant = moves->text("coolant").value_or("off");
     s.secplane = moves->number("secplane").value_or(0);
     // The moves as every reader of the toolpath IR sees them (ir/geom/MoveWalk).
-    for (const ir::Move &m : ir::walkMoves(*moves, position_)) {
+    std::set<const ir::Node *> chorded;  // arcs out of the XY plane written as lines
+    for (const ir::Move &m : ir::walkMoves(*moves, position_, ir::PathKind::Programmed, arcs_)) {
+      if (m.chord)
+        chorded.insert(m.node);
       Move mv;
       mv.node = m.node;
       mv.from = m.from.value_or(position_);
@@ -149,11 +152,19 @@ private:
       mv.dwell = m.dwell;
       mv.feed = m.feed;
       mv.smooth = mv.kind == Move::Kind::Linear && m.node && m.node->flag("smooth").value_or(false);
-      mv.centre = m.center.head<2>();
+      mv.centre = m.plane.local(m.center).head<2>();
+      mv.plane = m.plane;
       mv.ccw = m.ccw;
       mv.turns = m.turns;
       s.moves.push_back(std::move(mv));
     }
+    if (!chorded.empty())
+      diags_.remark(e.origin.loc, e.kindName() + " " + e.symbol + ": " + std::to_string(chorded.size()) +
+                                      (chorded.size() == 1 ? " arc" : " arcs") +
+                                      " in the ZX or YZ plane written as lines, none more than " +
+                                      formatShortest(ir::kOutOfPlaneArcChord) +
+                                      " mm from its arc: the target writes arcs in the XY plane only")
+          .entity(e.origin.entityId);
     // A program that re-clamps selects each setup's work offset.
     if (reclamps_) {
       const std::string setup = moves->text("setup").value_or("");
@@ -318,6 +329,7 @@ private:
   const ir::Module &module_;
   const ToolTable *table_;
   DiagnosticEngine &diags_;
+  ir::OutOfPlaneArcs arcs_;
   Program program_;
   std::map<std::string, int> toolIndex_;       ///< by symbol
   std::map<std::string, int> toolByIdentity_;  ///< by toolIdentity
@@ -337,8 +349,9 @@ private:
 } // namespace
 
 double Move::sweep() const {
-  double angle = turnAngle(from.head<2>() - centre, to.head<2>() - centre, ccw);
-  if ((to.head<2>() - from.head<2>()).norm() <= kSame)
+  const geom::Vec2 a = fromInPlane(), b = toInPlane();
+  double angle = turnAngle(a - centre, b - centre, ccw);
+  if ((b - a).norm() <= kSame)
     angle = kTwoPi;  // over the start: a whole turn
   return angle + kTwoPi * static_cast<double>(turns);
 }
@@ -365,10 +378,11 @@ std::string whyNotCycle(const TargetDescriptor &d, const HoleCycle &c) {
   return "";
 }
 
-std::optional<Program> buildProgram(const ir::Module &module, const ToolTable *table, DiagnosticEngine &diags) {
-  if (!ir::requireThreeAxisMilling(module, "the G-code targets", diags))
+std::optional<Program> buildProgram(const ir::Module &module, const ToolTable *table, DiagnosticEngine &diags,
+                                    ir::OutOfPlaneArcs arcs) {
+  if (!ir::requireThreeAxisMilling(module, "the G-code targets", diags, ir::ArcPlanes::Principal))
     return std::nullopt;
-  return Builder(module, table, diags).build();
+  return Builder(module, table, diags, arcs).build();
 }
 
 } // namespace stepnc::backends

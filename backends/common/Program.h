@@ -7,8 +7,10 @@
 
 #include "backends/Target.h"
 #include "backends/common/ToolTable.h"
+#include "geom/ArcPlane.h"
 #include "geom/Geometry.h"
 #include "ir/Node.h"
+#include "ir/geom/MoveWalk.h"
 #include "support/Diagnostics.h"
 
 #include <optional>
@@ -32,8 +34,11 @@ struct Move {
   enum class Kind { Rapid, Linear, Arc, Dwell } kind = Kind::Rapid;
   Vec3 from = Vec3::Zero();  ///< where the tool is before the move
   Vec3 to = Vec3::Zero();
-  geom::Vec2 centre = geom::Vec2::Zero();  ///< arcs: the axis through the centre, parallel to z
-  bool ccw = false;
+  /// Arcs: the axis through the centre, along the plane's normal, in the
+  /// plane's coordinates (x, y in the XY plane; geom/ArcPlane.h).
+  geom::Vec2 centre = geom::Vec2::Zero();
+  bool ccw = false;  ///< seen from the tip of the plane's normal
+  geom::ArcPlane plane = geom::ArcPlane::xy();
   int64_t turns = 0;  ///< arcs: full turns before the last arc (toolpath IR rule)
   double feed = 0;    ///< mm/min; 0 for rapids
   bool smooth = false;  ///< a line that is a chord of a smooth curve (toolpath IR `smooth`)
@@ -53,6 +58,9 @@ struct Move {
   /// The whole angle an arc sweeps (radians, > 0), full turns included; a
   /// last arc ending over its start is a whole turn.
   double sweep() const;
+  /// Where an arc starts and ends in its plane's coordinates.
+  geom::Vec2 fromInPlane() const { return plane.local(from).head<2>(); }
+  geom::Vec2 toInPlane() const { return plane.local(to).head<2>(); }
 };
 
 /// A hole-making step whose moves are one axial cycle on one position, as
@@ -125,6 +133,10 @@ double clearanceHeight(const Step &s);
 
 /// The program of `module` (toolpath IR). Errors: an executable without
 /// moves, a tool missing from the table. Returns nullopt after reporting.
-std::optional<Program> buildProgram(const ir::Module &module, const ToolTable *table, DiagnosticEngine &diags);
+/// `arcs`: how arcs in the ZX and YZ planes come (ir::OutOfPlaneArcs): as
+/// arcs for a target that writes them (G18, G19), else as lines along their
+/// chords.
+std::optional<Program> buildProgram(const ir::Module &module, const ToolTable *table, DiagnosticEngine &diags,
+                                    ir::OutOfPlaneArcs arcs = ir::OutOfPlaneArcs::Chords);
 
 } // namespace stepnc::backends

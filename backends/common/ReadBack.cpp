@@ -71,8 +71,8 @@ std::string describe(const Move &m) {
     return s + " " + formatFixed(m.dwell, 3) + " s";
   s += " to " + point(m.to);
   if (m.kind == Move::Kind::Arc)
-    s += std::string(m.ccw ? " ccw" : " cw") + " about (" + formatFixed(m.centre.x(), 4) + ", " +
-         formatFixed(m.centre.y(), 4) + ")";
+    s += std::string(m.ccw ? " ccw" : " cw") + (m.plane.isXY() ? "" : std::string(" in the ") + m.plane.name() + " plane") +
+         " about (" + formatFixed(m.centre.x(), 4) + ", " + formatFixed(m.centre.y(), 4) + ")";
   if (m.kind != Move::Kind::Rapid)
     s += " at " + formatFixed(m.feed, 1) + " mm/min";
   return s;
@@ -266,17 +266,18 @@ private:
   /// in pieces about one centre); advances `b` past them. Pieces are taken
   /// until one ends where the plan's arc ends, within its last half turn.
   bool arc(size_t i, const Move &m, const std::vector<const ReadMove *> &read, size_t &b) {
-    const double radius = (m.from.head<2>() - m.centre).norm();
+    // In the plane's coordinates (centres are), the written arcs in the plan's plane.
+    const double radius = (m.fromInPlane() - m.centre).norm();
     const double sweep = m.sweep();
     const ReadMove &first = *read[b];
     double made = 0;
     const ReadMove *last = nullptr;
     auto centreTol = [&](const ReadMove &w) {
-      const double chord = (w.to.head<2>() - w.from.head<2>()).norm();
+      const double chord = (m.plane.local(w.to).head<2>() - m.plane.local(w.from).head<2>()).norm();
       return arcPathTol(d_) + posTol_ + 2 * unitOf(d_) * radius / std::max(chord, unitOf(d_));
     };
     while (b < read.size() && read[b]->kind == Move::Kind::Arc && read[b]->ccw == m.ccw &&
-           (read[b]->centre - m.centre).norm() <= centreTol(*read[b])) {
+           read[b]->plane == m.plane && (read[b]->centre - m.centre).norm() <= centreTol(*read[b])) {
       last = read[b];
       if (const std::optional<double> off = offCircle(*last, m); off && *off > arcPathTol(d_) + posTol_)
         return fail(i, last->line, "the arc leaves the plan's circle by " + formatFixed(*off, 4) + " mm (more than " +
@@ -290,9 +291,9 @@ private:
         break;
     }
     if (!last)
-      return fail(i, first.line, std::string(first.ccw ? "a ccw" : "a cw") + " arc about (" +
-                                     formatFixed(first.centre.x(), 4) + ", " + formatFixed(first.centre.y(), 4) +
-                                     ") where the plan has an " + describe(m));
+      return fail(i, first.line, std::string(first.ccw ? "a ccw" : "a cw") + " arc in the " + first.plane.name() +
+                                     " plane about " + formatTuple({first.centre.x(), first.centre.y()}, 4) +
+                                     " where the plan has an " + describe(m));
     if (!(std::abs(made - sweep) <= kSweepTol))
       return fail(i, last->line, "the arc turns " + formatFixed(made * 180 / std::numbers::pi, 3) +
                                      " deg where the plan's " + describe(m) + " turns " +
@@ -304,7 +305,7 @@ private:
 
   /// The arc `m` keeps within the contour tolerance of its chord.
   bool chordHolds(const Move &m) const {
-    const double radius = (m.from.head<2>() - m.centre).norm();
+    const double radius = (m.fromInPlane() - m.centre).norm();
     const double sweep = m.sweep();
     const double sagitta = sweep >= std::numbers::pi ? radius : radius * (1 - std::cos(sweep / 2));
     return sagitta <= tolerance_ + posTol_;
@@ -313,11 +314,12 @@ private:
   /// How far the written arc `w` gets from the planned arc's circle (points
   /// at its ends and between); nullopt when where it starts is not known.
   static std::optional<double> offCircle(const ReadMove &w, const Move &m) {
-    if (!w.from.head<2>().allFinite())
+    const geom::Vec2 from = m.plane.local(w.from).head<2>();
+    if (!from.allFinite())
       return std::nullopt;
-    const double radius = (m.from.head<2>() - m.centre).norm();
-    double worst = std::abs((w.from.head<2>() - m.centre).norm() - radius);
-    for (const geom::Vec2 &p : arcSplitPoints(w.from.head<2>(), w.centre, w.ccw, w.sweep, kArcSamples))
+    const double radius = (m.fromInPlane() - m.centre).norm();
+    double worst = std::abs((from - m.centre).norm() - radius);
+    for (const geom::Vec2 &p : arcSplitPoints(from, w.centre, w.ccw, w.sweep, kArcSamples))
       worst = std::max(worst, std::abs((p - m.centre).norm() - radius));
     return worst;
   }
@@ -381,7 +383,7 @@ std::vector<std::vector<Move>> expectedMoves(const Program &p, const TargetDescr
         at = Vec3(nan, nan, to.z());
         continue;
       }
-      if (m.kind == Move::Kind::Arc && arcPrintsClosed(m.from.head<2>(), m.to.head<2>(), m.sweep(), d.coordDecimals))
+      if (m.kind == Move::Kind::Arc && arcPrintsClosed(m.fromInPlane(), m.toInPlane(), m.sweep(), d.coordDecimals))
         m.kind = Move::Kind::Linear;
       if ((m.kind == Move::Kind::Rapid || m.kind == Move::Kind::Linear) && to == at)
         continue;  // prints as no motion

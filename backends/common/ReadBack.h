@@ -10,6 +10,7 @@
 #pragma once
 
 #include "backends/common/Program.h"
+#include "geom/ArcPlane.h"
 #include "support/Diagnostics.h"
 
 #include <cstddef>
@@ -26,8 +27,9 @@ struct ReadMove {
   Move::Kind kind = Move::Kind::Rapid;
   Vec3 from = Vec3::Zero();
   Vec3 to = Vec3::Zero();
-  geom::Vec2 centre = geom::Vec2::Zero();  ///< arcs
+  geom::Vec2 centre = geom::Vec2::Zero();  ///< arcs, in their plane's coordinates
   bool ccw = false;                        ///< arcs
+  geom::ArcPlane plane = geom::ArcPlane::xy();  ///< arcs: G17, G18 or G19 in force
   double sweep = 0;  ///< arcs: the whole angle turned, radians (> 0), full turns included
   double feed = 0;   ///< mm/min, feed moves (the modal feed in force)
   double dwell = 0;  ///< dwells, s

@@ -20,6 +20,7 @@ TargetDescriptor rs274Descriptor() {
   d.arcs = ArcForm::IncrementalCentre;
   d.helix = true;
   d.helixTurns = true;  // P: number of turns
+  d.arcPlanes = true;   // G18 (ZX: I, K), G19 (YZ: J, K)
   // G81/G82 (dwell P), G83, G85/G89 (dwell P), G84 and G74 (left hand).
   d.cycles = {{CycleKind::Drill, {.dwell = true}},
               {CycleKind::Peck, {}},

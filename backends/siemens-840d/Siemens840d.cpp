@@ -29,6 +29,7 @@ TargetDescriptor siemensDescriptor() {
   d.arcs = ArcForm::IncrementalCentre;
   d.helix = true;
   d.helixTurns = true;  // TURN=
+  d.arcPlanes = true;   // G18 (ZX: I, K), G19 (YZ: J, K)
   // CYCLE81/CYCLE82 (dwell DTB), CYCLE83, CYCLE84. CYCLE83's DTB and DTS
   // are left at 0: where it dwells with them is not among the checked facts.
   d.cycles = {{CycleKind::Drill, {.dwell = true}}, {CycleKind::Peck, {}}, {CycleKind::Tap, {}}};

@@ -112,6 +112,10 @@ private:
   /// the shape_aspect_relationship whose related shape aspect is the
   /// occurrence. Invalid when the feature has none.
   Instance component(const Instance &feature, std::string_view occurrence);
+  /// The length `item` of the `entity` that the occurrence `occurrence` of
+  /// feature `f` uses, set as `attribute` of `n`; false after a located error.
+  bool componentLength(const Instance &f, std::string_view occurrence, std::string_view entity,
+                       std::string_view item, Node &n, const char *attribute);
   /// Whether stepnc lowers a feature of this kind (round holes, closed
   /// rectangular pockets).
   static bool isLoweredFeature(const Instance &f);

@@ -109,6 +109,20 @@ std::optional<double> AimLowerer::required(const Instance &of, const Parameters 
   return it->second.value;
 }
 
+bool AimLowerer::componentLength(const Instance &f, std::string_view occurrence, std::string_view entity,
+                                 std::string_view item, Node &n, const char *attribute) {
+  const Instance c = component(f, occurrence);
+  if (!c.isA(entity)) {
+    base_.missing(f, std::string(occurrence),
+                  "is not given: no " + std::string(entity) + " of that occurrence gives the feature's " + attribute);
+    return false;
+  }
+  const std::optional<double> v = required(c, parameters(c), item, kLength);
+  if (v)
+    n.set(attribute, Value::length(*v));
+  return v.has_value();
+}
+
 bool AimLowerer::isLoweredFeature(const Instance &f) {
   if (f.isA("round_hole"))
     return true;
@@ -148,29 +162,8 @@ std::optional<std::string> AimLowerer::machiningFeature(const Instance &f) {
 
 bool AimLowerer::roundHole(const Instance &f, Node &n) {
   n.kind = ir::Kind::RoundHole;
-  bool ok = true;
-  const Instance diameter = component(f, "diameter occurrence");
-  if (!diameter.isA("circular_closed_profile")) {
-    base_.missing(f, "diameter occurrence",
-                  "is not given: a round hole's diameter is a circular_closed_profile its 'diameter occurrence' "
-                  "uses");
-    ok = false;
-  } else if (auto d = required(diameter, parameters(diameter), "diameter", kLength)) {
-    n.set("diameter", Value::length(*d));
-  } else {
-    ok = false;
-  }
-  const Instance depth = component(f, "hole depth occurrence");
-  if (!depth.isA("path_feature_component")) {
-    base_.missing(f, "hole depth occurrence",
-                  "is not given: a round hole's depth is a linear path_feature_component its 'hole depth "
-                  "occurrence' uses");
-    ok = false;
-  } else if (auto d = required(depth, parameters(depth), "distance", kLength)) {
-    n.set("depth", Value::length(*d));
-  } else {
-    ok = false;
-  }
+  bool ok = componentLength(f, "diameter occurrence", "circular_closed_profile", "diameter", n, "diameter");
+  ok = componentLength(f, "hole depth occurrence", "path_feature_component", "distance", n, "depth") && ok;
   const Instance bottom = component(f, "bottom condition occurrence");
   const std::string kind = normalName(bottom.string("description").value_or(""));
   const Parameters b = bottom ? parameters(bottom) : Parameters{};
@@ -215,17 +208,7 @@ bool AimLowerer::pocket(const Instance &f, Node &n) {
   const Parameters own = parameters(f);
   if (auto r = own.measures.find("fillet radius"); r != own.measures.end() && r->second.dims == kLength)
     n.set("planar_radius", Value::length(r->second.value));
-  const Instance depth = component(f, "pocket depth occurrence");
-  if (!depth.isA("path_feature_component")) {
-    base_.missing(f, "pocket depth occurrence",
-                  "is not given: a pocket's depth is a linear path_feature_component its 'pocket depth "
-                  "occurrence' uses");
-    ok = false;
-  } else if (auto d = required(depth, parameters(depth), "distance", kLength)) {
-    n.set("depth", Value::length(*d));
-  } else {
-    ok = false;
-  }
+  ok = componentLength(f, "pocket depth occurrence", "path_feature_component", "distance", n, "depth") && ok;
   const Instance bottom = component(f, "bottom condition occurrence");
   const std::string kind = normalName(bottom.string("description").value_or(""));
   if (!bottom) {

@@ -15,7 +15,7 @@ using ir::Vec3;
 
 constexpr double kTwoPi = 2 * std::numbers::pi;
 
-/// The counter-clockwise angle from a to b about c in the plane, in [0, 2pi).
+/// The counter-clockwise angle from a to b about c in the plane (x, y), in [0, 2pi).
 double ccwAngle(const Vec3 &c, const Vec3 &a, const Vec3 &b) {
   const double start = std::atan2(a.y() - c.y(), a.x() - c.x());
   const double end = std::atan2(b.y() - c.y(), b.x() - c.x());
@@ -27,20 +27,10 @@ double ccwAngle(const Vec3 &c, const Vec3 &a, const Vec3 &b) {
   return d;
 }
 
-/// The circle or helix axis must be along z (either way): pieces are circular in the plane.
-bool axisAlongZ(const Node &n, bool &positive, std::string &error) {
-  const Vec3 axis = n.vec("axis").value_or(Vec3::UnitZ());
-  if (std::abs(std::abs(axis.z()) - 1) > 1e-9) {
-    error = n.kindName() + " with its axis along " + formatTuple({axis.x(), axis.y(), axis.z()}, 6) +
-            ": only circles and helices about the tool axis are supported";
-    return false;
-  }
-  positive = axis.z() > 0;
-  return true;
-}
-
 class Converter {
 public:
+  explicit Converter(ArcPlanes planes) : planes_(planes) {}
+
   CurveResult result;
 
   void curve(const Node &n, bool forward) {
@@ -59,11 +49,31 @@ public:
     } else if (n.kind == ir::Kind::BSplineCurve) {
       spline(n, forward);
     } else {
-      fail("'" + n.kindName() + "' is not a curve");
+      std::string message = "'";
+      message += n.kindName();
+      message += "' is not a curve";
+      fail(std::move(message));
     }
   }
 
 private:
+  ArcPlanes planes_;
+
+  /// The plane a circle or helix turns in: its axis along z (either way), or
+  /// along x or y too when the caller allows the principal planes.
+  std::optional<geom::ArcPlane> planeOf(const Node &n, bool &positive) {
+    const Vec3 axis = n.vec("axis").value_or(Vec3::UnitZ());
+    std::optional<geom::ArcPlane> plane = geom::ArcPlane::about(axis, positive);
+    if (plane && (plane->isXY() || planes_ == ArcPlanes::Principal))
+      return plane;
+    fail(n.kindName() + " with its axis along " + formatTuple({axis.x(), axis.y(), axis.z()}, 6) +
+         (planes_ == ArcPlanes::Principal
+              ? ": only circles and helices about the x, y or z axis are supported (arcs in the XY, ZX and YZ "
+                "planes)"
+              : ": only circles and helices about the tool axis are supported"));
+    return std::nullopt;
+  }
+
   void fail(std::string message) {
     if (result.error.empty())
       result.error = std::move(message);
@@ -149,15 +159,17 @@ private:
 
   void fullCircle(const Node &n, bool forward) {
     bool positive = true;
-    if (!axisAlongZ(n, positive, result.error))
+    const std::optional<geom::ArcPlane> plane = planeOf(n, positive);
+    if (!plane)
       return;
     const Vec3 c = *n.vec("at");
     const Vec3 start = c + *n.vec("ref") * *n.number("radius");
     const bool ccw = positive == forward;
     // A full circle: two half turns, so that each piece has distinct ends.
-    const Vec3 opposite = 2 * c - start;
-    result.pieces.push_back({true, start, Vec3(opposite.x(), opposite.y(), start.z()), c, ccw, 0});
-    result.pieces.push_back({true, Vec3(opposite.x(), opposite.y(), start.z()), start, c, ccw, 0});
+    const Vec3 s = plane->local(start), o = plane->local(2 * c - start);
+    const Vec3 opposite = plane->world(Vec3(o.x(), o.y(), s.z()));
+    result.pieces.push_back({true, start, opposite, c, ccw, 0, *plane});
+    result.pieces.push_back({true, opposite, start, c, ccw, 0, *plane});
   }
 
   void trimmed(const Node &n, bool forward) {
@@ -179,15 +191,19 @@ private:
       addLine(a, b);
     } else if (basis->kind == ir::Kind::Circle || basis->kind == ir::Kind::Helix) {
       bool positive = true;
-      if (!axisAlongZ(*basis, positive, result.error))
+      const std::optional<geom::ArcPlane> plane = planeOf(*basis, positive);
+      if (!plane)
         return;
-      const Vec3 c = *basis->vec("at");
+      // In the plane's coordinates: (first, second) in the plane, then along its normal.
+      const Vec3 cw = *basis->vec("at");
+      const Vec3 c = plane->local(cw), la = plane->local(a), lb = plane->local(b);
       const double radius = basis->number("radius").value_or(0);
       for (const Vec3 &end : {a, b})
-        if (const double off = (end - c).head<2>().norm() - radius; std::abs(off) > kArcEndTolerance) {
-          fail("the trimmed " + basis->kindName() + " ends at (" + formatFixed(end.x(), 4) + ", " +
-               formatFixed(end.y(), 4) + ") mm, " + formatFixed(std::abs(off), 4) + " mm " +
-               (off > 0 ? "outside" : "inside") + " its circle of radius " + formatFixed(radius, 4) +
+        if (const double off = (plane->local(end) - c).head<2>().norm() - radius; std::abs(off) > kArcEndTolerance) {
+          const std::string where = plane->isXY() ? formatTuple({end.x(), end.y()}, 4)
+                                                  : formatTuple({end.x(), end.y(), end.z()}, 4);
+          fail("the trimmed " + basis->kindName() + " ends at " + where + " mm, " + formatFixed(std::abs(off), 4) +
+               " mm " + (off > 0 ? "outside" : "inside") + " its circle of radius " + formatFixed(radius, 4) +
                " mm (more than " + formatShortest(kArcEndTolerance) + " mm): no arc has both ends there");
           return;
         }
@@ -196,7 +212,7 @@ private:
       if (basis->kind == ir::Kind::Helix) {
         // The angle travelled follows from the rise: |dz| / |pitch| turns.
         const double pitch = std::abs(*basis->number("pitch"));
-        const double rise = std::abs(b.z() - a.z());
+        const double rise = std::abs(lb.z() - la.z());
         const double risen = pitch > 0 ? rise / pitch : 0;  // turns
         if (!(risen <= kMaxHelixTurns)) {
           fail("the trimmed helix rises " + formatFixed(rise, 3) + " mm at a pitch of " + formatShortest(pitch) +
@@ -206,14 +222,14 @@ private:
         }
         const double total = risen * kTwoPi;
         // The last partial arc: a whole turn when the ends meet in the plane.
-        double partial = ccwAngle(c, a, b);
+        double partial = ccwAngle(c, la, lb);
         if (!ccw && partial > 0)
           partial = kTwoPi - partial;
         if (partial < 1e-9)
           partial = kTwoPi;
         turns = std::max<int64_t>(0, std::llround((total - partial) / kTwoPi));
       }
-      result.pieces.push_back({true, a, b, c, ccw, turns});
+      result.pieces.push_back({true, a, b, cw, ccw, turns, *plane});
     } else {
       fail("trimmed " + basis->kindName() + " curves are not supported");
     }
@@ -322,8 +338,8 @@ std::optional<BSpline> bspline(const ir::Node &curve, std::string &error) {
   return s;
 }
 
-CurveResult curvePieces(const ir::Node &curve) {
-  Converter c;
+CurveResult curvePieces(const ir::Node &curve, ArcPlanes planes) {
+  Converter c(planes);
   c.curve(curve, true);
   return std::move(c.result);
 }

@@ -5,8 +5,10 @@
 // kSplineChordTolerance of the curve.
 #pragma once
 
+#include "geom/ArcPlane.h"
 #include "geom/Geometry.h"
 #include "ir/Node.h"
+#include "ir/Program.h"
 
 #include <optional>
 #include <string>
@@ -14,17 +16,19 @@
 
 namespace stepnc::ir {
 
-/// A straight piece, or a circular (helical when `to` is at another height)
-/// piece about an axis parallel to z through `center`.
+/// A straight piece, or a circular (helical when `to` is at another height
+/// along the plane's normal) piece about an axis through `center` along the
+/// normal of `plane` (z unless the caller allows the other principal planes).
 struct CurvePiece {
   bool arc = false;
   ir::Vec3 from = ir::Vec3::Zero();
   ir::Vec3 to = ir::Vec3::Zero();
   ir::Vec3 center = ir::Vec3::Zero();
-  bool ccw = true;    ///< seen from +z
+  bool ccw = true;    ///< seen from the tip of the plane's normal (+z in XY)
   /// Full turns before the last arc to `to`, which is itself a whole turn when
   /// `to` is over `from` (the toolpath IR's rule for arcs).
   int64_t turns = 0;
+  geom::ArcPlane plane = geom::ArcPlane::xy();
 };
 
 /// How far a B-spline's chords may stray from the curve, mm: a tenth of the
@@ -62,8 +66,11 @@ struct CurveResult {
 };
 
 /// The pieces of `curve` (a node of category "curve") in the coordinates it is
-/// written in, in its direction of travel.
-CurveResult curvePieces(const ir::Node &curve);
+/// written in, in its direction of travel. `planes`: circles about z only
+/// (profiles, outlines and courses of features, which lie in their plane), or
+/// about any of x, y and z (explicit toolpaths: arcs in the XY, ZX and YZ
+/// planes).
+CurveResult curvePieces(const ir::Node &curve, ArcPlanes planes = ArcPlanes::XYOnly);
 
 /// The pieces as plane segments (z dropped). Full turns become full circles.
 std::vector<geom::Seg> planarSegs(const std::vector<CurvePiece> &pieces);

@@ -4,6 +4,7 @@
 // feed adaptation, the backends) walks them through here.
 #pragma once
 
+#include "geom/ArcPlane.h"
 #include "geom/Geometry.h"
 #include "ir/Node.h"
 #include "ir/Program.h"
@@ -23,8 +24,14 @@ struct Move {
   /// Where the move starts; unknown for the first move of a program.
   std::optional<ir::Vec3> from;
   ir::Vec3 to = ir::Vec3::Zero();
-  ir::Vec3 center = ir::Vec3::Zero();  ///< arcs: the axis position (its z is not used)
-  bool ccw = false;                    ///< arcs, seen from +z
+  ir::Vec3 center = ir::Vec3::Zero();  ///< arcs: the axis position (its coordinate along the axis is not used)
+  bool ccw = false;                    ///< arcs, seen from the tip of the plane's normal (+z in XY)
+  /// Arcs: the plane they turn in (IR `normal`; XY when it has none). A
+  /// normal along -x, -y or -z is read as the plane's with `ccw` turned.
+  geom::ArcPlane plane = geom::ArcPlane::xy();
+  /// A line that stands for a piece of an arc out of the XY plane (walked
+  /// with OutOfPlaneArcs::Chords): `node` is that arc.
+  bool chord = false;
   /// Arcs: full turns before the last arc to `to`; that arc is itself a whole
   /// turn when `to` is over `from` in the plane.
   int64_t turns = 0;
@@ -39,12 +46,27 @@ struct Move {
   bool changesHeight() const;
   double length() const;  ///< in space; helices included
   /// The move seen from +z: its segments in the plane (a helix's full turns as
-  /// half arcs, then the last partial arc). Empty for a purely axial move.
+  /// half arcs, then the last partial arc; an arc out of the XY plane as its
+  /// chords). Empty for a purely axial move.
   std::vector<geom::Seg> planar() const;
   /// The point `s` mm along a line, or along an arc at constant height, from
   /// its start (which must be known).
   ir::Vec3 pointAt(double s) const;
+  /// An arc's points from its start to `to`, each chord within `tolerance`
+  /// mm of it (a helix's height spread over them); a line's two ends.
+  std::vector<ir::Vec3> chordPoints(double tolerance) const;
 };
+
+/// How far the chords that stand for an arc out of the XY plane may be from
+/// it (mm): the chord tolerance of B-splines (ir/geom/Curves.h).
+inline constexpr double kOutOfPlaneArcChord = 0.001;
+
+/// How walkMoves gives arcs out of the XY plane (ZX, YZ): as they are (for
+/// readers that handle every principal plane: the G-code emitters), or as
+/// lines along chords within kOutOfPlaneArcChord, each marked `chord` (for
+/// the passes that work in the XY plane: verification, the cutting model,
+/// motion planning).
+enum class OutOfPlaneArcs : uint8_t { Chords, Exact };
 
 /// Which end point a move is read with. Compensated moves (docs/deflection-
 /// compensation.md) are programmed off the part by the deflection the cut is
@@ -60,6 +82,6 @@ enum class PathKind : uint8_t { Programmed, Predicted };
 /// move that stays where the tool is (where the first move of a program
 /// starts unknown, at the origin).
 std::vector<Move> walkMoves(const ir::Node &moves, std::optional<ir::Vec3> start = std::nullopt,
-                            PathKind path = PathKind::Programmed);
+                            PathKind path = PathKind::Programmed, OutOfPlaneArcs arcs = OutOfPlaneArcs::Chords);
 
 } // namespace stepnc::ir

@@ -49,17 +49,27 @@ void Emitter::linear(const Vec3 &to, double feed, const char *role, bool smooth)
 }
 
 void Emitter::arc(const Vec3 &to, const geom::Vec2 &centre, bool ccw, int64_t turns, double feed, const char *role) {
+  arc(to, at(centre, pos_.z()), geom::ArcPlane::xy(), ccw, turns, feed, role);
+}
+
+void Emitter::arc(const Vec3 &to, const Vec3 &centre, geom::ArcPlane plane, bool ccw, int64_t turns, double feed,
+                  const char *role) {
   // An arc under half a turn whose ends print as one point would read back
   // as a whole circle: it is the line it is within the printed resolution.
-  const geom::Vec2 a = pos_.head<2>() - centre, b = to.head<2>() - centre;
+  const Vec3 start = plane.local(pos_), end = plane.local(to), c = plane.local(centre);
+  const geom::Vec2 a = start.head<2>() - c.head<2>(), b = end.head<2>() - c.head<2>();
   const bool underHalf = (ccw ? 1 : -1) * (a.x() * b.y() - a.y() * b.x()) > 0 && a.dot(b) > 0;
-  if (turns == 0 && underHalf && ir::printsAsOnePoint(Vec3(pos_.x(), pos_.y(), 0), Vec3(to.x(), to.y(), 0))) {
+  if (turns == 0 && underHalf &&
+      ir::printsAsOnePoint(Vec3(start.x(), start.y(), 0), Vec3(end.x(), end.y(), 0))) {
     linear(to, feed, role);
     return;
   }
   Node &m = moves_.add(Node(ir::Kind::Arc));
   m.set("to", Value::point(to));
-  m.set("center", Value::point(at(centre, pos_.z())));
+  // The centre at the start's height along the normal, as in the XY plane.
+  m.set("center", Value::point(plane.world(Vec3(c.x(), c.y(), start.z()))));
+  if (!plane.isXY())
+    m.set("normal", Value::direction(plane.normalVector()));
   m.set("dir", Value::word(ccw ? "ccw" : "cw"));
   if (turns > 0)
     m.set("turns", Value::integer(turns));

@@ -4,6 +4,7 @@
 // the security plane, across, and down along the tool axis.
 #pragma once
 
+#include "geom/ArcPlane.h"
 #include "geom/Boolean.h"
 #include "ir/Node.h"
 
@@ -38,6 +39,10 @@ public:
   /// An arc (a helix when `to` is at another height) about `centre`,
   /// after `turns` whole turns.
   void arc(const ir::Vec3 &to, const geom::Vec2 &centre, bool ccw, int64_t turns, double feed, const char *role);
+  /// The same in any principal plane: about the axis along `plane`'s normal
+  /// through `centre`, `ccw` seen from the normal's tip (IR `normal`).
+  void arc(const ir::Vec3 &to, const ir::Vec3 &centre, geom::ArcPlane plane, bool ccw, int64_t turns, double feed,
+           const char *role);
 
   /// The tool waits where it is for `seconds` (> 0; none otherwise).
   void dwell(double seconds);

@@ -56,6 +56,16 @@ ExplicitKind explicitKind(const Node &tp) {
   return {rapid, rapid ? "position" : "cut"};
 }
 
+/// Why an arc out of the XY plane cannot be placed by the feature's frame:
+/// a frame turned about z, or mirrored, would turn its plane out of the
+/// principal planes (or its direction); one that only moves it keeps both.
+std::string outOfPlaneArcFrame(const ir::PlaneFrame &f, const ir::CurvePiece &c) {
+  if (c.plane.isXY() || ((f.x - geom::Vec2::UnitX()).norm() < 1e-9 && (f.y - geom::Vec2::UnitY()).norm() < 1e-9))
+    return {};
+  return std::string("an arc in the ") + c.plane.name() +
+         " plane, in a feature frame turned about z: only arcs in the XY plane turn with their feature";
+}
+
 /// One piece of an explicit toolpath, mapped from the feature's frame; the
 /// path's run records where it starts and which moves the stock decides.
 void explicitPiece(const ir::PlaneFrame &f, const ir::CurvePiece &c, const ExplicitKind &kind, double feed,
@@ -83,8 +93,10 @@ void explicitPiece(const ir::PlaneFrame &f, const ir::CurvePiece &c, const Expli
     e.rapid(to, kind.role);
   else if (!c.arc)
     e.linear(to, feed, kind.role);
-  else
+  else if (c.plane.isXY())
     e.arc(to, f.map(c.center.head<2>()), c.ccw != f.mirrored(), c.turns, feed, kind.role);
+  else  // the frame only moves it (outOfPlaneArcFrame)
+    e.arc(to, at(f.map(c.center.head<2>()), f.z + c.center.z()), c.plane, c.ccw, c.turns, feed, kind.role);
   if (moves.children.size() > before && (kind.rapid || (kind.connectNoSpeed && !c.arc)))
     run.decided.push_back({before, !kind.rapid, toolpath.origin});
 }
@@ -111,7 +123,10 @@ bool expandExplicitToolpaths(Expander &x, const Step &step) {
     for (const Node &curve : tp->children) {
       if (curve.category() != ir::Category::Curve)
         continue;
-      ir::CurveResult cr = ir::curvePieces(curve);
+      ir::CurveResult cr = ir::curvePieces(curve, ir::ArcPlanes::Principal);
+      for (const ir::CurvePiece &c : cr.pieces)
+        if (std::string why = outOfPlaneArcFrame(frame, c); !why.empty() && cr.error.empty())
+          cr.error = why;
       if (!cr.error.empty()) {
         x.report(ws, "its explicit toolpath: " + cr.error);
         // The moves made so far are attached as they are: the error stops
@@ -155,7 +170,7 @@ void expandRapidMovement(Expander &x, Node &rm, const std::string &setup) {
   for (const Node *tp : rm.childrenOf(ir::Kind::Toolpath))
     for (const Node &curve : tp->children)
       if (curve.category() == ir::Category::Curve) {
-        ir::CurveResult cr = ir::curvePieces(curve);
+        ir::CurveResult cr = ir::curvePieces(curve, ir::ArcPlanes::Principal);
         if (!cr.error.empty()) {
           x.report(rm, "its toolpath: " + cr.error);
           return;

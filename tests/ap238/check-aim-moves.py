@@ -13,6 +13,11 @@ The expected moves come from a file written by hand from the STEP-NC file
     rapid X Y Z              a rapid ending at X Y Z
     line X Y Z F             a feed move to X Y Z at F mm/min
     arc X Y Z CX CY cw|ccw F an arc in XY to X Y Z about CX CY
+    arc X Y Z C1 C2 cw|ccw F zx|yz
+                             an arc in the ZX (G18) or YZ (G19) plane, its
+                             centre C1 C2 in that plane's coordinates (ZX: z
+                             then x; YZ: y then z), cw or ccw seen from +y
+                             or +x, as LinuxCNC's canonical ARC_FEED has it
     dwell T                  a wait of T s
 
 Between the file's moves the program may add rapids only (stepnc's own
@@ -67,7 +72,7 @@ def read_expected(path):
             words = line.split("#")[0].split()
             if not words:
                 continue
-            out.append((n, words[0], [w if w in ("cw", "ccw") else float(w) for w in words[1:]]))
+            out.append((n, words[0], [w if w in ("cw", "ccw", "xy", "zx", "yz") else float(w) for w in words[1:]]))
     return out
 
 
@@ -103,9 +108,10 @@ def compare(expected, moves, states):
             if m["kind"] != "linear" or not near(m["to"], args[:3]) or abs(m["feed"] - args[3]) > 0.01:
                 why = "expected a feed move"
         elif kind == "arc":
-            if (m["kind"] != "arc" or not near(m["to"], args[:3]) or not near(m["centre"], args[3:5]) or
-                    m["ccw"] != (args[5] == "ccw") or abs(m["feed"] - args[6]) > 0.01):
-                why = "expected an arc"
+            plane = args[7] if len(args) > 7 else "xy"
+            if (m["kind"] != "arc" or m["plane"] != plane or not near(m["to"], args[:3]) or
+                    not near(m["centre"], args[3:5]) or m["ccw"] != (args[5] == "ccw") or abs(m["feed"] - args[6]) > 0.01):
+                why = "expected an arc in the %s plane" % plane.upper()
         else:
             why = "unknown expectation '%s'" % kind
         if not why and kind != "dwell" and spindle is not None:

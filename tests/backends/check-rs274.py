@@ -38,11 +38,12 @@ import sys
 import tempfile
 
 import toolpath_ir
-from toolpath_ir import arc_sweep
+from toolpath_ir import arc_sweep, local, world
 
 TOL = 1e-3
 
-CANON_RE = re.compile(r"(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED|SET_FEED_RATE|NURBS_FEED|DWELL)\(([^)]*)\)")
+CANON_RE = re.compile(r"(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED|SET_FEED_RATE|NURBS_FEED|DWELL|SELECT_PLANE)\(([^)]*)\)")
+CANON_PLANES = {"CANON_PLANE_XY": "xy", "CANON_PLANE_XZ": "zx", "CANON_PLANE_YZ": "yz"}
 G5_RE = re.compile(r"^G5 X(\S+) Y(\S+) I(\S+) J(\S+) P(\S+) Q(\S+)")
 SPLINE_TOL = 0.01
 PRINTED = 1.5e-4  # the program's 4 decimals: ends this close may print as one point
@@ -60,12 +61,16 @@ def canon_moves(path, program):
     feed = 0.0
     splines = iter(g5_blocks(program))
     at = (0.0, 0.0, 0.0)
+    plane = "xy"
     with open(path) as f:
         for n, line in enumerate(f, 1):
             m = CANON_RE.search(line)
             if not m:
                 continue
             args = [a.strip() for a in m.group(2).split(",")]
+            if m.group(1) == "SELECT_PLANE":
+                plane = CANON_PLANES[args[0]]
+                continue
             if m.group(1) == "SET_FEED_RATE":
                 feed = float(args[0])
                 continue
@@ -84,12 +89,13 @@ def canon_moves(path, program):
                 at = out[-1]["to"]
                 continue
             if m.group(1) == "ARC_FEED":
+                # The plane's first and second axes, then its normal (XZ: z, x, y).
                 e1, e2, c1, c2, turn, e3 = (float(a) for a in args[:6])
                 # An arc that ends where it starts is a whole turn: the
                 # sweep says what the controller cuts.
-                sweep = arc_sweep(at, (e1, e2), (c1, c2), turn > 0) + 2 * math.pi * (abs(int(turn)) - 1)
-                out.append({"kind": "arc", "to": (e1, e2, e3), "centre": (c1, c2), "ccw": turn > 0,
-                            "turns": abs(int(turn)) - 1, "sweep": sweep, "feed": feed,
+                sweep = arc_sweep(local(at, plane), (e1, e2), (c1, c2), turn > 0) + 2 * math.pi * (abs(int(turn)) - 1)
+                out.append({"kind": "arc", "to": world((e1, e2, e3), plane), "plane": plane, "centre": (c1, c2),
+                            "ccw": turn > 0, "turns": abs(int(turn)) - 1, "sweep": sweep, "feed": feed,
                             "text": "canon line %d: %s" % (n, line.strip())})
             else:
                 kind = "rapid" if m.group(1) == "STRAIGHT_TRAVERSE" else "linear"
@@ -155,7 +161,7 @@ def normalise(moves, feeds_only):
     at = None
     for mv in moves:
         if mv["kind"] == "arc" and "start" in mv and mv["sweep"] < math.pi and \
-                math.dist(mv["start"][:2], mv["to"][:2]) <= PRINTED:
+                math.dist(local(mv["start"], mv["plane"])[:2], local(mv["to"], mv["plane"])[:2]) <= PRINTED:
             # An IR arc whose ends print as one point is written as the line
             # it is within the last decimal: a controller reads an arc over its
             # start as a whole circle (backends/common/Words.h, arcPrintsClosed).
@@ -186,6 +192,8 @@ def compare(ir, canon, feeds_only, feed_tol):
             why = "dwell %.3f s != %.3f s" % (x["time"], y["time"])
         elif x["kind"] not in ("rapid", "dwell") and abs(x["feed"] - y["feed"]) > feed_tol:
             why = "feed %.3f != %.3f" % (x["feed"], y["feed"])
+        elif x["kind"] == "arc" and x["plane"] != y["plane"]:
+            why = "arc in the %s plane, the IR's in the %s plane" % (y["plane"].upper(), x["plane"].upper())
         elif x["kind"] == "arc" and (not close(x["centre"], y["centre"]) or x["ccw"] != y["ccw"]
                                      or x["turns"] != y["turns"]):
             why = "arc centre, direction or turns differ"

@@ -12,6 +12,32 @@ def point(text):
     return tuple(float(v) for v in text.split(")")[0].strip("(").split(","))
 
 
+PLANES = {"xy": (0, 1, 2), "zx": (2, 0, 1), "yz": (1, 2, 0)}
+
+
+def local(p, plane):
+    """A point in an arc plane's coordinates: its first and second axes, then
+    the normal (XY: x y z; ZX: z x y; YZ: y z x), as stepnc and LinuxCNC's
+    canonical ARC_FEED order them."""
+    return tuple(p[k] for k in PLANES[plane])
+
+
+def world(q, plane):
+    """Back from an arc plane's coordinates."""
+    p = [0.0, 0.0, 0.0]
+    for v, k in zip(q, PLANES[plane]):
+        p[k] = v
+    return tuple(p)
+
+
+def plane_of(normal):
+    """The plane an IR arc `normal` names, and whether it points the plane's way."""
+    for name, k in (("xy", 2), ("zx", 1), ("yz", 0)):
+        if abs(abs(normal[k]) - 1) <= 1e-9:
+            return name, normal[k] > 0
+    raise ValueError("an arc normal along none of x, y and z: %r" % (normal,))
+
+
 def arc_sweep(start, end, centre, ccw):
     """The angle from start to end about centre (radians, in (0, 2 pi]); end over start is a whole turn."""
     if math.dist(start[:2], end[:2]) <= 1e-9:
@@ -31,8 +57,9 @@ def read_moves(path):
     in order, each a dict: kind (rapid, linear, arc, dwell), start and to (x,
     y, z; the first move starts at the origin, as the program model has it),
     feed (mm/min, feed moves only), line (in the file) and text; arcs also
-    centre (x, y), ccw, turns, radius and sweep (radians, full turns
-    included); dwells their time (s), where the tool is."""
+    plane ('xy', 'zx', 'yz'), centre (in the plane's coordinates: x, y in XY),
+    ccw (seen from the plane's normal), turns, radius and sweep (radians,
+    full turns included); dwells their time (s), where the tool is."""
     out = []
     pos = (0.0, 0.0, 0.0)
     with open(path) as f:
@@ -50,11 +77,13 @@ def read_moves(path):
             if "feed" in attrs:
                 move["feed"] = float(attrs["feed"].replace("mm/min", ""))
             if move["kind"] == "arc":
-                centre = point(attrs["center"])[:2]
-                ccw = attrs["dir"] == "ccw"
+                plane, positive = plane_of(point(attrs["normal"])) if "normal" in attrs else ("xy", True)
+                centre = local(point(attrs["center"]), plane)[:2]
+                ccw = (attrs["dir"] == "ccw") == positive
                 turns = int(attrs.get("turns", "0"))
-                move.update(centre=centre, ccw=ccw, turns=turns, radius=math.dist(pos[:2], centre),
-                            sweep=arc_sweep(pos, move["to"], centre, ccw) + 2 * math.pi * turns)
+                start, end = local(pos, plane), local(move["to"], plane)
+                move.update(plane=plane, centre=centre, ccw=ccw, turns=turns, radius=math.dist(start[:2], centre),
+                            sweep=arc_sweep(start, end, centre, ccw) + 2 * math.pi * turns)
             pos = move["to"]
             out.append(move)
     return out

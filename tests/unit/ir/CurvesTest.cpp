@@ -101,3 +101,39 @@ TEST_CASE("B-splines that do not make a curve are refused, saying why", "[curves
   CHECK_FALSE(ir::bspline(spline(1, "with_knots", {{0, 0, 0}, {1, 0, 0}}, {1, -1}, {{0.0, 2}, {1.0, 2}}), error));
   CHECK(error.find("weights must be positive") != std::string::npos);
 }
+
+TEST_CASE("circles about x or y: arcs in the ZX and YZ planes for explicit toolpaths only", "[curves]") {
+  // A circle of radius 5 about +y centred at (3, 2, 1), trimmed from its
+  // bottom (3, 2, -4) to (8, 2, 1) along its sense: counterclockwise seen
+  // from +y (the long way, by -x and the top).
+  Node circle(Kind::Circle);
+  circle.set("at", Value::point({3, 2, 1}))
+      .set("axis", Value::direction({0, 1, 0}))
+      .set("ref", Value::direction({0, 0, 1}))
+      .set("radius", Value::length(5));
+  Node trimmed(Kind::TrimmedCurve);
+  trimmed.set("from_point", Value::point({3, 2, -4})).set("to_point", Value::point({8, 2, 1})).set("sense",
+                                                                                                   Value::boolean(true));
+  trimmed.add(circle);
+
+  const ir::CurveResult xyOnly = ir::curvePieces(trimmed);
+  CHECK(xyOnly.error.find("only circles and helices about the tool axis") != std::string::npos);
+
+  const ir::CurveResult r = ir::curvePieces(trimmed, ir::ArcPlanes::Principal);
+  REQUIRE(r.error.empty());
+  REQUIRE(r.pieces.size() == 1);
+  const ir::CurvePiece &p = r.pieces.front();
+  CHECK(p.arc);
+  CHECK(p.plane.normal == 1);
+  CHECK(p.ccw);  // along the circle's sense about its axis +y
+  CHECK((p.center - Vec3(3, 2, 1)).norm() < 1e-12);
+
+  // An end off the circle is refused in that plane too.
+  trimmed.set("to_point", Value::point({8.01, 2, 1}));
+  CHECK(ir::curvePieces(trimmed, ir::ArcPlanes::Principal).error.find("outside its circle") != std::string::npos);
+
+  // A circle about a slanted axis is none of the principal planes.
+  circle.set("axis", Value::direction(Vec3(1, 1, 0).normalized()));
+  Node full = circle;
+  CHECK(ir::curvePieces(full, ir::ArcPlanes::Principal).error.find("about the x, y or z axis") != std::string::npos);
+}

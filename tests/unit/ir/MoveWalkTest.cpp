@@ -136,3 +136,65 @@ TEST_CASE("planar(): lines, axial moves, full circles and helices", "[verify][mo
   REQUIRE(back.size() == 6);  // 3 whole turns, clockwise
   CHECK(totalSweep(back) == Approx(-6 * kPi));
 }
+
+// Arcs in the ZX and YZ planes (IR `normal` along y or x): read in their
+// plane, exact for the G-code emitters and as chords for the passes that
+// work in XY. Worked out by hand: a quarter circle of radius 10 in the
+// plane y = 5, from (10, 5, 0) about (0, 5, 0) to (0, 5, 10). Turning about
+// +y by the right-hand rule takes +z to +x, so the short way from +x to +z
+// is clockwise seen from +y.
+TEST_CASE("arcs in the ZX and YZ planes: exact and as chords", "[movewalk]") {
+  Node moves(ir::Kind::Moves);
+  rapid(moves, {10, 5, 0});
+  arc(moves, {0, 5, 10}, {0, 5, 0}, false).set("normal", Value::direction(Vec3::UnitY()));
+  // The same arc written about -y: counterclockwise seen from -y.
+  rapid(moves, {10, 5, 0});
+  arc(moves, {0, 5, 10}, {0, 5, 0}, true).set("normal", Value::direction(-Vec3::UnitY()));
+  // A half circle in the YZ plane x = 2, about +x from (2, 0, -4) over (2, 4, 0) to (2, 0, 4):
+  // about +x the right-hand rule takes y to z, so -z to +y to +z is counterclockwise.
+  rapid(moves, {2, 0, -4});
+  arc(moves, {2, 0, 4}, {2, 0, 0}, true).set("normal", Value::direction(Vec3::UnitX()));
+
+  const std::vector<Move> exact = walkMoves(moves, std::nullopt, PathKind::Programmed, OutOfPlaneArcs::Exact);
+  REQUIRE(exact.size() == 6);
+  for (size_t i : {1u, 3u}) {
+    CHECK(exact[i].kind == MoveKind::Arc);
+    CHECK(exact[i].plane.normal == 1);
+    CHECK_FALSE(exact[i].ccw);  // both read as clockwise about +y
+    CHECK(exact[i].length() == Approx(10 * kPi / 2));
+    const Vec3 mid = exact[i].pointAt(10 * kPi / 4);
+    CHECK(mid.x() == Approx(10 / std::sqrt(2.0)));
+    CHECK(mid.y() == Approx(5));
+    CHECK(mid.z() == Approx(10 / std::sqrt(2.0)));
+  }
+  CHECK(exact[5].plane.normal == 0);
+  CHECK(exact[5].length() == Approx(4 * kPi));
+  CHECK(exact[5].pointAt(2 * kPi).y() == Approx(4));
+
+  // As chords: lines from the arc's start to its end, every vertex on its
+  // circle, every chord's middle within kOutOfPlaneArcChord of it.
+  const std::vector<Move> chords = walkMoves(moves);
+  std::vector<const Move *> first;
+  for (const Move &m : chords)
+    if (m.chord && m.node == exact[1].node)
+      first.push_back(&m);
+  REQUIRE(first.size() > 10);
+  CHECK((*first.front()->from - Vec3(10, 5, 0)).norm() < 1e-12);
+  CHECK((first.back()->to - Vec3(0, 5, 10)).norm() < 1e-12);
+  double worst = 0;
+  for (const Move *m : first) {
+    CHECK(m->kind == MoveKind::Linear);
+    CHECK(m->feed == 300);
+    CHECK(std::hypot(m->to.x(), m->to.z()) == Approx(10));
+    CHECK(m->to.y() == Approx(5));
+    const Vec3 middle = (*m->from + m->to) / 2;
+    worst = std::max(worst, 10 - std::hypot(middle.x(), middle.z()));
+  }
+  CHECK(worst <= kOutOfPlaneArcChord);
+  CHECK(worst > kOutOfPlaneArcChord / 4);  // not finer than it needs
+  // Seen from +z the ZX arc is a line along x: its chords' projections.
+  double along = 0;
+  for (const geom::Seg &s : exact[1].planar())
+    along += s.length();
+  CHECK(along == Approx(10));
+}
