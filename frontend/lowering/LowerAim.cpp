@@ -488,7 +488,8 @@ std::optional<std::string> AimLowerer::stepFeature(const Instance &ws, bool foll
     else if (reported_.insert(feature.index()).second)
       report(feature, feature.loc(),
              "the feature '" + feature.string("description").value_or("") +
-                 "' is not one stepnc lowers yet (round holes and closed rectangular pockets; docs/ap238.md), and "
+                 "' is not one stepnc lowers yet (round holes, closed rectangular pockets, straight slots of square U "
+                 "section; docs/ap238.md), and "
                  "the operation of workingstep " + hashId(ws.id()) + " has no toolpaths to follow");
     return std::nullopt;
   }

@@ -112,17 +112,20 @@ private:
   /// the shape_aspect_relationship whose related shape aspect is the
   /// occurrence. Invalid when the feature has none.
   Instance component(const Instance &feature, std::string_view occurrence);
+  /// Every such component, in the order of the occurrences in the file.
+  std::vector<Instance> components(const Instance &feature, std::string_view occurrence);
   /// The length `item` of the `entity` that the occurrence `occurrence` of
   /// feature `f` uses, set as `attribute` of `n`; false after a located error.
   bool componentLength(const Instance &f, std::string_view occurrence, std::string_view entity,
                        std::string_view item, Node &n, const char *attribute);
   /// Whether stepnc lowers a feature of this kind (round holes, closed
-  /// rectangular pockets).
-  static bool isLoweredFeature(const Instance &f);
+  /// rectangular pockets, straight slots of square U section).
+  bool isLoweredFeature(const Instance &f);
   /// The IR feature of a machining feature, under the workpiece; its symbol.
   std::optional<std::string> machiningFeature(const Instance &f);
   bool roundHole(const Instance &f, Node &n);
   bool pocket(const Instance &f, Node &n);
+  bool slot(const Instance &f, Node &n);
   /// A length, angle, time or ratio the component or feature must give.
   std::optional<double> required(const Instance &of, const Parameters &p, std::string_view name, const aim::Dims &dims);
   /// The IR kind of an operation whose path stepnc's strategies make, from its

@@ -73,10 +73,11 @@ AimLowerer::Parameters AimLowerer::parameters(const Instance &of) {
   return p;
 }
 
-Instance AimLowerer::component(const Instance &feature, std::string_view occurrence) {
+std::vector<Instance> AimLowerer::components(const Instance &feature, std::string_view occurrence) {
+  std::vector<Instance> out;
   auto defs = propertyDefs_.find(feature.index());
   if (defs == propertyDefs_.end())
-    return {};
+    return out;
   for (size_t d : defs->second) {
     auto aspects = aspectsOf_.find(d);
     if (aspects == aspectsOf_.end())
@@ -86,11 +87,18 @@ Instance AimLowerer::component(const Instance &feature, std::string_view occurre
         continue;
       if (auto rels = aspectRelationsTo_.find(a); rels != aspectRelationsTo_.end())
         for (size_t r : rels->second)
-          if (Instance c = at(r).ref("relating_shape_aspect"))
-            return c;
+          if (Instance c = at(r).ref("relating_shape_aspect")) {
+            out.push_back(c);
+            break;
+          }
     }
   }
-  return {};
+  return out;
+}
+
+Instance AimLowerer::component(const Instance &feature, std::string_view occurrence) {
+  std::vector<Instance> all = components(feature, occurrence);
+  return all.empty() ? Instance() : all.front();
 }
 
 std::optional<double> AimLowerer::required(const Instance &of, const Parameters &p, std::string_view name,
@@ -126,6 +134,9 @@ bool AimLowerer::componentLength(const Instance &f, std::string_view occurrence,
 bool AimLowerer::isLoweredFeature(const Instance &f) {
   if (f.isA("round_hole"))
     return true;
+  if (f.isA("slot"))
+    return component(f, "swept shape occurrence").isA("square_u_profile") &&
+           normalName(component(f, "course of travel occurrence").string("description").value_or("")) == "linear";
   return f.isA("pocket") && normalName(f.string("description").value_or("")) == "closed rectangular";
 }
 
@@ -144,7 +155,7 @@ std::optional<std::string> AimLowerer::machiningFeature(const Instance &f) {
                   "axis2_placement_3d named 'orientation'");
     return std::nullopt;
   }
-  const bool ok = f.isA("round_hole") ? roundHole(f, n) : pocket(f, n);
+  const bool ok = f.isA("round_hole") ? roundHole(f, n) : f.isA("slot") ? slot(f, n) : pocket(f, n);
   if (!ok)
     return std::nullopt;
   base_.setPlacement(n, placement->second);
@@ -240,6 +251,66 @@ bool AimLowerer::pocket(const Instance &f, Node &n) {
     base_.setPlacement(profile, o->second);
   if (auto r = p.measures.find("corner radius"); r != p.measures.end() && r->second.dims == kLength)
     n.set("orthogonal_radius", Value::length(r->second.value));
+  n.add(std::move(profile));
+  return ok;
+}
+
+bool AimLowerer::slot(const Instance &f, Node &n) {
+  // A straight slot of square U section (isLoweredFeature): its course of
+  // travel a linear path feature component, its depth the profile's.
+  n.kind = ir::Kind::Slot;
+  bool ok = true;
+  const Instance course = component(f, "course of travel occurrence");
+  const Parameters c = parameters(course);
+  Node path(ir::Kind::Path);
+  base_.stamp(path, course, "");
+  Node line(ir::Kind::Line);
+  line.set("at", Value::point(Vec3::Zero()));
+  line.set("dir", Value::direction(c.directions.empty() ? Vec3::UnitX() : c.directions.begin()->second.normalized()));
+  if (auto d = required(course, c, "distance", kLength))
+    line.set("length", Value::length(*d));
+  else
+    ok = false;
+  path.add(std::move(line));
+  const Instance shape = component(f, "swept shape occurrence");
+  const Parameters s = parameters(shape);
+  Node profile(ir::Kind::SquareUProfile);
+  base_.stamp(profile, shape, "");
+  const std::optional<double> width = required(shape, s, "width", kLength), depth = required(shape, s, "depth", kLength);
+  if (!width || !depth)
+    return false;
+  profile.set("width", Value::length(*width));
+  n.set("depth", Value::length(*depth));
+  for (const auto &[item, attribute, dims] : {std::tuple{"first radius", "first_radius", kLength},
+                                              {"first angle", "first_angle", kAngle},
+                                              {"second radius", "second_radius", kLength},
+                                              {"second angle", "second_angle", kAngle}})
+    if (auto m = s.measures.find(item); m != s.measures.end() && m->second.dims == dims)
+      profile.set(attribute, dims == kAngle ? Value::angle(m->second.value) : Value::length(m->second.value));
+  // Its ends, in the order of their occurrences; a slot that gives fewer is open there.
+  const std::vector<Instance> ends = components(f, "end condition occurrence");
+  if (ends.size() > 2) {
+    base_.missing(f, "end condition occurrence", "is given " + std::to_string(ends.size()) + " times: a slot has two ends");
+    return false;
+  }
+  for (size_t i = 0; i < 2; ++i) {
+    std::string word = "open";
+    if (i < ends.size()) {
+      word = normalName(ends[i].string("description").value_or(""));
+      if (word == "woodruff") {
+        if (auto r = required(ends[i], parameters(ends[i]), "radius", kLength))
+          n.set("end_radius", Value::length(*r));
+        else
+          ok = false;
+      } else if (word != "open" && word != "radiused" && word != "flat" && word != "loop") {
+        base_.unsupported(ends[i], "slot end '" + word + "'");
+        ok = false;
+        continue;
+      }
+    }
+    n.set(i == 0 ? "end_1" : "end_2", Value::word(word));
+  }
+  n.add(std::move(path));
   n.add(std::move(profile));
   return ok;
 }
