@@ -26,8 +26,10 @@
 #include "support/Format.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
+#include <unordered_map>
 
 namespace stepnc::lowering {
 
@@ -83,9 +85,40 @@ void AimLowerer::index() {
                           propertyDefinition = entity("property_definition"),
                           definitionRep = entity("property_definition_representation"),
                           shapeAspect = entity("shape_aspect"), aspectRelationship = entity("shape_aspect_relationship");
-  auto is = [&](size_t i, express::EntityId e) { return e != express::kNone && bound_.isA(i, e); };
+  // Which of these an instance is depends on its entity alone: asked of the
+  // model once per entity name in the file (per instance for the rare
+  // complex instances), then read from a bit mask.
+  const std::array<express::EntityId, 20> kinds = {
+      relationship,   actionProperty,  resourceProperty, actionPropRep,    resourcePropRep,
+      machiningTool,  association,     project,          pdProcess,        projectWorkpiece,
+      repRelationship, resourceRelationship, sequence,   executableEntity, operationEntity,
+      toolpathEntity, propertyDefinition, definitionRep, shapeAspect,      aspectRelationship};
+  std::unordered_map<p21::NameId, uint32_t> maskByName;
+  uint32_t mask = 0;  // the instance at hand's
+  auto computeMask = [&](size_t i) {
+    uint32_t m = 0;
+    for (size_t k = 0; k < kinds.size(); ++k)
+      if (kinds[k] != express::kNone && bound_.isA(i, kinds[k]))
+        m |= 1u << k;
+    return m;
+  };
+  auto is = [&](size_t, express::EntityId e) {
+    for (size_t k = 0; k < kinds.size(); ++k)
+      if (kinds[k] == e)
+        return e != express::kNone && (mask >> k & 1u) != 0;
+    return false;
+  };
   const size_t n = bound_.file().entries().size();
   for (size_t i = 0; i < n; ++i) {
+    const p21::NameId name = bound_.file().entries()[i].name();
+    if (name == p21::kComplexInstance) {
+      mask = computeMask(i);
+    } else {
+      auto [it, fresh] = maskByName.try_emplace(name, 0);
+      if (fresh)
+        it->second = computeMask(i);
+      mask = it->second;
+    }
     if (is(i, executableEntity) || is(i, operationEntity) || is(i, toolpathEntity))
       methods_.push_back(i);
     if (is(i, shapeAspect))
