@@ -368,6 +368,12 @@ std::optional<std::string> Lowerer::feature(const Instance &f) {
     commonPlacementAndDepth();
     addPath("profile_swept_shape", false);
     addProfile("feature_boundary", true);
+  } else if (f.isA("toolpath_feature")) {
+    // ISO 14649-10: a feature that is no more than the toolpaths that
+    // machine it. Its depth plane says nothing the IR keeps: the steps'
+    // moves are checked for the safety rules only.
+    n.kind = ir::Kind::ToolpathFeature;
+    commonPlacement();
   } else if (f.isA("boss")) {
     n.kind = ir::Kind::Boss;
     commonPlacementAndDepth();
