@@ -105,7 +105,7 @@ std::optional<std::string> IsoEmitter::run(const Program &p) {
       }
     }
     if (const std::string g17 = selectPlane(geom::ArcPlane::xy()); !g17.empty())
-      out_.block(g17.substr(0, g17.size() - 1));
+      out_.block(g17);
   }
   footer(p);
   for (size_t line : out_.overlong())
@@ -254,7 +254,7 @@ std::string IsoEmitter::selectPlane(geom::ArcPlane p) {
     return {};
   plane_ = p;
   modal_.forget("G");  // G2/G3 are written again in the new plane
-  return p.isXY() ? "G17 " : p.normal == 1 ? "G18 " : "G19 ";
+  return p.isXY() ? "G17" : p.normal == 1 ? "G18" : "G19";
 }
 
 void IsoEmitter::arc(const Move &m) {
@@ -291,6 +291,8 @@ void IsoEmitter::arc(const Move &m) {
     const geom::Vec2 printedTo(roundTo(to.x(), d_.coordDecimals), roundTo(to.y(), d_.coordDecimals));
     const std::string g = m.ccw ? "G3" : "G2";
     std::string text = selectPlane(plane);
+    if (!text.empty())
+      text += ' ';
     text += modal_.change("G", g) ? g + " " : "";
     text += axes(plane.world(to), plane);
     if (d_.arcs == ArcForm::Radius) {

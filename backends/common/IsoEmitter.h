@@ -99,7 +99,7 @@ private:
   /// The plane G17/G18/G19 selects: XY from the header on; an arc in another
   /// plane selects its own, and the step ends back in XY (cycles drill along z).
   geom::ArcPlane plane_ = geom::ArcPlane::xy();
-  /// The word that selects `p` when it is not the plane in force ("G18 "), else "".
+  /// The word that selects `p` when it is not the plane in force ("G18"), else "".
   std::string selectPlane(geom::ArcPlane p);
 };
 

@@ -102,7 +102,7 @@ void AimLowerer::index() {
         m |= 1u << k;
     return m;
   };
-  auto is = [&](size_t, express::EntityId e) {
+  auto is = [&](express::EntityId e) {
     for (size_t k = 0; k < kinds.size(); ++k)
       if (kinds[k] == e)
         return e != express::kNone && (mask >> k & 1u) != 0;
@@ -119,65 +119,65 @@ void AimLowerer::index() {
         it->second = computeMask(i);
       mask = it->second;
     }
-    if (is(i, executableEntity) || is(i, operationEntity) || is(i, toolpathEntity))
+    if (is(executableEntity) || is(operationEntity) || is(toolpathEntity))
       methods_.push_back(i);
-    if (is(i, shapeAspect))
+    if (is(shapeAspect))
       if (Instance of = Instance(bound_, i).ref("of_shape"))
         aspectsOf_[of.index()].push_back(i);
-    if (is(i, relationship)) {
+    if (is(relationship)) {
       const Instance r(bound_, i);
       if (Instance from = r.ref("relating_method"))
         byRelating_[from.index()].push_back(i);
       if (Instance to = r.ref("related_method"))
         held_.insert(to.index());
-      if (is(i, sequence))
+      if (is(sequence))
         if (Instance to = r.ref("related_method"))
           sequenced_.insert(to.index());
-    } else if (is(i, actionProperty)) {
+    } else if (is(actionProperty)) {
       const Instance p(bound_, i);
       if (Instance of = p.ref("definition"))
         actionProps_[of.index()].push_back(i);
-    } else if (is(i, resourceProperty)) {
+    } else if (is(resourceProperty)) {
       const Instance p(bound_, i);
       if (Instance of = p.ref("resource"))
         resourceProps_[of.index()].push_back(i);
-    } else if (is(i, actionPropRep) || is(i, resourcePropRep)) {
+    } else if (is(actionPropRep) || is(resourcePropRep)) {
       const Instance r(bound_, i);
       if (Instance p = r.ref("property"))
         propReps_[p.index()].push_back(i);
-    } else if (is(i, machiningTool)) {
+    } else if (is(machiningTool)) {
       const Instance t(bound_, i);
       for (const Instance &use : t.refs("usage"))
         toolOf_.emplace(use.index(), i);
-    } else if (is(i, association)) {
+    } else if (is(association)) {
       const Instance a(bound_, i);
       if (Instance process = a.ref("process"))
         if (Instance method = process.ref("chosen_method"))
           if (Instance feature = a.ref("property_or_shape"))
             featureOfProcess_.emplace(method.index(), feature.index());
-    } else if (is(i, project)) {
+    } else if (is(project)) {
       projects_.emplace_back(bound_, i);
-    } else if (is(i, pdProcess)) {
+    } else if (is(pdProcess)) {
       const Instance p(bound_, i);
       if (p.ref("chosen_method").isA("machining_workplan"))
         workplanProcesses_.push_back(p);
-    } else if (is(i, projectWorkpiece)) {
+    } else if (is(projectWorkpiece)) {
       projectWorkpieces_.emplace_back(bound_, i);
-    } else if (is(i, resourceRelationship)) {
+    } else if (is(resourceRelationship)) {
       const Instance r(bound_, i);
       if (Instance from = r.ref("relating_resource"))
         if (Instance to = r.ref("related_resource"))
           componentsOf_[from.index()].push_back(to.index());
-    } else if (is(i, propertyDefinition)) {
+    } else if (is(propertyDefinition)) {
       if (Instance of = Instance(bound_, i).ref("definition"))
         propertyDefs_[of.index()].push_back(i);
-    } else if (is(i, definitionRep)) {
+    } else if (is(definitionRep)) {
       if (Instance of = Instance(bound_, i).ref("definition"))
         definitionReps_[of.index()].push_back(i);
-    } else if (is(i, aspectRelationship)) {
+    } else if (is(aspectRelationship)) {
       if (Instance to = Instance(bound_, i).ref("related_shape_aspect"))
         aspectRelationsTo_[to.index()].push_back(i);
-    } else if (is(i, repRelationship)) {
+    } else if (is(repRelationship)) {
       const Instance r(bound_, i);
       const Instance a = r.ref("rep_1"), b = r.ref("rep_2");
       if (a && b) {

@@ -105,6 +105,11 @@ private:
     std::map<std::string, aim::Measure> measures;
     std::map<std::string, Placement> placements;
     std::map<std::string, Vec3> directions;
+    /// The measure `name` when there is one of dimensions `dims`.
+    std::optional<double> value(std::string_view name, const aim::Dims &dims) const {
+      auto it = measures.find(std::string(name));
+      return it != measures.end() && it->second.dims == dims ? std::optional(it->second.value) : std::nullopt;
+    }
   };
   Parameters parameters(const Instance &of);
   /// The feature component that an occurrence of `feature` described

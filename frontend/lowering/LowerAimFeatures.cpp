@@ -175,41 +175,46 @@ bool AimLowerer::roundHole(const Instance &f, Node &n) {
   n.kind = ir::Kind::RoundHole;
   bool ok = componentLength(f, "diameter occurrence", "circular_closed_profile", "diameter", n, "diameter");
   ok = componentLength(f, "hole depth occurrence", "path_feature_component", "distance", n, "depth") && ok;
+  if (component(f, "change in diameter occurrence"))
+    base_.unsupported(f, "a tapered round hole ('change in diameter occurrence')");
+  // The bottom's kind (its description), the IR's word for it and the one
+  // value that kind requires.
+  struct Bottom {
+    std::string_view kind, word, item;
+    const char *attribute;
+    Dims dims;
+  };
+  static const Bottom kBottoms[] = {
+      {"through", "through", {}, nullptr, {}},
+      {"flat", "flat", {}, nullptr, {}},
+      {"flat with radius", "flat_with_radius", "corner radius", "bottom_radius", kLength},
+      {"spherical", "spherical", "radius", "bottom_radius", kLength},
+      {"conical", "conical", "tip angle", "tip_angle", kAngle}};
   const Instance bottom = component(f, "bottom condition occurrence");
-  const std::string kind = normalName(bottom.string("description").value_or(""));
-  const Parameters b = bottom ? parameters(bottom) : Parameters{};
   if (!bottom.isA("hole_bottom")) {
     base_.missing(f, "bottom condition occurrence",
                   "is not given: a round hole's bottom is a hole_bottom its 'bottom condition occurrence' uses");
-    ok = false;
-  } else if (kind == "through" || kind == "flat") {
-    n.set("bottom", Value::word(kind));
-  } else if (kind == "flat with radius") {
-    n.set("bottom", Value::word("flat_with_radius"));
-    if (auto r = required(bottom, b, "corner radius", kLength))
-      n.set("bottom_radius", Value::length(*r));
-    else
-      ok = false;
-  } else if (kind == "spherical") {
-    n.set("bottom", Value::word("spherical"));
-    if (auto r = required(bottom, b, "radius", kLength))
-      n.set("bottom_radius", Value::length(*r));
-    else
-      ok = false;
-  } else if (kind == "conical") {
-    n.set("bottom", Value::word("conical"));
-    if (auto a = required(bottom, b, "tip angle", kAngle))
-      n.set("tip_angle", Value::angle(*a));
-    else
-      ok = false;
-    if (auto r = b.measures.find("tip radius"); r != b.measures.end() && r->second.dims == kLength)
-      n.set("tip_radius", Value::length(r->second.value));
-  } else {
-    base_.unsupported(bottom, "hole bottom '" + kind + "'");
-    ok = false;
+    return false;
   }
-  if (component(f, "change in diameter occurrence"))
-    base_.unsupported(f, "a tapered round hole ('change in diameter occurrence')");
+  const std::string kind = normalName(bottom.string("description").value_or(""));
+  const Bottom *row = nullptr;
+  for (const Bottom &r : kBottoms)
+    if (r.kind == kind)
+      row = &r;
+  if (!row) {
+    base_.unsupported(bottom, "hole bottom '" + kind + "'");
+    return false;
+  }
+  n.set("bottom", Value::word(std::string(row->word)));
+  const Parameters b = parameters(bottom);
+  if (row->attribute) {
+    if (auto v = required(bottom, b, row->item, row->dims))
+      n.set(row->attribute, row->dims == kAngle ? Value::angle(*v) : Value::length(*v));
+    else
+      ok = false;
+  }
+  if (auto r = b.value("tip radius", kLength); r && kind == "conical")
+    n.set("tip_radius", Value::length(*r));
   return ok;
 }
 
@@ -217,8 +222,8 @@ bool AimLowerer::pocket(const Instance &f, Node &n) {
   n.kind = ir::Kind::ClosedPocket;
   bool ok = true;
   const Parameters own = parameters(f);
-  if (auto r = own.measures.find("fillet radius"); r != own.measures.end() && r->second.dims == kLength)
-    n.set("planar_radius", Value::length(r->second.value));
+  if (auto r = own.value("fillet radius", kLength))
+    n.set("planar_radius", Value::length(*r));
   ok = componentLength(f, "pocket depth occurrence", "path_feature_component", "distance", n, "depth") && ok;
   const Instance bottom = component(f, "bottom condition occurrence");
   const std::string kind = normalName(bottom.string("description").value_or(""));
@@ -249,8 +254,8 @@ bool AimLowerer::pocket(const Instance &f, Node &n) {
   profile.set("length", Value::length(*length));
   if (auto o = p.placements.find("orientation"); o != p.placements.end() && !isIdentity(o->second))
     base_.setPlacement(profile, o->second);
-  if (auto r = p.measures.find("corner radius"); r != p.measures.end() && r->second.dims == kLength)
-    n.set("orthogonal_radius", Value::length(r->second.value));
+  if (auto r = p.value("corner radius", kLength))
+    n.set("orthogonal_radius", Value::length(*r));
   n.add(std::move(profile));
   return ok;
 }
@@ -285,8 +290,8 @@ bool AimLowerer::slot(const Instance &f, Node &n) {
                                               {"first angle", "first_angle", kAngle},
                                               {"second radius", "second_radius", kLength},
                                               {"second angle", "second_angle", kAngle}})
-    if (auto m = s.measures.find(item); m != s.measures.end() && m->second.dims == dims)
-      profile.set(attribute, dims == kAngle ? Value::angle(m->second.value) : Value::length(m->second.value));
+    if (auto v = s.value(item, dims))
+      profile.set(attribute, dims == kAngle ? Value::angle(*v) : Value::length(*v));
   // Its ends, in the order of their occurrences; a slot that gives fewer is open there.
   const std::vector<Instance> ends = components(f, "end condition occurrence");
   if (ends.size() > 2) {
