@@ -12,6 +12,9 @@
 // round-trip reals).
 #include "backends/step-nc/OptimisedFile.h"
 
+#include "backends/step-nc/ArmFromIr.h"
+#include "backends/step-nc/Toolpaths.h"
+
 #include "frontend/part21/Writer.h"
 #include "ir/Kinds.h"
 #include "ir/Program.h"
@@ -36,309 +39,6 @@ using ir::Node;
 using ir::Vec3;
 using p21::InstanceId;
 using ir::PlaneFrame;
-
-constexpr double kTwoPi = 2 * std::numbers::pi;
-/// Units in the last place searched either side of a first guess for a value
-/// that reads back exactly.
-constexpr int kUlpSearch = kPreimageUlps;
-
-/// Candidates within kUlpSearch units in the last place of `x`, nearest first.
-std::vector<double> around(double x) {
-  std::vector<double> out{x};
-  double up = x, down = x;
-  for (int i = 0; i < kUlpSearch; ++i) {
-    up = std::nextafter(up, INFINITY);
-    down = std::nextafter(down, -INFINITY);
-    out.push_back(up);
-    out.push_back(down);
-  }
-  return out;
-}
-
-/// `p` (workpiece coordinates) in the frame `f`: the local point that
-/// expand-strategies maps back to exactly `p` where one is found.
-Vec3 localPoint(const ir::PlaneFrame &f, const Vec3 &p) {
-  const geom::Vec2 d = p.head<2>() - f.origin;
-  const double lx = d.dot(f.x), ly = d.dot(f.y);
-  const double lz = preimage(p.z(), p.z() - f.z, [&](double z) { return f.z + z; });
-  for (double x : around(lx))
-    for (double y : around(ly))
-      if (f.map(geom::Vec2(x, y)) == p.head<2>())
-        return {x, y, lz};
-  return {lx, ly, lz};
-}
-
-/// New instances, numbered from the first free id, as canonical Part 21 lines.
-class Instances {
-public:
-  explicit Instances(InstanceId first) : next_(first) {}
-
-  InstanceId add(std::string_view entity, std::string_view params) {
-    const InstanceId id = next_++;
-    text_ += '#' + std::to_string(id) + '=' + std::string(entity) + '(' + std::string(params) + ");\n";
-    return id;
-  }
-
-  InstanceId point(const Vec3 &p) {
-    return shared(points_, {p.x(), p.y(), p.z()}, [&] { return add("CARTESIAN_POINT", "''," + reals(p)); });
-  }
-
-  InstanceId direction(const Vec3 &d) {
-    return shared(directions_, {d.x(), d.y(), d.z()}, [&] { return add("DIRECTION", "''," + reals(d)); });
-  }
-
-  /// An axis2_placement_3d at `at` with the frame's own axes.
-  InstanceId placement(const Vec3 &at) {
-    const InstanceId location = point(at);
-    return add("AXIS2_PLACEMENT_3D",
-               "''," + ref(location) + ',' + ref(direction(Vec3::UnitZ())) + ',' + ref(direction(Vec3::UnitX())));
-  }
-
-  static std::string ref(InstanceId id) { return '#' + std::to_string(id); }
-  static std::string real(double v) {
-    std::string s;
-    p21::appendReal(s, v);
-    return s;
-  }
-  static std::string reals(const Vec3 &v) { return '(' + real(v.x()) + ',' + real(v.y()) + ',' + real(v.z()) + ')'; }
-
-  InstanceId firstFree() const { return next_; }
-  const std::string &text() const { return text_; }
-
-private:
-  using Key = std::array<double, 3>;
-  template <class Make> InstanceId shared(std::map<Key, InstanceId> &pool, const Key &key, Make make) {
-    if (auto it = pool.find(key); it != pool.end())
-      return it->second;
-    const InstanceId id = make();
-    pool.emplace(key, id);
-    return id;
-  }
-
-  InstanceId next_;
-  std::string text_;
-  std::map<Key, InstanceId> points_, directions_;
-};
-
-/// The ISO 14649 toolpath type that gives a move of `role` back on lowering
-/// (expand-strategies reads the pair type, rapid); empty when none does.
-std::string_view toolpathType(std::string_view role, bool rapid) {
-  struct Row {
-    std::string_view role, rapidType, feedType;
-  };
-  static constexpr Row kTypes[] = {{"position", "NON_CONTACT", "NON_CONTACT"},
-                                   {"approach", "APPROACH", ""},
-                                   {"plunge", "", "APPROACH"},
-                                   {"cut", "CONTACT", "CONTACT"},
-                                   {"link", "CONNECT", "CONNECT"},
-                                   {"retract", "LIFT", "LIFT"}};
-  for (const Row &r : kTypes)
-    if (r.role == role)
-      return rapid ? r.rapidType : r.feedType;
-  return {};
-}
-
-/// Writes the moves of workingsteps as toolpath lists.
-class ToolpathWriter {
-public:
-  ToolpathWriter(Instances &out, const ir::SourceUnits &units, DiagnosticEngine &diags)
-      : out_(out), units_(units), diags_(diags) {}
-
-  /// The TOOLPATH_LIST of `ws`'s `moves`, in the frame of its feature; none
-  /// (after an error) when a move cannot be written, or (silently) when the
-  /// moves are a single positioning.
-  std::optional<InstanceId> write(const Node &ws, const Node &moves, const ir::PlaneFrame &frame,
-                                  const std::string &feedReference, std::optional<Vec3> start) {
-    ws_ = &ws;
-    frame_ = &frame;
-    spindle_ = moves.number("spindle").value_or(0);
-    feedReference_ = feedReference;
-    trajectories_.clear();
-    run_ = {};
-    bool smooth = false;
-    std::optional<Vec3> at;
-    for (const Node *move : moveNodes(moves)) {
-      const Node &m = *move;
-      if (m.kind == ir::Kind::Dwell) {
-        fail(m, "a dwell has no ISO 14649 toolpath form");
-        return std::nullopt;
-      }
-      const Vec3 to = *m.vec("to");
-      const std::string role = m.text("role").value_or(m.kind == ir::Kind::Rapid ? "position" : "cut");
-      smooth = smooth || m.flag("smooth").value_or(false);
-      if (!at) {
-        // The first move takes the tool to the first point of the first
-        // toolpath: lowering makes it again, from wherever the tool is. A
-        // step that goes on from where the one before left the tool (the
-        // file's paths joined) starts its toolpath there.
-        const bool positions =
-            m.kind == ir::Kind::Rapid && role == "position" && to.z() == moves.number("secplane").value_or(0);
-        if (positions) {
-          at = to;
-          continue;
-        }
-        if (!start) {
-          fail(m, "the first move is not a rapid to the security plane");
-          return std::nullopt;
-        }
-        at = start;
-      }
-      const bool rapid = m.kind == ir::Kind::Rapid;
-      const double feed = rapid ? 0 : m.number("feed").value_or(0);
-      const std::string_view type = toolpathType(role, rapid);
-      if (type.empty()) {
-        fail(m, "a " + m.kindName() + " move with role " + role + " has no ISO 14649 toolpath type");
-        return std::nullopt;
-      }
-      if (m.kind == ir::Kind::Arc) {
-        flush();
-        if (!arc(*at, m, type, feed))
-          return std::nullopt;
-      } else {
-        if (run_.points.empty() || run_.rapid != rapid || run_.type != type || run_.feed != feed) {
-          flush();
-          run_ = {rapid, std::string(type), feed, {*at}};
-        }
-        run_.points.push_back(to);
-      }
-      at = to;
-    }
-    flush();
-    if (smooth)
-      diags_
-          .warning(ws.origin.loc, "workingstep " + ws.symbol +
-                                      ": the chords of its smooth curves are written as polylines; a target "
-                                      "with splines writes them as lines when this file is compiled")
-          .entity(ws.origin.entityId);
-    if (trajectories_.empty())
-      return std::nullopt;
-    std::string list = "(";
-    for (size_t i = 0; i < trajectories_.size(); ++i)
-      list += (i ? "," : "") + Instances::ref(trajectories_[i]);
-    return out_.add("TOOLPATH_LIST", list + ')');
-  }
-
-  bool failed() const { return failed_; }
-
-private:
-  /// A run of straight moves of one kind, type and feed: one polyline.
-  struct Run {
-    bool rapid = false;
-    std::string type;
-    double feed = 0;
-    std::vector<Vec3> points; ///< workpiece coordinates, from the run's start
-  };
-
-  /// The moves of `moves`, those of its canned cycles in place.
-  static std::vector<const Node *> moveNodes(const Node &moves) {
-    std::vector<const Node *> out;
-    for (const Node &m : moves.children)
-      if (m.kind == ir::Kind::Cycle)
-        for (const Node &c : m.children)
-          out.push_back(&c);
-      else if (m.category() == ir::Category::Move)
-        out.push_back(&m);
-    return out;
-  }
-
-  void fail(const Node &move, const std::string &why) {
-    const std::optional<Vec3> to = move.vec("to");
-    diags_
-        .error(ws_->origin.loc, "workingstep " + ws_->symbol + ": cannot write its toolpath as STEP-NC: " + why + " (" +
-                                    move.kindName() + (to ? " to " + Instances::reals(*to) : "") + ")")
-        .entity(ws_->origin.entityId);
-    failed_ = true;
-  }
-
-  void flush() {
-    if (run_.points.size() < 2)
-      return;
-    std::string points = "(";
-    for (size_t i = 0; i < run_.points.size(); ++i)
-      points += (i ? "," : "") + Instances::ref(out_.point(localPoint(*frame_, run_.points[i])));
-    const InstanceId curve = out_.add("POLYLINE", "''," + points + ')');
-    trajectory(run_.type, run_.rapid, run_.feed, curve);
-    run_ = {};
-  }
-
-  /// An arc from `from` as a trimmed circle, or a trimmed helix when it changes height.
-  bool arc(const Vec3 &from, const Node &m, std::string_view type, double feed) {
-    const ir::PlaneFrame &f = *frame_;
-    const Vec3 a = localPoint(f, from), b = localPoint(f, *m.vec("to"));
-    const Vec3 centre = *m.vec("center");
-    const Vec3 c = localPoint(f, Vec3(centre.x(), centre.y(), from.z()));
-    const bool ccw = (m.text("dir") == "ccw") != f.mirrored();
-    const int64_t turns = m.count("turns").value_or(0);
-    const double radius = std::hypot(a.x() - c.x(), a.y() - c.y());
-    if (!(radius > 0)) {
-      fail(m, "an arc of radius 0");
-      return false;
-    }
-    InstanceId basis = 0;
-    if (b.z() == a.z()) {
-      if (turns > 0) {
-        fail(m, "a flat arc of more than one turn");
-        return false;
-      }
-      basis = out_.add("CIRCLE", "''," + Instances::ref(out_.placement(c)) + ',' + Instances::real(radius));
-    } else {
-      // The pitch that gives back the turns: lowering counts them from the
-      // rise, the pitch and the last partial arc (ir/geom/Curves.cpp).
-      double partial = std::atan2(b.y() - c.y(), b.x() - c.x()) - std::atan2(a.y() - c.y(), a.x() - c.x());
-      partial = std::fmod(std::fmod(partial, kTwoPi) + kTwoPi, kTwoPi);
-      if (!ccw && partial > 0)
-        partial = kTwoPi - partial;
-      if (partial < 1e-9)
-        partial = kTwoPi;
-      const double pitch = std::abs(b.z() - a.z()) / (static_cast<double>(turns) + partial / kTwoPi);
-      // The pitch is positive (the IR's rule); the trimming points say which way the arc rises.
-      basis = out_.add("HELIX", "''," + Instances::ref(out_.placement(c)) + ',' + Instances::real(radius) + ',' +
-                                    Instances::real(pitch));
-    }
-    const InstanceId curve =
-        out_.add("TRIMMED_CURVE", "''," + Instances::ref(basis) + ",(" + Instances::ref(out_.point(a)) + "),(" +
-                                      Instances::ref(out_.point(b)) + ")," + (ccw ? ".T." : ".F.") + ",.CARTESIAN.");
-    trajectory(type, false, feed, curve);
-    return true;
-  }
-
-  void trajectory(std::string_view type, bool rapid, double feed, InstanceId curve) {
-    const std::string speed = rapid ? "SPEED_NAME(.RAPID.)" : "$";
-    const std::string technology = rapid ? "$" : Instances::ref(this->technology(feed));
-    trajectories_.push_back(out_.add("CUTTER_LOCATION_TRAJECTORY", ".T.,." + std::string(type) + ".," + speed + ',' +
-                                                                       technology + ",$,$," + Instances::ref(curve) +
-                                                                       ",$,$"));
-  }
-
-  /// A milling technology with `feed` (mm/min) and the workingstep's spindle,
-  /// shared by every toolpath that has both.
-  InstanceId technology(double feed) {
-    // In the units the input was read in, so that the file stays consistent.
-    const auto key = std::make_tuple(feed, spindle_, feedReference_);
-    if (auto it = technologies_.find(key); it != technologies_.end())
-      return it->second;
-    const double speed =
-        preimage(feed, feed / units_.feedToMmPerMin, [&](double v) { return v * units_.feedToMmPerMin; });
-    const double spindle = preimage(spindle_, spindle_ / units_.spindleToRevPerMin,
-                                    [&](double v) { return v * units_.spindleToRevPerMin; });
-    const InstanceId id = out_.add("MILLING_TECHNOLOGY", Instances::real(speed) + ",." + feedReference_ + ".,$," +
-                                                             Instances::real(spindle) + ",$,.F.,.F.,.F.,$");
-    technologies_.emplace(key, id);
-    return id;
-  }
-
-  Instances &out_;
-  const ir::SourceUnits &units_;
-  DiagnosticEngine &diags_;
-  const Node *ws_ = nullptr;
-  const ir::PlaneFrame *frame_ = nullptr;
-  double spindle_ = 0;
-  std::string feedReference_;
-  Run run_;
-  std::vector<InstanceId> trajectories_;
-  std::map<std::tuple<double, double, std::string>, InstanceId> technologies_;
-  bool failed_ = false;
-};
 
 /// Every machining workingstep with moves, in program order.
 void workingsteps(const Node &n, std::vector<const Node *> &out) {
@@ -428,34 +128,6 @@ bool givesNothing(std::string_view line, size_t index) {
   char *end = nullptr;
   const double v = std::strtod(text.c_str(), &end);
   return end != text.c_str() && *end == '\0' && v == 0;
-}
-
-/// FILE_DESCRIPTION with `lines` first, then the input's own description.
-/// Quotes in `lines` become double quotes: Open CASCADE 7.6's STEP reader
-/// fails on a doubled quote followed by ',' or ')' inside a string.
-std::string fileDescription(const p21::Part21File &input, const std::vector<std::string> &lines) {
-  std::vector<std::string> all = lines;
-  for (std::string &line : all)
-    std::replace(line.begin(), line.end(), '\'', '"');
-  std::string level = "2;1";
-  if (const p21::HeaderEntity *h = input.headerEntity("FILE_DESCRIPTION")) {
-    const auto params = input.metadata().params(h->record);
-    if (!params.empty() && params[0].kind == p21::ValueKind::List)
-      for (const p21::Value &v : input.metadata().children(params[0]))
-        if (v.kind == p21::ValueKind::String)
-          all.push_back("input: " + std::string(v.str()));
-    if (params.size() > 1 && params[1].kind == p21::ValueKind::String)
-      level = std::string(params[1].str());
-  }
-  std::string out = "FILE_DESCRIPTION((";
-  for (size_t i = 0; i < all.size(); ++i) {
-    if (i)
-      out += ',';
-    p21::appendString(out, all[i]);
-  }
-  out += "),";
-  p21::appendString(out, level);
-  return out + ");";
 }
 
 } // namespace
@@ -643,7 +315,11 @@ std::string writeOptimisedPart21(const p21::Part21File &input, const ir::Module 
   }
 
   // Patch the canonical text: one header entity or instance per line.
-  const std::string description = fileDescription(input, options.description);
+  const std::string description = fileDescription(
+      input, options.description,
+      "kept: every instance of the input with its id and values; changed: the its_toolpath of each expanded "
+      "operation, now a TOOLPATH_LIST of required CUTTER_LOCATION_TRAJECTORY in the frame of the feature; "
+      "added: the instances above the largest id of the input");
   const bool hasDescription = input.headerEntity("FILE_DESCRIPTION") != nullptr;
   const size_t lastEndsec = canonical.rfind("ENDSEC;\n");
   std::string text;
@@ -684,17 +360,12 @@ std::string writeOptimisedPart21(const p21::Part21File &input, const ir::Module 
 std::unique_ptr<p21::Part21File> buildOptimisedFile(const p21::Part21File &input, const ir::Module &module,
                                                     const OptimisedFileOptions &options,
                                                     std::unique_ptr<SourceFile> &text, DiagnosticEngine &diags) {
-  if (!ir::requireThreeAxisMilling(module, "the STEP-NC writer", diags))
+  if (!ir::requireThreeAxisMilling(module, "the STEP-NC writer", diags, ir::ArcPlanes::Principal))
     return nullptr;
-  if (!module.aimSchema.empty()) {
-    // The writer patches the source file's own ARM instances; an AIM file's
-    // write-back has to be AIM, which is not written yet (docs/ap238.md).
-    diags.error(input.loc(0), "machine-optimised STEP-NC is written for ISO 14649 ARM files; this file is an AP238 "
-                              "AIM file (" + module.aimSchema +
-                                  "), whose write-back stepnc does not write yet (docs/ap238.md)");
-    return nullptr;
-  }
-  std::string written = writeOptimisedPart21(input, module, options, diags);
+  // An ARM file is patched; an AP238 AIM file has no ARM instances to patch:
+  // its write-back is an ARM file written from the IR (docs/ap238.md).
+  std::string written = module.aimSchema.empty() ? writeOptimisedPart21(input, module, options, diags)
+                                                 : writeArmFromIr(input, module, options, diags);
   if (written.empty())
     return nullptr;
   text = SourceFile::fromString(std::string(input.source().name()) + " (optimised)", written);

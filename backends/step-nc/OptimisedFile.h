@@ -27,7 +27,8 @@ namespace stepnc::backends {
 
 struct OptimisedFileOptions {
   /// Readable lines for FILE_DESCRIPTION: how the file was made and what was
-  /// defaulted or changed. The input's own description lines follow them.
+  /// defaulted or changed. The writer says what the file holds after the
+  /// first; the input's own description lines follow them all.
   std::vector<std::string> description;
 };
 

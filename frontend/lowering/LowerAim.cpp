@@ -351,6 +351,8 @@ std::optional<Measure> AimLowerer::measure(const Instance &item) {
     return std::nullopt;
   }
   m.value = *value * v.factor;
+  m.written = *value;
+  m.factor = v.factor;
   m.dims = v.dims;
   return m;
 }
@@ -795,7 +797,7 @@ Node AimLowerer::technology(const Instance &tech) {
         else if (m->dims == kLength && kind == "feed per tooth")
           n.set("feed_per_tooth", Value::length(m->value));
         else if (m->dims == kFeed)
-          n.set("feed", Value::feed(m->value * 60));
+          n.set("feed", Value::feed(m->scaled(60)));
         else if (m->dims == kFeedPerRev)
           n.set("feed_per_rev", Value::feedPerRev(m->value));
         else
@@ -803,9 +805,9 @@ Node AimLowerer::technology(const Instance &tech) {
       } else if (property == "spindle") {
         const bool maximum = m->name.find("maximum") != std::string::npos;
         if (m->dims == kRotation)
-          n.set(maximum ? "spindle_max" : "spindle", Value::spindle(maximum ? std::abs(m->value * 60) : m->value * 60));
+          n.set(maximum ? "spindle_max" : "spindle", Value::spindle(maximum ? std::abs(m->scaled(60)) : m->scaled(60)));
         else if (m->dims == kFeed)
-          n.set("cutting_speed", Value::feed(m->value * 60));
+          n.set("cutting_speed", Value::feed(m->scaled(60)));
         else
           wrong("a rotational speed (revolutions per minute) or a surface speed");
       } else if (reported_.insert(item.index()).second) {

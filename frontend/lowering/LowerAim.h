@@ -39,6 +39,12 @@ struct Measure {
   std::string name;  ///< the item's name, normalised
   double value = 0;  ///< in stepnc's base units (UnitValue::factor applied)
   Dims dims;
+  double written = 0;  ///< as the file writes it
+  double factor = 1;   ///< its unit's UnitValue::factor
+  /// The value in a unit `scale` times the base unit's inverse (mm/min from
+  /// mm/s: 60), the factors combined first: 5 in/min is 127 mm/min exactly
+  /// (5 x 25.4), where 5 x (25.4 / 60) x 60 is not.
+  double scaled(double scale) const { return written * (factor * scale); }
 };
 
 } // namespace aim

@@ -2,6 +2,7 @@
 // operations with their technology, machine functions, strategies and
 // approach/retract, explicit toolpaths; and the tools they use (ISO 14649-111).
 #include "frontend/lowering/Lowerer.h"
+#include "frontend/lowering/ToolBodies.h"
 #include "frontend/express/Schema.h"
 #include "ir/Plausible.h"
 #include "support/Format.h"
@@ -33,18 +34,6 @@ constexpr std::pair<std::string_view, ir::Kind> kOperations[] = {
     {"boring", ir::Kind::Boring},
     {"tapping", ir::Kind::Tapping},
     {"thread_drilling", ir::Kind::ThreadDrilling}};
-
-// ARM tool body entity -> IR tool type; most specific first.
-constexpr std::pair<std::string_view, std::string_view> kToolBodies[] = {
-    {"ball_endmill", "ball_endmill"},     {"bullnose_endmill", "bullnose_endmill"},
-    {"tapered_endmill", "tapered_endmill"}, {"endmill", "endmill"},
-    {"facemill", "facemill"},             {"side_mill", "side_mill"},
-    {"t_slot_mill", "t_slot_mill"},       {"tapered_drill", "tapered_drill"},
-    {"twist_drill", "twist_drill"},       {"spot_drill", "spot_drill"},
-    {"centerdrill", "center_drill"},      {"tapered_reamer", "tapered_reamer"},
-    {"reamer", "reamer"},                 {"tap", "tap"},
-    {"boring_tool", "boring_tool"},       {"countersink", "countersink"},
-    {"counterbore", "counterbore"}};
 
 constexpr std::pair<std::string_view, std::string_view> kStrategies[] = {
     {"unidirectional", "unidirectional"},       {"bidirectional", "bidirectional"},
@@ -89,8 +78,7 @@ bool Lowerer::toolFromUse(const Instance &t, Node &n) {
   // The body as ISO 14649-111 writes it: the entity of the tool type, its
   // dimension the diameter; a boring tool also says whether it may retract
   // with the spindle turning (not forbidden: what the program does).
-  const auto body = std::ranges::find_if(kToolBodies, [&](const auto &b) { return b.second == type; });
-  std::string entity = express::upper(body->first);
+  std::string entity = express::upper(toolBodyEntity(type));
   fix(t, "its_tool_body",
       newInstance(entity + "(" + newInstance("MILLING_TOOL_DIMENSION(" + real(*diameter) + ",$,$,$,$,$,$)") +
                   ",$,$,$,$" + (type == "boring_tool" ? ",.F.)" : ")")));
@@ -435,7 +423,8 @@ std::optional<Node> Lowerer::operation(const Instance &op) {
 
 void Lowerer::toolpaths(const Instance &list, Node &parent) {
   for (const Instance &tp : list.refs("its_list")) {
-    if (!tp.isA("cutter_location_trajectory")) {
+    const bool feedstop = tp.isA("feedstop");
+    if (!feedstop && !tp.isA("cutter_location_trajectory")) {
       unsupported(tp, "toolpath");
       continue;
     }
@@ -443,6 +432,17 @@ void Lowerer::toolpaths(const Instance &list, Node &parent) {
     stamp(n, tp, "");
     n.set("role", Value::word(tp.enumeration("its_type").value_or("trajectory_path")));
     n.set("required", Value::boolean(tp.boolean("its_priority").value_or(true)));
+    if (feedstop) {
+      // A dwell where the path before it ends (ISO 14649-10 feedstop).
+      const std::optional<double> dwell = tp.real("dwell");
+      if (!dwell || !(*dwell >= 0)) {
+        missing(tp, "dwell", dwell ? "is negative: a feedstop waits 0 s or more" : "");
+        continue;
+      }
+      n.set("dwell", Value::time(*dwell));
+      parent.add(std::move(n));
+      continue;
+    }
     if (auto r = tp.real("its_speed"))
       n.set("speed_ratio", Value::ratio(*r));
     else if (tp.enumeration("its_speed") == "rapid")

@@ -118,6 +118,11 @@ bool expandExplicitToolpaths(Expander &x, const Step &step) {
       // A feedstop waits where the path before it ended.
       if (e.positioned())
         e.dwell(*dwell);
+      else
+        x.diags->warning(tp->origin.loc, "workingstep " + ws.symbol +
+                                             ": a feedstop before its first toolpath, where the tool is not yet: "
+                                             "left out")
+            .entity(tp->origin.entityId);
       continue;
     }
     for (const Node &curve : tp->children) {

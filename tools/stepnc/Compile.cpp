@@ -76,9 +76,6 @@ std::vector<std::string> optimisedDescription(const CompileOptions &opts, const 
   std::vector<std::string> lines = {
       "machine-optimised STEP-NC written by stepnc compile --emit=stepnc from " +
           std::filesystem::path(opts.input).filename().string(),
-      "kept: every instance of the input with its id and values; changed: the its_toolpath of each expanded "
-      "operation, now a TOOLPATH_LIST of required CUTTER_LOCATION_TRAJECTORY in the frame of the feature; "
-      "added: the instances above the largest id of the input",
       "machine: " + (opts.machine.empty() ? std::string("none given") : opts.machine),
       "passes: " + pipeline,
       opts.noAdaptFeed ? std::string("feeds: as programmed (--no-adapt-feed)")
