@@ -118,6 +118,10 @@ private:
 
   void resolve(ir::Node &op, const ir::Node *step, const ir::Node *tool, DiagnosticEngine &diags,
                PassStats &stats, PassResult &result) {
+    // A turning or deposition operation's speeds and feeds are its process's
+    // (a feed per revolution, a constant cutting speed): not milling's rules.
+    if (op.is(ir::Trait::Turning) || op.is(ir::Trait::Additive))
+      return;
     ir::Node *tech = nullptr;
     for (ir::Node &c : op.children)
       if (c.kind == ir::Kind::Technology)

@@ -1,12 +1,14 @@
 // Lowering of manufacturing features (ISO 14649-10): planar faces, pockets,
-// round holes, slots, steps, general outside profiles and bosses. A feature is
-// lowered once, under its workpiece, and referred to by symbol.
+// round holes, slots, steps, general outside profiles and bosses; and the
+// turned features of ISO 14649-12 (docs/turning.md). A feature is lowered
+// once, under its workpiece, and referred to by symbol.
 #include "frontend/lowering/Lowerer.h"
 
 #include "support/Format.h"
 
 #include <cmath>
 #include <numbers>
+#include <tuple>
 
 namespace stepnc::lowering {
 
@@ -374,6 +376,65 @@ std::optional<std::string> Lowerer::feature(const Instance &f) {
     // moves are checked for the safety rules only.
     n.kind = ir::Kind::ToolpathFeature;
     commonPlacement();
+  } else if (f.isA("outer_diameter") || f.isA("outer_diameter_to_shoulder")) {
+    // ISO 14649-12 turned features: placed on the turning axis (their
+    // placement's z); their profiles lie in its XZ half plane and are kept
+    // as the file places them (docs/turning.md).
+    const bool shoulder = f.isA("outer_diameter_to_shoulder");
+    n.kind = shoulder ? ir::Kind::OuterDiameterToShoulder : ir::Kind::OuterDiameter;
+    commonPlacement();
+    if (auto d = toleranced(f, "diameter_at_placement"))
+      n.set("diameter", Value::length(*d));
+    else
+      missing(f, "diameter_at_placement");
+    if (shoulder) {
+      if (auto profile = this->profile(f.ref("v_shape_boundary")))
+        n.add(std::move(*profile));
+      else
+        missing(f, "v_shape_boundary");
+    } else {
+      length("length", "feature_length");
+      if (!n.has("length"))
+        missing(f, "feature_length");
+      if (Instance taper = f.ref("reduced_size")) {
+        if (taper.isA("diameter_taper")) {
+          if (auto d = toleranced(taper, "final_diameter"))
+            n.set("reduced_diameter", Value::length(*d));
+        } else if (taper.isA("angle_taper")) {
+          if (auto a = taper.real("angle"))
+            n.set("taper_angle", angle(*a));
+        } else {
+          unsupported(taper, "taper of an outer diameter");
+        }
+      }
+    }
+  } else if (f.isA("revolved_feature")) {
+    static constexpr std::tuple<std::string_view, ir::Kind, std::string_view> kRevolved[] = {
+        {"revolved_flat", ir::Kind::RevolvedFlat, "flat_edge_shape"},
+        {"revolved_round", ir::Kind::RevolvedRound, "rounded_edge_shape"},
+        {"groove", ir::Kind::Groove, "sweep"},
+        {"general_revolution", ir::Kind::GeneralRevolution, "outer_edge_profile"}};
+    std::string_view shape;
+    for (const auto &[entity, kind, attribute] : kRevolved)
+      if (f.isA(entity)) {
+        n.kind = kind;
+        shape = attribute;
+      }
+    if (shape.empty()) {
+      unsupported(f, "feature");
+      return std::nullopt;
+    }
+    commonPlacement();
+    length("radius", "radius");
+    if (!n.has("radius"))
+      missing(f, "radius");
+    if (Instance side = f.ref("material_side"))
+      if (auto d = direction(side))
+        n.set("material_side", Value::direction(*d));
+    if (auto profile = this->profile(f.ref(shape)))
+      n.add(std::move(*profile));
+    else
+      missing(f, shape);
   } else if (f.isA("boss")) {
     n.kind = ir::Kind::Boss;
     commonPlacementAndDepth();

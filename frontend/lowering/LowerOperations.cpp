@@ -1,6 +1,7 @@
-// Lowering of operations (ISO 14649-10/11): milling and drilling-type
-// operations with their technology, machine functions, strategies and
-// approach/retract, explicit toolpaths; and the tools they use (ISO 14649-111).
+// Lowering of operations (ISO 14649-10/11/12): milling, drilling-type and
+// turning operations with their technology, machine functions, strategies
+// and approach/retract, explicit toolpaths; and the tools they use (ISO
+// 14649-111 and -121).
 #include "frontend/lowering/Lowerer.h"
 #include "frontend/lowering/ToolBodies.h"
 #include "frontend/express/Schema.h"
@@ -33,7 +34,37 @@ constexpr std::pair<std::string_view, ir::Kind> kOperations[] = {
     {"reaming", ir::Kind::Reaming},
     {"boring", ir::Kind::Boring},
     {"tapping", ir::Kind::Tapping},
-    {"thread_drilling", ir::Kind::ThreadDrilling}};
+    {"thread_drilling", ir::Kind::ThreadDrilling},
+    // ISO 14649-12 turning operations.
+    {"contouring_rough", ir::Kind::ContouringRough},
+    {"contouring_finish", ir::Kind::ContouringFinish},
+    {"facing_rough", ir::Kind::FacingRough},
+    {"facing_finish", ir::Kind::FacingFinish},
+    {"grooving_rough", ir::Kind::GroovingRough},
+    {"grooving_finish", ir::Kind::GroovingFinish},
+    {"cutting_in", ir::Kind::CuttingIn},
+    {"threading_rough", ir::Kind::ThreadingRough},
+    {"threading_finish", ir::Kind::ThreadingFinish},
+    {"knurling", ir::Kind::Knurling}};
+
+// ISO 14649-121 turning tool body entity -> IR tool type.
+constexpr std::pair<std::string_view, std::string_view> kTurningBodies[] = {
+    {"general_turning_tool", "turning_tool"},
+    {"turning_threading_tool", "threading_tool"},
+    {"grooving_tool", "grooving_tool"},
+    {"knurling_tool", "knurling_tool"}};
+
+// ISO 14649-12 turning strategy entity -> IR turning_strategy type; most
+// specific first.
+constexpr std::pair<std::string_view, std::string_view> kTurningStrategies[] = {
+    {"unidirectional_perpendicular", "unidirectional_perpendicular"},
+    {"unidirectional_diagonal", "unidirectional_diagonal"},
+    {"bidirectional_turning", "bidirectional"},
+    {"contour_turning", "contour"},
+    {"thread_strategy", "thread"},
+    {"multistep_grooving_strategy", "multistep_grooving"},
+    {"grooving_strategy", "grooving"},
+    {"explicit_turning_strategy", "explicit"}};
 
 constexpr std::pair<std::string_view, std::string_view> kStrategies[] = {
     {"unidirectional", "unidirectional"},       {"bidirectional", "bidirectional"},
@@ -89,6 +120,28 @@ bool Lowerer::toolFromUse(const Instance &t, Node &n) {
   return true;
 }
 
+void Lowerer::turningToolBody(const Instance &body, Node &n) {
+  if (Instance dim = body.ref("dimension")) {
+    copyReal(n, "corner_radius", dim, "nose_radius", Value::length);
+    copyReal(n, "cutting_edge_length", dim, "cutting_edge_length", Value::length);
+    copyAngle(n, "side_edge_angle", dim, "side_cutting_edge_angle");
+    copyAngle(n, "end_edge_angle", dim, "end_cutting_edge_angle");
+    copyReal(n, "diameter", dim, "circle_diameter", Value::length);  // a round insert's
+  } else {
+    missing(body, "dimension");
+  }
+  if (auto hand = body.enumeration("hand_of_tool"))
+    n.set("hand", Value::word(*hand));
+  copyReal(n, "max_cutting_depth", body, "maximum_cutting_depth", Value::length);
+  if (body.isA("grooving_tool")) {
+    copyReal(n, "cutting_width", body, "cutting_width", Value::length);
+    copyReal(n, "corner_radius", body, "corner_radius", Value::length);
+  } else if (body.isA("turning_threading_tool")) {
+    copyReal(n, "thread_pitch", body, "threading_pitch", Value::length);
+    copyAngle(n, "thread_angle", body, "threading_angle");
+  }
+}
+
 void Lowerer::writeToolExplicitly(const Instance &t) {
   // An abstract cutting_tool (binding read it as written) is the milling
   // cutting tool its body describes: ISO 14649-111 makes drills, taps and
@@ -133,10 +186,15 @@ std::optional<std::string> Lowerer::tool(const Instance &t) {
       type = word;
       break;
     }
+  for (const auto &[entity, word] : kTurningBodies)
+    if (body.isA(entity))
+      type = word;
   if (body && type == "cutting_tool")
     unsupported(body, "tool body");
   n.set("type", Value::word(std::string(type)));
-  if (body) {
+  if (body.isA("turning_machine_tool_body")) {
+    turningToolBody(body, n);
+  } else if (body) {
     if (Instance dim = body.ref("dimension")) {
       copyReal(n, "diameter", dim, "diameter", Value::length);
       copyReal(n, "corner_radius", dim, "edge_radius", Value::length);
@@ -185,6 +243,24 @@ void checkPlausible(Lowerer &l, const Instance &tech, std::string_view attribute
   l.diags().warning(tech.attrLoc(attribute), text).entity(tech.id(), "MILLING_TECHNOLOGY");
 }
 
+/// A strategy node of `kind` whose `type` is the word `table` gives the
+/// first entity `strategy` is (the table lists the most specific first);
+/// none, after saying so, when it is none of them.
+template <size_t N>
+std::optional<Node> typedStrategy(Lowerer &l, const Instance &strategy,
+                                  const std::pair<std::string_view, std::string_view> (&table)[N], ir::Kind kind,
+                                  std::string_view what) {
+  const auto row = std::ranges::find_if(table, [&](const auto &r) { return strategy.isA(r.first); });
+  if (row == std::end(table)) {
+    l.unsupported(strategy, what);
+    return std::nullopt;
+  }
+  Node s(kind);
+  l.stamp(s, strategy, "");
+  s.set("type", Value::word(std::string(row->second)));
+  return s;
+}
+
 /// What every 2.5D milling strategy has: overlap and multiple passes.
 void commonStrategyAttributes(Lowerer &l, Node &s, const Instance &strategy) {
   if (auto o = strategy.real("overlap")) {
@@ -213,10 +289,8 @@ std::optional<Node> millingStrategy(Lowerer &l, const Instance &strategy) {
     if (trochoidal) {
       copyReal(p, "radius", strategy, "trochoid_radius", Value::length);
       copyReal(p, "step", strategy, "step_per_revolution", Value::length);
-      if (auto w = strategy.enumeration("rotation_direction"))
-        p.set("rotation", Value::word(*w));
-      if (auto w = strategy.enumeration("cutmode"))
-        p.set("cutmode", Value::word(*w));
+      copyWord(p, "rotation", strategy, "rotation_direction");
+      copyWord(p, "cutmode", strategy, "cutmode");
     } else {
       copyReal(p, "clearance", strategy, "clearance_height", Value::length);
       copyReal(p, "retract_offset", strategy, "retract_offset", Value::length);
@@ -242,36 +316,105 @@ std::optional<Node> millingStrategy(Lowerer &l, const Instance &strategy) {
     p.add(std::move(*g));
     return p;
   }
-  std::string_view type;
-  for (const auto &[entity, word] : kStrategies)
-    if (strategy.isA(entity)) {
-      type = word;
-      break;
-    }
-  if (type.empty()) {
-    l.unsupported(strategy, "machining strategy");
+  std::optional<Node> typed = typedStrategy(l, strategy, kStrategies, ir::Kind::Strategy, "machining strategy");
+  if (!typed)
     return std::nullopt;
-  }
-  Node s(ir::Kind::Strategy);
-  l.stamp(s, strategy, "");
-  s.set("type", Value::word(std::string(type)));
+  Node &s = *typed;
   commonStrategyAttributes(l, s, strategy);
   if (Instance fd = strategy.ref("feed_direction"))
     if (auto d = l.direction(fd))
       s.set("feed_dir", Value::direction(*d));
-  if (auto w = strategy.enumeration("stepover_direction"))
-    s.set("stepover_dir", Value::word(*w));
+  copyWord(s, "stepover_dir", strategy, "stepover_direction");
   if (auto w = strategy.enumeration("its_stroke_connection_strategy"))
     s.set("stroke_connection", Value::word(*w == "straghtline" ? "straightline" : *w));  // the ARM's spelling
-  if (auto w = strategy.enumeration("rotation_direction"))
-    s.set("rotation", Value::word(*w));
-  if (auto w = strategy.enumeration("cutmode"))
-    s.set("cutmode", Value::word(*w));
+  copyWord(s, "rotation", strategy, "rotation_direction");
+  copyWord(s, "cutmode", strategy, "cutmode");
   copyFlag(s, "spiral_cutmode_change", strategy, "spiral_cutmode_change");
-  return s;
+  return typed;
+}
+
+/// A turning technology (ISO 14649-12): a constant spindle speed, or a
+/// constant cutting speed (CSS) clamped by a maximum spindle speed; a feed
+/// per revolution, or per minute.
+Node turningTechnology(Lowerer &l, const Instance &tech) {
+  Node n(ir::Kind::Technology);
+  if (auto f = tech.real("feedrate"))
+    n.set("feed", Value::feed(l.feedMmPerMin(*f)));
+  if (auto f = tech.real("feedrate_per_revolution")) {
+    if (*f > 0)
+      n.set("feed_per_rev", Value::feedPerRev(*f));
+    else
+      l.missing(tech, "feedrate_per_revolution", "is not positive: a feed per revolution is a length (mm) above 0");
+  }
+  Instance speed = tech.ref("spindle_speed");
+  if (speed.isA("const_spindle_speed")) {
+    if (auto s = speed.real("rot_speed")) {
+      const double rpm = l.spindleRevPerMin(*s);
+      n.set("spindle", Value::spindle(rpm));
+      checkPlausible(l, speed, "rot_speed", rpm, ir::kPlausibleMinSpindleRpm, ir::kPlausibleMaxSpindleRpm, "rev/min");
+    } else {
+      l.missing(speed, "rot_speed");
+    }
+  } else if (speed.isA("const_cutting_speed")) {
+    if (auto v = speed.real("speed")) {
+      const double mmPerMin = l.cuttingSpeedMmPerMin(*v);
+      n.set("cutting_speed", Value::feed(mmPerMin));
+      checkPlausible(l, speed, "speed", mmPerMin, 1000 * ir::kPlausibleMinCuttingSpeedMPerMin,
+                     1000 * ir::kPlausibleMaxCuttingSpeedMPerMin, "mm/min");
+    } else {
+      l.missing(speed, "speed");
+    }
+    if (auto m = speed.real("max_speed"))
+      n.set("spindle_max", Value::spindle(std::abs(l.spindleRevPerMin(*m))));
+  } else if (speed) {
+    l.unsupported(speed, "spindle speed");
+  } else {
+    l.missing(tech, "spindle_speed");
+  }
+  const std::optional<std::string> reference = tech.enumeration("feedrate_reference");
+  n.set("feed_reference", Value::word(reference.value_or("tcp")));
+  if (!reference)
+    l.fix(tech, "feedrate_reference", ".TCP.");
+  copyFlag(n, "sync_spindle_feed", tech, "sync_spindle_and_z_feed");
+  copyFlag(n, "inhibit_feed_override", tech, "inhibit_feedrate_override");
+  copyFlag(n, "inhibit_spindle_override", tech, "inhibit_spindle_override");
+  return n;
+}
+
+/// A turning strategy (ISO 14649-12) with the attributes of its type.
+std::optional<Node> turningStrategy(Lowerer &l, const Instance &strategy) {
+  std::optional<Node> typed =
+      typedStrategy(l, strategy, kTurningStrategies, ir::Kind::TurningStrategy, "turning strategy");
+  if (!typed)
+    return std::nullopt;
+  Node &s = *typed;
+  copyReal(s, "overcut", strategy, "overcut_length", Value::length);
+  copyFlag(s, "multiple_passes", strategy, "allow_multiple_passes");
+  if (std::vector<double> depths = strategy.reals("cutting_depth"); !depths.empty())
+    s.set("cutting_depths", Value::reals(std::move(depths)));
+  for (auto [irName, attribute] : {std::pair{"feed_dir", "feed_direction"}, {"back_path_dir", "back_path_direction"},
+                                   {"stepover_dir", "stepover_direction"}})
+    if (Instance d = strategy.ref(attribute))
+      if (auto v = l.direction(d))
+        s.set(irName, Value::direction(*v));
+  for (auto [irName, attribute] :
+       {std::pair{"back_path_feed", "back_path_feed"}, {"lift_feed", "lift_feed"}, {"downward_feed", "downward_feed"}})
+    if (auto v = strategy.real(attribute))
+      s.set(irName, Value::feed(l.feedMmPerMin(*v)));
+  copyReal(s, "lift_height", strategy, "lift_height", Value::length);
+  l.copyAngle(s, "return_angle", strategy, "path_return_angle");
+  copyReal(s, "variable_depth", strategy, "variable_depth", Value::ratio);
+  copyReal(s, "variable_downward_feed", strategy, "variable_downward_feed", Value::ratio);
+  copyWord(s, "infeed", strategy, "cut_in_amount_function");
+  copyWord(s, "thread_side", strategy, "threading_direction");
+  copyReal(s, "travel_distance", strategy, "travel_distance", Value::length);
+  copyReal(s, "retract_distance", strategy, "retract_distance", Value::length);
+  return typed;
 }
 
 Node technology(Lowerer &l, const Instance &tech) {
+  if (tech.isA("turning_technology"))
+    return turningTechnology(l, tech);
   Node n(ir::Kind::Technology);
   if (auto f = tech.real("feedrate")) {
     const double feed = l.feedMmPerMin(*f);
@@ -304,6 +447,15 @@ Node technology(Lowerer &l, const Instance &tech) {
 Node machineFunctions(const Instance &mf) {
   Node n(ir::Kind::MachineFunctions);
   for (std::string_view flag : {"coolant", "mist", "through_spindle_coolant", "chip_removal"})
+    copyFlag(n, flag, mf, flag);
+  // Turning machine functions name the coolant's kind, and the supports.
+  if (auto type = mf.enumeration("coolant_type"); type && mf.boolean("coolant").value_or(false)) {
+    if (*type == "mist")
+      n.set("mist", Value::boolean(true));
+    else if (*type == "through_tool")
+      n.set("through_spindle_coolant", Value::boolean(true));
+  }
+  for (std::string_view flag : {"tail_stock", "steady_rest", "follow_rest"})
     copyFlag(n, flag, mf, flag);
   copyReal(n, "coolant_pressure", mf, "coolant_pressure", Value::ratio);
   copyReal(n, "through_pressure", mf, "through_pressure", Value::ratio);
@@ -358,6 +510,27 @@ std::optional<Node> Lowerer::operation(const Instance &op) {
   copyReal(n, "dwell_step", op, "dwell_time_step", Value::time);
   copyFlag(n, "compensation_chuck", op, "compensation_chuck");
   copyFlag(n, "helical_movement", op, "helical_movement_on_forward");
+  // Turning operations.
+  length("x_return", "x_return_amount");
+  length("z_return", "z_return_amount");
+  length("return_amount", "return_amount");
+  length("allowance", "allowance");
+  copyReal(n, "feed_ratio", op, "variable_feedrate", Value::ratio);
+  if (op.isA("cutting_in")) {
+    if (auto d = toleranced(op, "depth"))
+      n.set("depth", Value::length(*d));
+    else
+      missing(op, "depth");
+    if (Instance d = op.ref("cut_in_direction"))
+      if (auto v = direction(d))
+        n.set("direction", Value::direction(*v));
+  }
+  if (Instance dwell = op.ref("dwell_type")) {
+    if (dwell.isA("dwell_time"))
+      copyReal(n, "dwell", dwell, "time", Value::time);
+    else if (dwell.isA("dwell_revolution"))
+      copyReal(n, "dwell_revolutions", dwell, "revolution", Value::ratio);
+  }
 
   if (Instance tech = op.ref("its_technology")) {
     n.add(technology(*this, tech));
@@ -376,7 +549,10 @@ std::optional<Node> Lowerer::operation(const Instance &op) {
   else  // binding said: read as absent (no coolant, no chip removal)
     fix(op, "its_machine_functions", newInstance("MILLING_MACHINE_FUNCTIONS(.F.,$,$,.F.,$,(),.F.,$,$,())"));
   if (Instance strategy = op.ref("its_machining_strategy")) {
-    if (strategy.isA("drilling_type_strategy")) {
+    if (strategy.isA("turning_machining_strategy")) {
+      if (auto lowered = turningStrategy(*this, strategy))
+        n.add(std::move(*lowered));
+    } else if (strategy.isA("drilling_type_strategy")) {
       Node d(ir::Kind::DrillingStrategy);
       stamp(d, strategy, "");
       for (std::string_view ratio :

@@ -414,6 +414,11 @@ constexpr std::pair<std::string_view, std::string_view> kAngles[] = {
     {"plunge_helix", "angle"},
     {"plunge_zigzag", "angle"},
     {"ap_retract_angle", "angle"},
+    {"turning_tool_dimension", "side_cutting_edge_angle"},
+    {"turning_tool_dimension", "end_cutting_edge_angle"},
+    {"turning_threading_tool", "threading_angle"},
+    {"unidirectional_diagonal", "path_return_angle"},
+    {"contour_turning", "path_return_angle"},
 };
 
 } // namespace
@@ -531,6 +536,13 @@ void Lowerer::chooseSpeedUnits(const std::vector<Instance> &operations) {
     for (auto [attribute, list] : {std::pair{"feedrate", &feeds}, {"cutspeed", &cutspeeds}, {"spindle", &spindles}})
       if (auto v = tech.real(attribute); v && *v != 0)
         list->push_back({tech, attribute, *v, diameter, spindle, flutes});
+    // A turning technology's speeds are in its spindle speed select (the
+    // diameter they act on is the workpiece's, not known here).
+    Instance speed = tech.ref("spindle_speed");
+    for (auto [attribute, list] :
+         {std::pair{"rot_speed", &spindles}, {"speed", &cutspeeds}, {"max_speed", &spindles}})
+      if (auto v = speed.real(attribute); v && *v != 0)
+        list->push_back({speed, attribute, *v, 0.0, 0.0, 0});
   }
   // Plausible: spindle speeds of 10 to 60000 rev/min that give a cutting
   // speed of 1 to 1500 m/min on the tool, when its diameter is known;

@@ -75,6 +75,13 @@ inline void copyFlag(Node &to, std::string_view irName, const Instance &from, st
     to.set(std::string(irName), Value::boolean(*b));
 }
 
+/// Copies enumeration attribute `attribute` of `from` into `to` as the word
+/// `irName`, when present.
+inline void copyWord(Node &to, std::string_view irName, const Instance &from, std::string_view attribute) {
+  if (auto w = from.enumeration(attribute))
+    to.set(std::string(irName), Value::word(*w));
+}
+
 class Lowerer {
 public:
   Lowerer(const binding::BoundFile &bound, DiagnosticEngine &diags, const LowerOptions &options)
@@ -217,6 +224,8 @@ public:
   /// slot's width less the side allowances for the end mill that mills it.
   /// False (nothing assumed) when the use does not say.
   bool toolFromUse(const Instance &tool, Node &n);
+  /// The dimensions of an ISO 14649-121 turning tool body.
+  void turningToolBody(const Instance &body, Node &n);
   /// Adds the toolpaths of a toolpath_list as children of `parent`.
   void toolpaths(const Instance &list, Node &parent);
 

@@ -200,6 +200,13 @@ private:
     const Node *op = ir::operationOf(ws);
     if (!op)
       return;
+    if (op->is(ir::Trait::Turning) || op->is(ir::Trait::Additive)) {
+      x_.report(ws, std::string("its operation ") + op->kindName() + " '" + op->label + "' is a " +
+                        (op->is(ir::Trait::Turning) ? "turning" : "deposition") +
+                        " operation: stepnc does not compile its process yet (" +
+                        (op->is(ir::Trait::Turning) ? "docs/turning.md" : "docs/ir.md") + ")");
+      return;
+    }
     const Node *feature = ir::findFeature(*x_.module, ws.text("feature").value_or(""));
     const Node *tool = ir::findTool(*x_.module, op->text("tool").value_or(""));
     if (!feature || !tool)

@@ -155,7 +155,7 @@ TEST_CASE("the parser reports errors line after line, skipping what it could not
                "4:16: attribute 'type' of 'tool' is one of (endmill, facemill, ball_endmill, bullnose_endmill, "
                "tapered_endmill, side_mill, t_slot_mill, twist_drill, center_drill, spot_drill, tapered_drill, "
                "reamer, tapered_reamer, tap, boring_tool, countersink, counterbore, cutting_tool, turning_tool, "
-               "grooving_tool, threading_tool, deposition_head), found 'drill'",
+               "grooving_tool, threading_tool, knurling_tool, deposition_head), found 'drill'",
                "5:5: 'clamp' is not allowed under 'tool', which takes no children",
                "6:31: attribute 'flutes' of 'tool' is a count (an integer), found '4.0'"});
 }
