@@ -616,13 +616,7 @@ std::optional<Node> AimLowerer::rapidMovement(const Instance &rm) {
 
 std::optional<Node> AimLowerer::operation(const Instance &op) {
   reached_.insert(op.index());
-  if (op.isA("turning_type_operation")) {
-    report(op, op.loc(),
-           "a lathe operation: not supported yet (stepnc's targets are milling targets until turning lands; "
-           "docs/ap238.md)");
-    return std::nullopt;
-  }
-  if (!op.isA("milling_type_operation") && !op.isA("drilling_type_operation")) {
+  if (!op.isA("milling_type_operation") && !op.isA("drilling_type_operation") && !op.isA("turning_type_operation")) {
     base_.unsupported(op, "operation");
     return std::nullopt;
   }
@@ -632,7 +626,14 @@ std::optional<Node> AimLowerer::operation(const Instance &op) {
   // path stepnc's strategies make.
   const bool followsToolpaths = !related(op, "machining_toolpath_sequence_relationship").empty();
   Node n(ir::Kind::FreeformOperation);
-  if (!followsToolpaths) {
+  if (op.isA("turning_type_operation")) {
+    // A lathe operation is the ISO 14649-12 operation its entity and
+    // description name, its toolpaths or not (docs/turning.md).
+    if (std::optional<ir::Kind> kind = turningOperationKind(op))
+      n.kind = *kind;
+    else
+      return std::nullopt;
+  } else if (!followsToolpaths) {
     if (std::optional<ir::Kind> kind = strategyOperationKind(op))
       n.kind = *kind;
     else
@@ -683,12 +684,13 @@ std::optional<std::string> AimLowerer::tool(const Instance &t) {
   if (kind.empty())
     kind = normalName(t.ref("kind").string("name").value_or(""));
   static const std::pair<std::string_view, std::string_view> kKinds[] = {
+      {"groov", "grooving_tool"},      {"knurl", "knurling_tool"},    {"turning", "turning_tool"},
       {"ball", "ball_endmill"},        {"bull", "bullnose_endmill"},  {"face", "facemill"},
       {"center", "center_drill"},      {"centre", "center_drill"},    {"spot", "spot_drill"},
       {"twist", "twist_drill"},        {"drill", "twist_drill"},      {"ream", "reamer"},
       {"tap", "tap"},                  {"bor", "boring_tool"},        {"countersink", "countersink"},
       {"counterbore", "counterbore"},  {"side mill", "side_mill"},    {"t slot", "t_slot_mill"},
-      {"end", "endmill"},              {"mill", "endmill"}};
+      {"end", "endmill"},              {"mill", "endmill"},           {"thread", "threading_tool"}};
   std::string_view type;
   for (const auto &[word, irType] : kKinds)
     if (type.empty() && kind.find(word) != std::string::npos)
@@ -753,7 +755,10 @@ std::optional<std::string> AimLowerer::tool(const Instance &t) {
         diags_.remark(item.loc(), "tool property '" + m->name + "' is not read by stepnc")
             .entity(item.id(), entityUpper(item));
     }
-  if (!n.has("diameter")) {
+  // A lathe insert has no diameter; every milling and hole-making tool has.
+  const bool lathe = type == "turning_tool" || type == "grooving_tool" || type == "threading_tool" ||
+                     type == "knurling_tool";
+  if (!lathe && !n.has("diameter")) {
     base_.missing(t, "diameter", "is not given: no resource property of the tool has a 'diameter' measure");
     return std::nullopt;
   }

@@ -143,6 +143,9 @@ private:
   /// entity and description ('roughing', 'center drilling'); nullopt after a
   /// located error when stepnc has none.
   std::optional<ir::Kind> strategyOperationKind(const Instance &op);
+  /// The IR kind of a lathe operation (ISO 14649-12) from its entity and
+  /// description; nullopt after a located error.
+  std::optional<ir::Kind> turningOperationKind(const Instance &op);
   /// The operation's action properties (retract plane, allowances, depths, ...).
   void operationParameters(const Instance &op, Node &n);
   /// Its machining, approach and retract strategies

@@ -353,6 +353,33 @@ std::optional<ir::Kind> AimLowerer::strategyOperationKind(const Instance &op) {
   return std::nullopt;
 }
 
+std::optional<ir::Kind> AimLowerer::turningOperationKind(const Instance &op) {
+  struct Row {
+    std::string_view entity, description;
+    ir::Kind kind;
+  };
+  static const Row kRows[] = {
+      {"contouring_turning_operation", "roughing", ir::Kind::ContouringRough},
+      {"contouring_turning_operation", "finishing", ir::Kind::ContouringFinish},
+      {"facing_turning_operation", "roughing", ir::Kind::FacingRough},
+      {"facing_turning_operation", "finishing", ir::Kind::FacingFinish},
+      {"grooving_turning_operation", "roughing", ir::Kind::GroovingRough},
+      {"grooving_turning_operation", "finishing", ir::Kind::GroovingFinish},
+      {"threading_turning_operation", "roughing", ir::Kind::ThreadingRough},
+      {"threading_turning_operation", "finishing", ir::Kind::ThreadingFinish},
+  };
+  if (op.isA("knurling_turning_operation"))
+    return ir::Kind::Knurling;
+  const std::string description = normalName(op.string("description").value_or(""));
+  for (const Row &r : kRows)
+    if (op.isA(r.entity) && description == r.description)
+      return r.kind;
+  report(op, op.loc(),
+         "a " + std::string(op.entityName()) + " described '" + description +
+             "': not a turning operation of ISO 14649-12 (roughing or finishing; docs/turning.md)");
+  return std::nullopt;
+}
+
 std::optional<Measure> AimLowerer::propertyMeasure(const Instance &of, std::string_view property) {
   for (const Instance &rep : propertyRepresentations(of, property, false))
     for (const Instance &item : rep.refs("items"))
