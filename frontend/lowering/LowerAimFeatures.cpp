@@ -322,12 +322,28 @@ bool AimLowerer::slot(const Instance &f, Node &n) {
 
 // --- operations left to stepnc's strategies ------------------------------------------
 
+namespace {
+
+/// An operation entity with the description that says which ARM operation it is.
+struct OperationRow {
+  std::string_view entity, description;
+  ir::Kind kind;
+};
+
+/// The kind of the first row whose entity `op` is and whose description it has.
+template <size_t N>
+std::optional<ir::Kind> operationKind(const Instance &op, const std::string &description,
+                                      const OperationRow (&rows)[N]) {
+  for (const OperationRow &r : rows)
+    if (op.isA(r.entity) && description == r.description)
+      return r.kind;
+  return std::nullopt;
+}
+
+} // namespace
+
 std::optional<ir::Kind> AimLowerer::strategyOperationKind(const Instance &op) {
-  struct Row {
-    std::string_view entity, description;
-    ir::Kind kind;
-  };
-  static const Row kRows[] = {
+  static const OperationRow kRows[] = {
       {"drilling_operation", "drilling", ir::Kind::Drilling},
       {"drilling_operation", "center drilling", ir::Kind::CenterDrilling},
       {"drilling_operation", "counter sinking", ir::Kind::CounterSinking},
@@ -344,9 +360,8 @@ std::optional<ir::Kind> AimLowerer::strategyOperationKind(const Instance &op) {
       {"side_milling_operation", "finishing", ir::Kind::SideFinishMilling},
   };
   const std::string description = normalName(op.string("description").value_or(""));
-  for (const Row &r : kRows)
-    if (op.isA(r.entity) && description == r.description)
-      return r.kind;
+  if (std::optional<ir::Kind> kind = operationKind(op, description, kRows))
+    return kind;
   report(op, op.loc(),
          "a " + std::string(op.entityName()) + " described '" + description +
              "' without toolpaths: not an operation stepnc's strategies make (docs/ap238.md)");
@@ -354,11 +369,7 @@ std::optional<ir::Kind> AimLowerer::strategyOperationKind(const Instance &op) {
 }
 
 std::optional<ir::Kind> AimLowerer::turningOperationKind(const Instance &op) {
-  struct Row {
-    std::string_view entity, description;
-    ir::Kind kind;
-  };
-  static const Row kRows[] = {
+  static const OperationRow kRows[] = {
       {"contouring_turning_operation", "roughing", ir::Kind::ContouringRough},
       {"contouring_turning_operation", "finishing", ir::Kind::ContouringFinish},
       {"facing_turning_operation", "roughing", ir::Kind::FacingRough},
@@ -371,9 +382,8 @@ std::optional<ir::Kind> AimLowerer::turningOperationKind(const Instance &op) {
   if (op.isA("knurling_turning_operation"))
     return ir::Kind::Knurling;
   const std::string description = normalName(op.string("description").value_or(""));
-  for (const Row &r : kRows)
-    if (op.isA(r.entity) && description == r.description)
-      return r.kind;
+  if (std::optional<ir::Kind> kind = operationKind(op, description, kRows))
+    return kind;
   report(op, op.loc(),
          "a " + std::string(op.entityName()) + " described '" + description +
              "': not a turning operation of ISO 14649-12 (roughing or finishing; docs/turning.md)");
