@@ -715,6 +715,16 @@ std::optional<std::string> AimLowerer::tool(const Instance &t) {
         reps.push_back(r);
   for (const Instance &rep : reps)
     for (const Instance &item : rep.refs("items")) {
+      if (item.isA("descriptive_representation_item") &&
+          normalName(item.string("name").value_or("")) == "hand of cut") {
+        // 'right', 'left' or 'neutral' (ISO 14649-111 hand_of_cut, -121 hand_of_tool).
+        const std::string hand = normalName(item.string("description").value_or(""));
+        if (hand == "right" || hand == "left" || hand == "neutral")
+          n.set("hand", Value::word(hand));
+        else
+          report(item, item.loc(), "'hand of cut' is '" + hand + "': right, left or neutral");
+        continue;
+      }
       if (!item.isA("measure_representation_item"))
         continue;
       const std::optional<Measure> m = measure(item);
