@@ -188,6 +188,22 @@ std::optional<std::string> Lowerer::feature(const Instance &f) {
       missing(f, attribute);
     }
   };
+  // A taper_select: a diameter_taper's final diameter as `finalDiameter`,
+  // an angle_taper's angle as `taper_angle`.
+  auto addTaper = [&](std::string_view attribute, std::string_view finalDiameter, std::string_view what) {
+    Instance taper = f.ref(attribute);
+    if (!taper)
+      return;
+    if (taper.isA("diameter_taper")) {
+      if (auto d = toleranced(taper, "final_diameter"))
+        n.set(std::string(finalDiameter), Value::length(*d));
+    } else if (taper.isA("angle_taper")) {
+      if (auto a = taper.real("angle"))
+        n.set("taper_angle", angle(*a));
+    } else {
+      unsupported(taper, what);
+    }
+  };
   auto addPath = [&](std::string_view attribute, bool required) {
     if (auto p = path(f.ref(attribute)))
       n.add(std::move(*p));
@@ -291,17 +307,7 @@ std::optional<std::string> Lowerer::feature(const Instance &f) {
       n.set("diameter", Value::length(*d));
     else
       missing(f, "diameter");
-    if (Instance taper = f.ref("change_in_diameter")) {
-      if (taper.isA("diameter_taper")) {
-        if (auto d = toleranced(taper, "final_diameter"))
-          n.set("final_diameter", Value::length(*d));
-      } else if (taper.isA("angle_taper")) {
-        if (auto a = taper.real("angle"))
-          n.set("taper_angle", angle(*a));
-      } else {
-        unsupported(taper, "hole taper");
-      }
-    }
+    addTaper("change_in_diameter", "final_diameter", "hole taper");
     const Instance &bottom = bottomCondition;
     if (bottom.isA("through_bottom_condition")) {
       n.set("bottom", Value::word("through"));
@@ -396,17 +402,7 @@ std::optional<std::string> Lowerer::feature(const Instance &f) {
       length("length", "feature_length");
       if (!n.has("length"))
         missing(f, "feature_length");
-      if (Instance taper = f.ref("reduced_size")) {
-        if (taper.isA("diameter_taper")) {
-          if (auto d = toleranced(taper, "final_diameter"))
-            n.set("reduced_diameter", Value::length(*d));
-        } else if (taper.isA("angle_taper")) {
-          if (auto a = taper.real("angle"))
-            n.set("taper_angle", angle(*a));
-        } else {
-          unsupported(taper, "taper of an outer diameter");
-        }
-      }
+      addTaper("reduced_size", "reduced_diameter", "taper of an outer diameter");
     }
   } else if (f.isA("revolved_feature")) {
     static constexpr std::tuple<std::string_view, ir::Kind, std::string_view> kRevolved[] = {
