@@ -725,4 +725,16 @@ int SegIndex::winding(const Vec2 &p) const {
   return sum;
 }
 
+Region mirroredAcrossX(const Region &r) {
+  Region m;
+  for (const Loop &l : r.loops) {
+    Loop back;
+    for (auto it = l.segs.rbegin(); it != l.segs.rend(); ++it)
+      back.segs.push_back(Seg{Vec2(it->b.x(), -it->b.y()), Vec2(it->a.x(), -it->a.y()), Vec2(it->c.x(), -it->c.y()),
+                              it->turn});
+    m.loops.push_back(std::move(back));
+  }
+  return m;
+}
+
 } // namespace stepnc::geom

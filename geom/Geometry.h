@@ -161,6 +161,10 @@ private:
   mutable uint32_t epoch_ = 0;
 };
 
+/// The region's mirror image across the x axis (y negated), each loop
+/// reversed so that it keeps its orientation.
+Region mirroredAcrossX(const Region &r);
+
 // --- Offsets and clipping (the generator's tools) -----------------------------
 
 /// The region grown (d > 0) or shrunk (d < 0) by |d|: every point at distance

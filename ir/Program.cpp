@@ -71,24 +71,35 @@ std::optional<std::string> beyond(const Node &n, ArcPlanes planes) {
   return std::nullopt;
 }
 
-std::optional<Beyond> firstBeyond(const Node &n, ArcPlanes planes) {
+std::optional<Beyond> firstBeyond(const Node &n, ArcPlanes planes, TurningSteps turning) {
+  if (turning == TurningSteps::Skip && isTurningStep(n))
+    return std::nullopt;
   if (auto what = beyond(n, planes))
     return Beyond{&n, *what};
   for (const Node &c : n.children)
-    if (auto found = firstBeyond(c, planes))
+    if (auto found = firstBeyond(c, planes, turning))
       return found;
   return std::nullopt;
 }
 
 } // namespace
 
-std::optional<Beyond> beyondThreeAxisMilling(const Module &module, ArcPlanes planes) {
-  return firstBeyond(module.root, planes);
+bool isTurningStep(const Node &exec) {
+  if (exec.kind != Kind::Workingstep)
+    return false;
+  const Node *op = operationOf(exec);
+  return op && op->is(Trait::Turning);
+}
+
+const Node *millingMoves(const Node &exec) { return isTurningStep(exec) ? nullptr : exec.child(Kind::Moves); }
+
+std::optional<Beyond> beyondThreeAxisMilling(const Module &module, ArcPlanes planes, TurningSteps turning) {
+  return firstBeyond(module.root, planes, turning);
 }
 
 bool requireThreeAxisMilling(const Module &module, std::string_view consumer, DiagnosticEngine &diags,
-                             ArcPlanes planes) {
-  const std::optional<Beyond> b = beyondThreeAxisMilling(module, planes);
+                             ArcPlanes planes, TurningSteps turning) {
+  const std::optional<Beyond> b = beyondThreeAxisMilling(module, planes, turning);
   if (!b)
     return true;
   std::string subject = b->node->kindName();

@@ -69,6 +69,20 @@ bool toolpathsGiveFeeds(const Node &op);
 /// the machine does).
 bool runsAsWritten(const Node &executable);
 
+/// Whether `exec` is a turning workingstep (its operation has the Turning
+/// trait): its moves are a lathe's, in the ZX plane with feeds per
+/// revolution, and the milling passes leave them to the turning ones.
+bool isTurningStep(const Node &exec);
+
+/// The `moves` of an executable that a milling pass reads: null for a step
+/// without moves and for a turning step.
+const Node *millingMoves(const Node &exec);
+
+/// What a consumer of milling programs does with turning steps: refuses
+/// them (a reader that writes one program) or passes over them (a pass
+/// that works step by step and leaves lathe moves to the turning passes).
+enum class TurningSteps : uint8_t { Refuse, Skip };
+
 /// Which arcs a reader of the IR takes: in the XY plane only, or in any of
 /// the principal planes XY, ZX and YZ (an arc `normal` along x, y or z).
 enum class ArcPlanes : uint8_t { XYOnly, Principal };
@@ -91,12 +105,14 @@ struct Beyond {
 /// Principal: it walks moves with ir::walkMoves, which gives them as chords,
 /// or writes them itself) is not stopped by them; an arc about any other
 /// axis stops every consumer.
-std::optional<Beyond> beyondThreeAxisMilling(const Module &module, ArcPlanes planes = ArcPlanes::XYOnly);
+/// With `turning` Skip, turning workingsteps are passed over whole.
+std::optional<Beyond> beyondThreeAxisMilling(const Module &module, ArcPlanes planes = ArcPlanes::XYOnly,
+                                             TurningSteps turning = TurningSteps::Refuse);
 
 /// Reports the first construct `consumer` cannot take as an error at its
 /// node ("<consumer> cannot take <what> yet") and returns false; true when
 /// there is none.
 bool requireThreeAxisMilling(const Module &module, std::string_view consumer, DiagnosticEngine &diags,
-                             ArcPlanes planes = ArcPlanes::XYOnly);
+                             ArcPlanes planes = ArcPlanes::XYOnly, TurningSteps turning = TurningSteps::Refuse);
 
 } // namespace stepnc::ir

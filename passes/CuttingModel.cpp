@@ -175,7 +175,7 @@ CutAnalysis analyseCuts(const ir::Module &module, const CutOptions &options) {
   std::vector<Pending> pending;
   double smallest = kInf;
   for (const ir::Node *e : ir::programOrder(module))
-    if (const ir::Node *m = e->child(ir::Kind::Moves)) {
+    if (const ir::Node *m = ir::millingMoves(*e)) {
       pending.push_back({e, m, m->text("setup").value_or("")});
       if (auto t = out.tools.find(m->text("tool").value_or(""));
           t != out.tools.end() && t->second.mill && t->second.cutter.radius > 0)

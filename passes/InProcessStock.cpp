@@ -56,7 +56,7 @@ cutting::HeightMap &InProcessStock::of(const std::string &setup) {
   geom::Box box = raw ? raw->box : geom::Box{};
   double top = raw ? raw->top : -kInf;
   for (const ir::Node *e : ir::programOrder(module_)) {
-    const ir::Node *moves = e->child(ir::Kind::Moves);
+    const ir::Node *moves = ir::millingMoves(*e);
     if (!moves || moves->text("setup").value_or("") != setup)
       continue;
     const double r = toolRadius(ir::findTool(module_, moves->text("tool").value_or("")));
@@ -139,7 +139,7 @@ std::optional<StockHit> rapidMeetsStock(const cutting::HeightMap &stock, const i
 double rapidCheckCell(const ir::Module &module) {
   double smallest = kInf;
   for (const ir::Node *e : ir::programOrder(module))
-    if (const ir::Node *m = e->child(ir::Kind::Moves))
+    if (const ir::Node *m = ir::millingMoves(*e))
       if (const double r = toolRadius(ir::findTool(module, m->text("tool").value_or(""))); r > 0)
         smallest = std::min(smallest, r);
   return std::clamp(std::isfinite(smallest) ? smallest / 20 : 0.25, 0.02, 0.25);
@@ -150,7 +150,7 @@ void walkStock(const ir::Module &module, double cell, const std::function<void(c
   std::optional<ir::Vec3> position;
   std::string lastTool;
   for (const ir::Node *e : ir::programOrder(module)) {
-    const ir::Node *moves = e->child(ir::Kind::Moves);
+    const ir::Node *moves = ir::millingMoves(*e);
     if (!moves)
       continue;
     const std::string toolSymbol = moves->text("tool").value_or("");

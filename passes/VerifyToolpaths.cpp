@@ -44,6 +44,7 @@
 #include "ir/geom/MoveWalk.h"
 #include "passes/FeatureWalls.h"
 #include "passes/InProcessStock.h"
+#include "passes/VerifyTurning.h"
 #include "support/Format.h"
 
 #include <algorithm>
@@ -305,7 +306,7 @@ private:
     double secplane = 0;
     std::string lastTool;
     for (const ir::Node *e : ir::programOrder(module_)) {
-      const ir::Node *moves = e->child(ir::Kind::Moves);
+      const ir::Node *moves = ir::millingMoves(*e);
       if (!moves)
         continue;
       const std::string tool = moves->text("tool").value_or("");
@@ -400,7 +401,7 @@ private:
     for (ir::Node &c : n.children) {
       if (c.kind == ir::Kind::Workplan)
         visit(c);
-      else if (c.kind == ir::Kind::Workingstep || c.kind == ir::Kind::RapidMovement)
+      else if ((c.kind == ir::Kind::Workingstep || c.kind == ir::Kind::RapidMovement) && !ir::isTurningStep(c))
         for (ir::Node &m : c.children)
           if (m.kind == ir::Kind::Moves)
             verify(c, m);
@@ -1163,9 +1164,11 @@ public:
   std::string_view name() const override { return "verify-toolpaths"; }
 
   PassResult run(ir::Module &module, DiagnosticEngine &diags, PassStats &stats) override {
-    if (!ir::requireThreeAxisMilling(module, "verify-toolpaths", diags, ir::ArcPlanes::Principal))
+    if (!ir::requireThreeAxisMilling(module, "verify-toolpaths", diags, ir::ArcPlanes::Principal, ir::TurningSteps::Skip))
       return {false, false};
-    return ToolpathChecker(module, diags, stats, tolerance_).run();
+    PassResult milling = ToolpathChecker(module, diags, stats, tolerance_).run();
+    const bool turning = verifyTurning(module, diags, stats, tolerance_);
+    return {milling.ok && turning, milling.changed};
   }
 
 private:

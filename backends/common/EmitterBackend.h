@@ -8,8 +8,10 @@
 #pragma once
 
 #include "backends/Backend.h"
+#include "backends/common/LatheEmitter.h"
 #include "backends/common/Program.h"
 #include "backends/common/ReadBack.h"
+#include "ir/Program.h"
 #include "support/Format.h"
 
 #include <cmath>
@@ -24,6 +26,21 @@ public:
                                   DiagnosticEngine &diags) override {
     if (!holdsTolerance(options, diags))
       return std::nullopt;
+    if (hasTurningSteps(module)) {
+      // A lathe program, from the dialect's lathe emitter where it has one.
+      if constexpr (requires { Emitter::lathe(module, descriptor(), options, diags); }) {
+        return Emitter::lathe(module, descriptor(), options, diags);
+      } else {
+        for (const ir::Node *e : ir::programOrder(module))
+          if (ir::isTurningStep(*e)) {
+            diags.error(e->origin.loc, "workingstep " + e->symbol + " turns: " + descriptor().name +
+                                           " does not write lathe programs (docs/turning.md: rs274 does)")
+                .entity(e->origin.entityId);
+            break;
+          }
+        return std::nullopt;
+      }
+    }
     std::optional<Program> program =
         buildProgram(module, options.toolTable, diags,
                      descriptor().arcPlanes ? ir::OutOfPlaneArcs::Exact : ir::OutOfPlaneArcs::Chords);

@@ -120,13 +120,7 @@ std::string IsoEmitter::spindle(double rpm) const {
   return word("S", formatNumber(std::abs(rpm), {d_.speedDecimals, false, false})) + (rpm < 0 ? " M3" : " M4");
 }
 
-std::string IsoEmitter::coolant(const std::string &mode) const {
-  if (mode == "flood" || mode == "through_tool")
-    return "M8";
-  if (mode == "mist")
-    return "M7";
-  return "M9";
-}
+std::string IsoEmitter::coolant(const std::string &mode) const { return coolantWord(mode); }
 
 std::string IsoEmitter::radiusWord(double signedRadius) const { return word("R", num(signedRadius)); }
 

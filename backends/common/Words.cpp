@@ -113,4 +113,12 @@ std::vector<geom::Vec2> arcSplitPoints(const geom::Vec2 &from, const geom::Vec2 
   return out;
 }
 
+std::string coolantWord(const std::string &mode) {
+  if (mode == "flood" || mode == "through_tool")
+    return "M8";
+  if (mode == "mist")
+    return "M7";
+  return "M9";
+}
+
 } // namespace stepnc::backends

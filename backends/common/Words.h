@@ -68,6 +68,10 @@ private:
   std::map<std::string, std::string> last_;
 };
 
+/// The ISO 6983 coolant word for a coolant mode: M8 (flood, through the
+/// tool), M7 (mist), M9 (off).
+std::string coolantWord(const std::string &mode);
+
 /// The centre's offset from `from` (I J), rounded to `decimals`, choosing
 /// among the neighbouring rounded values the one whose start and end radius
 /// (to the printed `from` and `to`) differ least: rounding I and J alone

@@ -5,6 +5,7 @@
 #include "backends/common/EmitterBackend.h"
 #include "backends/common/IsoEmitter.h"
 #include "backends/common/IsoReader.h"
+#include "backends/common/LatheEmitter.h"
 
 #include <cmath>
 
@@ -36,20 +37,25 @@ TargetDescriptor rs274Descriptor() {
   return d;
 }
 
+/// A comment block: parentheses end a comment, so the text keeps to what one may hold.
+std::string rs274Comment(const std::string &text) {
+  std::string t;
+  for (char c : text)
+    t += c == '(' || c == ')' ? '_' : c;
+  return "(" + t + ")";
+}
+
 class Rs274Emitter final : public IsoEmitter {
 public:
   using IsoEmitter::IsoEmitter;
 
   static ProgramReading read(const std::string &text, const TargetDescriptor &d) { return readRs274(text, d); }
 
+  static std::optional<std::string> lathe(const ir::Module &module, const TargetDescriptor &d, const EmitOptions &o,
+                                          DiagnosticEngine &diags);
+
 private:
-  std::string comment(const std::string &text) const override {
-    // Parentheses end a comment: keep the text to what a comment may hold.
-    std::string t;
-    for (char c : text)
-      t += c == '(' || c == ')' ? '_' : c;
-    return "(" + t + ")";
-  }
+  std::string comment(const std::string &text) const override { return rs274Comment(text); }
 
   void header(const Program &p) override {
     out_.raw("%");
@@ -153,6 +159,44 @@ private:
 
   bool stickyDwell_ = false;  ///< an earlier cycle set P, which LinuxCNC keeps
 };
+
+/// LinuxCNC lathe programs (docs/turning.md): G18, diameter mode G7,
+/// G96 D S with G95 feeds per revolution (LinuxCNC's lathe words, as its
+/// g-code reference gives them).
+class Rs274LatheEmitter final : public LatheEmitter {
+public:
+  using LatheEmitter::LatheEmitter;
+
+private:
+  std::string comment(const std::string &text) const override { return rs274Comment(text); }
+  void preamble() override {
+    out_.block("G18 G7 G21 G90 G40 G80");
+    out_.block("G64 " + word("P", num(o_.tolerance.value_or(d_.tolerance))));
+  }
+  void postamble() override {
+    out_.block("M5 M9");
+    out_.block("M2");
+  }
+  void toolChange(int number) override {
+    out_.block(word("T", std::to_string(number)) + " M6");
+    out_.block("G43 H" + std::to_string(number));
+  }
+  std::string surfaceSpeed(double metresPerMinute, double maxRpm, bool clockwise) const override {
+    return "G96 " + word("D", formatNumber(maxRpm, {0, false, false})) + " " +
+           word("S", formatNumber(metresPerMinute, {1, false, false})) + (clockwise ? " M3" : " M4");
+  }
+  std::string spindleSpeed(double rpm) const override {
+    return "G97 " + word("S", formatNumber(std::abs(rpm), {0, false, false})) + (rpm < 0 ? " M3" : " M4");
+  }
+  std::string feedMode(bool perRevolution) const override { return perRevolution ? "G95" : "G94"; }
+  std::string dwell(double seconds) const override { return "G4 " + word("P", formatNumber(seconds, {3, false, true})); }
+  void message(const std::string &text) override { out_.block(comment("MSG," + text)); }
+};
+
+std::optional<std::string> Rs274Emitter::lathe(const ir::Module &module, const TargetDescriptor &d,
+                                               const EmitOptions &o, DiagnosticEngine &diags) {
+  return Rs274LatheEmitter(d, o, diags).run(module);
+}
 
 } // namespace
 

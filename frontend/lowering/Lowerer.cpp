@@ -224,6 +224,34 @@ std::optional<std::string> Lowerer::workpiece(const Instance &wp) {
       if (auto p = placement(bounding.ref("position")))
         setPlacement(raw, *p);
       node.add(std::move(raw));
+    } else if (bounding.isA("right_circular_cylinder")) {
+      // A bar for turning: its axis1_placement's location and axis, its
+      // height along the axis and its radius.
+      Node raw(ir::Kind::Rawpiece);
+      stamp(raw, bounding, "");
+      raw.set("shape", Value::word("cylinder"));
+      auto r = bounding.real("radius"), h = bounding.real("height");
+      if (r && h) {
+        raw.set("diameter", Value::length(2 * *r));
+        raw.set("height", Value::length(*h));
+      } else {
+        missing(bounding, !r ? "radius" : "height");
+      }
+      Placement p;
+      if (Instance a = bounding.ref("position")) {
+        if (Instance location = a.ref("location"))
+          if (auto at = point(location))
+            p.at = *at;
+        if (Instance axis = a.ref("axis"))
+          if (auto v = direction(axis))
+            p.axis = *v;
+        p.ref = std::abs(p.axis.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY();
+        p.ref = (p.ref - p.ref.dot(p.axis) * p.axis).normalized();
+      } else {
+        missing(bounding, "position");
+      }
+      setPlacement(raw, p);
+      node.add(std::move(raw));
     } else {
       unsupported(bounding, "raw piece shape");
     }

@@ -72,16 +72,6 @@ Selected select(const Node &op) {
   return {ir::Kind::Strategy, op.child(ir::Kind::Strategy)};
 }
 
-std::string coolant(const Node &op) {
-  const Node *mf = op.child(ir::Kind::MachineFunctions);
-  if (!mf)
-    return "off";
-  if (mf->flag("through_spindle_coolant").value_or(false))
-    return "through_tool";
-  if (mf->flag("mist").value_or(false))
-    return "mist";
-  return mf->flag("coolant").value_or(false) ? "flood" : "off";
-}
 
 /// Warns where the operation's approach or retract is not what `family`'s
 /// moves do, saying what they do instead.
@@ -102,6 +92,17 @@ void reportApproachRetract(Expander &x, const Step &step, const Family &family) 
 }
 
 } // namespace
+
+std::string coolant(const Node &op) {
+  const Node *mf = op.child(ir::Kind::MachineFunctions);
+  if (!mf)
+    return "off";
+  if (mf->flag("through_spindle_coolant").value_or(false))
+    return "through_tool";
+  if (mf->flag("mist").value_or(false))
+    return "mist";
+  return mf->flag("coolant").value_or(false) ? "flood" : "off";
+}
 
 const Family *findFamily(ir::Kind key) {
   for (const Family &f : kFamilies)
@@ -175,6 +176,7 @@ public:
     x_.stats = &stats;
     x_.result = {};
     x_.explicitRuns.clear();
+    x_.turnedStock.clear();
     // Workingsteps in the branches of control flow too: each branch is a
     // program of its own, which a target with control flow writes as such.
     leftOut_.clear();
@@ -200,11 +202,13 @@ private:
     const Node *op = ir::operationOf(ws);
     if (!op)
       return;
-    if (op->is(ir::Trait::Turning) || op->is(ir::Trait::Additive)) {
-      x_.report(ws, std::string("its operation ") + op->kindName() + " '" + op->label + "' is a " +
-                        (op->is(ir::Trait::Turning) ? "turning" : "deposition") +
-                        " operation: stepnc does not compile its process yet (" +
-                        (op->is(ir::Trait::Turning) ? "docs/turning.md" : "docs/ir.md") + ")");
+    if (op->is(ir::Trait::Turning)) {
+      expandTurning(x_, ws, *op, setup);
+      return;
+    }
+    if (op->is(ir::Trait::Additive)) {
+      x_.report(ws, std::string("its operation ") + op->kindName() + " '" + op->label +
+                        "' is a deposition operation: stepnc does not compile its process yet (docs/ir.md)");
       return;
     }
     const Node *feature = ir::findFeature(*x_.module, ws.text("feature").value_or(""));

@@ -129,6 +129,9 @@ public:
   std::string lastCoolant = "off";
   /// The paths the file gives, by executable.
   std::map<const Node *, ExplicitRun> explicitRuns;
+  /// The stock of each turned workpiece (by symbol) in the half plane of
+  /// its turning axis, as the lathe steps so far left it (Turning.cpp).
+  std::map<std::string, Region> turnedStock;
 
   /// Gives executable `ws` its moves and counts them.
   void attach(Node &ws, Node moves);
@@ -215,6 +218,12 @@ bool expandMilling2D(Expander &x, const Step &step);
 bool expandSlotLevels(Expander &x, const Step &step);
 /// PatternStrategies.cpp: trochoids along the guide strategy's paths.
 bool expandTrochoidal(Expander &x, const Step &step);
+/// Turning.cpp: the lathe moves of a turning workingstep, from its turned
+/// feature and the stock the steps before left; false after a diagnostic.
+bool expandTurning(Expander &x, Node &ws, const Node &op, const std::string &setup);
+/// Expand.cpp: the coolant an operation's machine functions ask for (off,
+/// flood, mist, through_tool).
+std::string coolant(const Node &op);
 /// PatternStrategies.cpp: plunges along the guide strategy's paths.
 bool expandPlunging(Expander &x, const Step &step);
 

@@ -56,7 +56,8 @@ def read_moves(path):
     """Every move of every `moves` block (those of its canned cycles in place),
     in order, each a dict: kind (rapid, linear, arc, dwell), start and to (x,
     y, z; the first move starts at the origin, as the program model has it),
-    feed (mm/min, feed moves only), line (in the file) and text; arcs also
+    feed (mm/min, feed moves only; a lathe's feed per revolution in mm/rev,
+    with per_rev set), line (in the file) and text; arcs also
     plane ('xy', 'zx', 'yz'), centre (in the plane's coordinates: x, y in XY),
     ccw (seen from the plane's normal), turns, radius and sweep (radians,
     full turns included); dwells their time (s), where the tool is."""
@@ -76,6 +77,9 @@ def read_moves(path):
             move = {"kind": m.group(1), "start": pos, "to": point(attrs["to"]), "line": n, "text": code.strip()}
             if "feed" in attrs:
                 move["feed"] = float(attrs["feed"].replace("mm/min", ""))
+            elif "feed_per_rev" in attrs:
+                move["feed"] = float(attrs["feed_per_rev"].replace("mm/rev", ""))
+                move["per_rev"] = True
             if move["kind"] == "arc":
                 plane, positive = plane_of(point(attrs["normal"])) if "normal" in attrs else ("xy", True)
                 centre = local(point(attrs["center"]), plane)[:2]

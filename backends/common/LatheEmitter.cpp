@@ -1,0 +1,203 @@
+#include "backends/common/LatheEmitter.h"
+
+#include "backends/common/ToolTable.h"
+#include "ir/Program.h"
+#include "support/Format.h"
+
+#include <cmath>
+
+namespace stepnc::backends {
+
+bool hasTurningSteps(const ir::Module &module) {
+  for (const ir::Node *e : ir::programOrder(module))
+    if (ir::isTurningStep(*e))
+      return true;
+  return false;
+}
+
+std::string LatheEmitter::coolant(const std::string &mode) const { return coolantWord(mode); }
+
+double LatheEmitter::readX(double radius) const {
+  return diameterMode() ? roundTo(2 * radius, d_.coordDecimals) / 2 : roundTo(radius, d_.coordDecimals);
+}
+
+std::string LatheEmitter::xWord(double radius) const { return word("X", num(diameterMode() ? 2 * radius : radius)); }
+
+int LatheEmitter::toolNumber(const ir::Node &tool) {
+  if (auto it = numbers_.find(tool.symbol); it != numbers_.end())
+    return it->second;
+  int n = 0;
+  if (o_.toolTable) {
+    const ToolTable::Entry *e = o_.toolTable->find(tool);
+    if (!e) {
+      diags_.error(tool.origin.loc, "tool " + tool.symbol + " (" + tool.label + ") is not in the tool table " +
+                                        o_.toolTable->name())
+          .entity(tool.origin.entityId);
+      ok_ = false;
+      return 0;
+    }
+    n = e->number;
+  } else {
+    n = nextNumber_++;
+  }
+  numbers_[tool.symbol] = n;
+  return n;
+}
+
+std::optional<std::string> LatheEmitter::run(const ir::Module &module) {
+  out_.raw("%");
+  const ir::Node &root = module.root;
+  out_.block(comment("stepnc: " + root.label + " from " + o_.source));
+  out_.block(comment("target " + d_.name + (o_.optionsText.empty() ? "" : ", options " + o_.optionsText)));
+  out_.block(comment(std::string("lathe program: X is the ") + (diameterMode() ? "diameter" : "radius") +
+                     ", Z along the spindle axis; feeds mm/rev, cutting speeds m/min, spindle rev/min"));
+  out_.block(comment("coordinates are the workpiece's: X0 on the spindle axis; set the work offset's Z to the "
+                     "workpiece's origin"));
+  out_.block(comment("moves stepnc plans program each insert's imaginary tip (its chuck-side corner), touched off "
+                     "on X and Z, with the nose radius in the path (G40); toolpaths the file gives are written as "
+                     "given"));
+  out_.block(comment(o_.toolTable ? "tool numbers from the tool table" : "no tool table: tools numbered in order "
+                                                                         "of first use"));
+  // The tools, numbered in order of first use (or by the table).
+  for (const ir::Node *e : ir::programOrder(module))
+    if (const ir::Node *moves = e->child(ir::Kind::Moves))
+      if (const ir::Node *tool = ir::findTool(module, moves->text("tool").value_or("")); tool && ir::isTurningStep(*e))
+        if (!numbers_.count(tool->symbol)) {
+          const int n = toolNumber(*tool);
+          out_.block(comment(word("T", std::to_string(n)) + " " + tool->label + ", " +
+                             tool->text("type").value_or("") + ", corner radius " +
+                             formatFixed(tool->number("corner_radius").value_or(0), 3) + " mm" +
+                             (tool->has("cutting_width")
+                                  ? ", width " + formatFixed(*tool->number("cutting_width"), 3) + " mm"
+                                  : std::string())));
+        }
+  if (!ok_)
+    return std::nullopt;
+  preamble();
+  for (const ir::Node *e : ir::programOrder(module)) {
+    switch (e->kind) {
+    case ir::Kind::DisplayMessage: message(e->text("message").value_or(e->label)); break;
+    case ir::Kind::ProgramStop: out_.block(stop(false)); break;
+    case ir::Kind::OptionalStop: out_.block(stop(true)); break;
+    case ir::Kind::Workingstep:
+      if (!ir::isTurningStep(*e)) {
+        diags_.error(e->origin.loc, "workingstep " + e->symbol + " mills or drills, in a lathe program: " + d_.name +
+                                        " does not write turning and milling in one program yet (docs/turning.md)")
+            .entity(e->origin.entityId);
+        return std::nullopt;
+      }
+      if (const ir::Node *moves = e->child(ir::Kind::Moves))
+        step(module, *e, *moves);
+      break;
+    default:
+      diags_.error(e->origin.loc, e->kindName() + " " + e->symbol + " in a lathe program: " + d_.name +
+                                      " does not write it there yet (docs/turning.md)")
+          .entity(e->origin.entityId);
+      return std::nullopt;
+    }
+    if (!ok_)
+      return std::nullopt;
+  }
+  postamble();
+  out_.raw("%");
+  if (!out_.overlong().empty()) {
+    diags_.error(SourceLoc{}, "line " + std::to_string(out_.overlong().front()) + " of the " + d_.name +
+                                  " program is longer than the controller reads");
+    return std::nullopt;
+  }
+  return out_.text();
+}
+
+void LatheEmitter::step(const ir::Module &module, const ir::Node &ws, const ir::Node &moves) {
+  out_.block(comment(ws.label.empty() ? ws.symbol : ws.label));
+  const ir::Node *tool = ir::findTool(module, moves.text("tool").value_or(""));
+  if (!tool)
+    return;
+  if (tool_ != tool->symbol) {
+    toolChange(toolNumber(*tool));
+    tool_ = tool->symbol;
+    modal_.clear();
+    spindleWords_.clear();
+  }
+  // The spindle: the step's constant surface speed, else its speed.
+  const double rpm = moves.number("spindle").value_or(0);
+  std::string spindle;
+  for (const ir::Node &c : moves.children)
+    if (c.kind == ir::Kind::State && c.has("surface_speed")) {
+      spindle = surfaceSpeed(*c.number("surface_speed") / 1000, c.number("spindle_max").value_or(0), rpm < 0);
+      break;
+    }
+  if (spindle.empty())
+    spindle = spindleSpeed(rpm);
+  if (spindle != spindleWords_) {
+    out_.block(spindle);
+    spindleWords_ = spindle;
+  }
+  const std::string cool = moves.text("coolant").value_or("off");
+  if (cool != coolant_) {
+    out_.block(coolant(cool));
+    coolant_ = cool;
+  }
+  for (const ir::Move &m : ir::walkMoves(moves, std::nullopt, ir::PathKind::Programmed, ir::OutOfPlaneArcs::Exact))
+    move(m);
+}
+
+void LatheEmitter::move(const ir::Move &m) {
+  if (m.kind == ir::MoveKind::Dwell) {
+    out_.block(dwell(m.dwell));
+    return;
+  }
+  std::string text;
+  auto axis = [&](const std::string &name, const std::string &value) {
+    if (modal_.change(name, value))
+      text += (text.empty() ? "" : " ") + word(name, value);
+  };
+  const std::string x = xWord(m.to.x()).substr(1), z = num(m.to.z());
+  if (m.kind == ir::MoveKind::Rapid) {
+    if (modal_.change("G", "0"))
+      text = "G0";
+    axis("X", x);
+    axis("Z", z);
+    if (text != "G0" && !text.empty())
+      out_.block(text);
+    else if (text == "G0")
+      modal_.forget("G");  // nothing moved: the next move says its own G
+    return;
+  }
+  const double perRev = m.node ? m.node->number("feed_per_rev").value_or(0) : 0;
+  const bool byRev = perRev > 0;
+  if (!perRev_ || *perRev_ != byRev) {
+    out_.block(feedMode(byRev));
+    perRev_ = byRev;
+    modal_.forget("F");
+  }
+  const double f = byRev ? perRev : m.feed;
+  if (m.kind == ir::MoveKind::Arc) {
+    // In the ZX plane (G18): I the radius offset of the centre, K its z offset, from the start as read.
+    const geom::Vec2 from(readX(m.from->x()), roundTo(m.from->z(), d_.coordDecimals));
+    const geom::Vec2 to(readX(m.to.x()), roundTo(m.to.z(), d_.coordDecimals));
+    const geom::Vec2 centre(m.center.x(), m.center.z());
+    const geom::Vec2 ik = roundedCentreOffset(from, to, centre, d_.coordDecimals);
+    // Counter-clockwise seen from +y in (z, x) is G3.
+    const bool g3 = m.ccw;
+    modal_.change("G", g3 ? "3" : "2");
+    text = g3 ? "G3" : "G2";
+    modal_.forget("X");
+    modal_.forget("Z");
+    axis("X", x);
+    axis("Z", z);
+    text += " " + word("I", num(ik.x())) + " " + word("K", num(ik.y()));
+  } else {
+    if (modal_.change("G", "1"))
+      text = "G1";
+    axis("X", x);
+    axis("Z", z);
+  }
+  const std::string fw = formatNumber(f, {byRev ? 4 : d_.feedDecimals, false, true});
+  if (modal_.change("F", fw))
+    text += (text.empty() ? "" : " ") + word("F", fw);
+  if (!text.empty() && text != "G1")
+    out_.block(text);
+}
+
+} // namespace stepnc::backends

@@ -1,0 +1,289 @@
+#include "ir/geom/TurnedShape.h"
+
+#include "support/Format.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace stepnc::ir {
+
+using geom::Loop;
+using geom::Region;
+using geom::Seg;
+using geom::Vec2;
+
+namespace {
+
+constexpr double kDegree = std::numbers::pi / 180;
+/// How far off the axis a placement may lie and still be on it (mm).
+constexpr double kOnAxis = 1e-6;
+
+std::string named(const Node &n) { return n.kindName() + (n.symbol.empty() ? "" : " " + n.symbol); }
+
+/// The placement of a turned feature in the half plane, or why it has none.
+struct Placed {
+  Vec2 at = Vec2::Zero();
+  double sign = 1;
+};
+
+std::optional<Placed> placedOnAxis(const Node &n, std::string &error) {
+  const Vec3 at = n.vec("at").value_or(Vec3::Zero());
+  const Vec3 axis = n.vec("axis").value_or(Vec3::UnitZ());
+  if (std::abs(at.x()) > kOnAxis || std::abs(at.y()) > kOnAxis) {
+    error = named(n) + " is placed at " + formatTuple({at.x(), at.y(), at.z()}, 4) +
+            " mm, off the turning axis (the workpiece's z axis): only features on it are turned";
+    return std::nullopt;
+  }
+  if (std::abs(std::abs(axis.z()) - 1) > 1e-9) {
+    error = named(n) + " has its axis along " + formatTuple({axis.x(), axis.y(), axis.z()}, 6) +
+            ": a turned feature's axis is the turning axis (the workpiece's z axis, either way)";
+    return std::nullopt;
+  }
+  return Placed{Vec2(at.z(), 0), axis.z() > 0 ? 1.0 : -1.0};
+}
+
+/// A loop through the points in order, counter-clockwise whichever way they are given.
+Loop ccwPolygon(const std::vector<Vec2> &pts) {
+  Loop l = geom::polygon(pts);
+  if (l.area() < 0) {
+    std::vector<Vec2> back(pts.rbegin(), pts.rend());
+    l = geom::polygon(back);
+  }
+  return l;
+}
+
+} // namespace
+
+Region TurnStock::region() const { return Region{{ccwPolygon({{z0, 0}, {z1, 0}, {z1, radius}, {z0, radius}})}}; }
+
+StockResult turnStock(const Node *workpiece) {
+  if (!workpiece)
+    return {std::nullopt, "the feature belongs to no workpiece"};
+  const Node *raw = workpiece->child(ir::Kind::Rawpiece);
+  if (!raw)
+    return {std::nullopt, "workpiece " + workpiece->symbol +
+                              " has no raw piece: turning needs the bar it starts from (a right_circular_cylinder "
+                              "as its raw piece's bounding geometry)"};
+  if (raw->text("shape") != "cylinder")
+    return {std::nullopt, "the raw piece of workpiece " + workpiece->symbol + " is a " +
+                              raw->text("shape").value_or("?") + ": turning takes a cylinder about the z axis"};
+  std::string error;
+  const std::optional<Placed> p = placedOnAxis(*raw, error);
+  if (!p)
+    return {std::nullopt, "the raw piece of workpiece " + workpiece->symbol + ": " + error};
+  const double d = raw->number("diameter").value_or(0), h = raw->number("height").value_or(0);
+  if (d <= 0 || h <= 0)
+    return {std::nullopt, "the raw piece of workpiece " + workpiece->symbol + " has no diameter or height"};
+  TurnStock s;
+  s.z0 = std::min(p->at.x(), p->at.x() + p->sign * h);
+  s.z1 = std::max(p->at.x(), p->at.x() + p->sign * h);
+  s.radius = d / 2;
+  return {s, {}};
+}
+
+namespace {
+
+class Builder {
+public:
+  Builder(const Node &f, const TurnStock &stock, double margin)
+      : f_(f), reachR_(stock.radius + margin), reachZ_(stock.z1 + margin) {}
+
+  TurnedShapeResult build() {
+    const std::optional<Placed> p = placedOnAxis(f_, error_);
+    if (!p)
+      return fail();
+    s_.symbol = f_.symbol;
+    s_.kind = f_.kind;
+    s_.at = p->at;
+    s_.axisSign = p->sign;
+    switch (f_.kind) {
+    case Kind::OuterDiameter: return outerDiameter(*p) ? ok() : fail();
+    case Kind::OuterDiameterToShoulder: return toShoulder(*p) ? ok() : fail();
+    case Kind::RevolvedFlat: return revolvedFlat(*p) ? ok() : fail();
+    case Kind::Groove: return groove(*p) ? ok() : fail();
+    default:
+      error_ = named(f_) + " has no turned shape in stepnc yet (docs/turning.md lists the features turned)";
+      return fail();
+    }
+  }
+
+private:
+  TurnedShapeResult ok() { return {std::move(s_), {}}; }
+  TurnedShapeResult fail() { return {std::nullopt, error_}; }
+
+  /// The material outside a surface running from the free end towards the
+  /// chuck along `wall` (its points from high z to low z), up to the reach.
+  /// The surface continues at the chuck end straight out to the reach (a
+  /// shoulder or the chuck); at the free end it runs on to the reach along z.
+  void outside(const std::vector<Vec2> &wall) {
+    std::vector<Vec2> pts;
+    pts.emplace_back(reachZ_, wall.front().y());
+    for (const Vec2 &q : wall)
+      pts.push_back(q);
+    pts.emplace_back(wall.back().x(), reachR_);
+    pts.emplace_back(reachZ_, reachR_);
+    s_.removal = Region{{ccwPolygon(pts)}};
+  }
+
+  bool outerDiameter(const Placed &p) {
+    const double d = f_.number("diameter").value_or(0), length = f_.number("length").value_or(0);
+    double r0 = d / 2, r1 = r0;
+    if (auto reduced = f_.number("reduced_diameter"))
+      r1 = *reduced / 2;
+    else if (auto taper = f_.number("taper_angle"))
+      r1 = r0 - length * std::tan(*taper * kDegree);
+    if (r0 <= 0 || length <= 0 || r1 <= 0) {
+      error_ = named(f_) + ": its diameter " + formatFixed(d, 4) + " mm over " + formatFixed(length, 4) +
+               " mm tapers to " + formatFixed(2 * r1, 4) + " mm: no turned surface";
+      return false;
+    }
+    // From the placement along its axis; the end nearer the free end (the
+    // higher z) is open: what lies beyond it is another feature's.
+    Vec2 a(p.at.x(), r0), b(p.at.x() + p.sign * length, r1);
+    if (a.x() < b.x())
+      std::swap(a, b);
+    // Beyond the high end the surface runs on at its radius: conservative
+    // (the step cuts nothing inside it there), and open for the tool.
+    outside({a, b});
+    s_.contour = {Seg::line(Vec2(reachZ_, a.y()), a), Seg::line(a, b), Seg::line(b, Vec2(b.x(), reachR_))};
+    return true;
+  }
+
+  bool toShoulder(const Placed &p) {
+    const double r = f_.number("diameter").value_or(0) / 2;
+    if (r <= 0) {
+      error_ = named(f_) + " has no diameter";
+      return false;
+    }
+    double fillet = 0;
+    if (const Node *vee = f_.child(Kind::VeeProfile)) {
+      fillet = vee->number("profile_radius").value_or(0);
+      const double angle = vee->number("profile_angle").value_or(90);
+      const double tilt = vee->number("tilt_angle").value_or(0);
+      if (std::abs(angle - 90) > 1e-9 || std::abs(tilt) > 1e-9) {
+        error_ = named(f_) + ": a shoulder at " + formatTrimmed(angle, 4) + " deg tilted " + formatTrimmed(tilt, 4) +
+                 " deg is not turned yet (square shoulders only: profile_angle 90, tilt_angle 0)";
+        return false;
+      }
+    }
+    if (p.sign < 0) {
+      error_ = named(f_) + " runs towards the chuck (its axis along -z): a diameter to a shoulder is turned from "
+                           "the free end (+z) towards its shoulder";
+      return false;
+    }
+    // From the free end along the diameter to the shoulder at the placement,
+    // round the fillet, up the shoulder face.
+    const double z0 = p.at.x();
+    const Vec2 start(reachZ_, r), corner(z0, r), up(z0, reachR_);
+    if (fillet > 0) {
+      const Vec2 c(z0 + fillet, r + fillet), t1(z0 + fillet, r), t2(z0, r + fillet);
+      Loop l;
+      l.segs = {Seg::line(t1, start), Seg::line(start, Vec2(reachZ_, reachR_)), Seg::line(Vec2(reachZ_, reachR_), up),
+                Seg::line(up, t2), Seg::arc(t2, t1, c, true)};
+      if (l.area() < 0)
+        l.segs = {};
+      s_.removal = Region{{l}};
+      s_.contour = {Seg::line(start, t1), Seg::arc(t1, t2, c, false), Seg::line(t2, up)};
+    } else {
+      s_.removal = Region{{ccwPolygon({start, corner, up, Vec2(reachZ_, reachR_)})}};
+      s_.contour = {Seg::line(start, corner), Seg::line(corner, up)};
+    }
+    return true;
+  }
+
+  bool revolvedFlat(const Placed &p) {
+    // A face across the axis at the placement, from `radius` out over its
+    // linear profile's length; the material is on `material_side` (along z).
+    const double inner = f_.number("radius").value_or(0);
+    const Node *prof = f_.child(Kind::LinearProfile);
+    const double extent = prof ? prof->number("length").value_or(0) : 0;
+    const Vec3 side = f_.vec("material_side").value_or(Vec3(0, 0, -p.sign));
+    if (std::abs(std::abs(side.z()) - 1) > 1e-9) {
+      error_ = named(f_) + ": its material side " + formatTuple({side.x(), side.y(), side.z()}, 6) +
+               " is not along the axis: a face across the axis has its material on one side of it";
+      return false;
+    }
+    if (side.z() > 0) {
+      error_ = named(f_) + " has its material on the free end's side (+z): only faces looking towards the free "
+                           "end are turned yet";
+      return false;
+    }
+    if (inner < 0 || extent <= 0) {
+      error_ = named(f_) + " needs its radius and a linear profile with a length (the face's radial extent)";
+      return false;
+    }
+    // Cleared from its inner radius out to the reach, whatever the profile's
+    // length: the tool comes in across the face from the outside.
+    const double z0 = p.at.x();
+    s_.removal = Region{{ccwPolygon({{z0, inner}, {reachZ_, inner}, {reachZ_, reachR_}, {z0, reachR_}})}};
+    s_.contour = {Seg::line(Vec2(z0, reachR_), Vec2(z0, inner))};
+    if (inner > 0)
+      s_.contour.push_back(Seg::line(Vec2(z0, inner), Vec2(reachZ_, inner)));
+    return true;
+  }
+
+  bool groove(const Placed &p) {
+    // An outer groove: its floor at `radius`, its square-U profile's width
+    // centred on the placement along the axis, open outwards.
+    const double floor = f_.number("radius").value_or(0);
+    const Vec3 side = f_.vec("material_side").value_or(Vec3(-1, 0, 0));
+    if (!(side.x() < -1 + 1e-9 && std::abs(side.z()) < 1e-9)) {
+      error_ = named(f_) + ": its material side " + formatTuple({side.x(), side.y(), side.z()}, 6) +
+               " is not towards the axis: only outer grooves are turned yet";
+      return false;
+    }
+    const Node *u = f_.child(Kind::SquareUProfile);
+    if (!u) {
+      error_ = named(f_) + ": only grooves with a square_u_profile are turned yet";
+      return false;
+    }
+    const double w = u->number("width").value_or(0);
+    const double r1 = u->number("first_radius").value_or(0), r2 = u->number("second_radius").value_or(0);
+    for (const char *a : {"first_angle", "second_angle"})
+      if (auto angle = u->number(a); angle && std::abs(*angle - 90) > 1e-9) {
+        error_ = named(f_) + ": a groove wall at " + formatTrimmed(*angle, 4) +
+                 " deg is not turned yet (square walls only)";
+        return false;
+      }
+    if (floor <= 0 || w <= 0 || r1 < 0 || r2 < 0 || r1 + r2 > w + 1e-9) {
+      error_ = named(f_) + ": its floor radius " + formatFixed(floor, 4) + " mm and width " + formatFixed(w, 4) +
+               " mm (corner radii " + formatFixed(r1, 4) + " and " + formatFixed(r2, 4) + " mm) make no groove";
+      return false;
+    }
+    const double lo = p.at.x() - w / 2, hi = p.at.x() + w / 2;
+    // Walls from the reach down to the floor, round the corners (r1 at the
+    // low z wall, r2 at the high), along the floor.
+    Loop l;
+    const Vec2 topLo(lo, reachR_), topHi(hi, reachR_);
+    std::vector<Seg> path;
+    path.push_back(Seg::line(topLo, Vec2(lo, floor + r1)));
+    if (r1 > 0)
+      path.push_back(Seg::arc(Vec2(lo, floor + r1), Vec2(lo + r1, floor), Vec2(lo + r1, floor + r1), true));
+    path.push_back(Seg::line(Vec2(lo + r1, floor), Vec2(hi - r2, floor)));
+    if (r2 > 0)
+      path.push_back(Seg::arc(Vec2(hi - r2, floor), Vec2(hi, floor + r2), Vec2(hi - r2, floor + r2), true));
+    path.push_back(Seg::line(Vec2(hi, floor + r2), topHi));
+    std::erase_if(path, [](const Seg &s) { return (s.b - s.a).norm() <= geom::kEps && !s.isArc(); });
+    l.segs = path;
+    l.segs.push_back(Seg::line(topHi, topLo));
+    s_.removal = Region{{l}};
+    s_.contour = path;  // from the low z wall's top round to the high one's
+    s_.grooveSpan = {lo, hi};
+    s_.grooveFloor = floor;
+    return true;
+  }
+
+  const Node &f_;
+  double reachR_, reachZ_;
+  TurnedShape s_;
+  std::string error_;
+};
+
+} // namespace
+
+TurnedShapeResult turnedShape(const Node &feature, const TurnStock &stock, double margin) {
+  return Builder(feature, stock, margin).build();
+}
+
+} // namespace stepnc::ir

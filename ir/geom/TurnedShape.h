@@ -1,0 +1,74 @@
+// What a turned feature is in the half plane of its turning axis: the
+// material its machining removes and the finished surface it leaves, in
+// coordinates (z, r) — z along the workpiece's z axis (the spindle axis),
+// r the distance from it. Turning expansion cuts this shape and the lathe
+// toolpath check measures moves against it; it is the one piece of
+// interpretation the two share (docs/turning.md says how each ISO 14649-12
+// attribute is read), so it is tested on its own.
+//
+// The turning axis is the workpiece's z axis; a feature placed off it, or
+// with its axis across it, is reported as not supported.
+#pragma once
+
+#include "geom/Geometry.h"
+#include "ir/Node.h"
+#include "ir/Program.h"
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace stepnc::ir {
+
+/// A point of the half plane: x() is z along the axis, y() the radius.
+using HalfPlanePoint = geom::Vec2;
+
+/// The workpiece's cylindrical raw piece in the half plane: a rectangle from
+/// `z0` (the chuck side, the lower z) to `z1`, from the axis to `radius`.
+struct TurnStock {
+  double z0 = 0, z1 = 0, radius = 0;
+  geom::Region region() const;
+};
+
+struct StockResult {
+  std::optional<TurnStock> stock;
+  std::string error;  ///< why there is none
+};
+
+/// The raw piece of `workpiece` as a lathe holds it: a cylinder about the z
+/// axis (`rawpiece shape=cylinder`, axis ±z through x = y = 0).
+StockResult turnStock(const ir::Node *workpiece);
+
+struct TurnedShape {
+  std::string symbol;
+  ir::Kind kind = ir::Kind::OuterDiameter;
+  /// The material the feature's machining removes: bounded by the finished
+  /// surface on the part's side and, elsewhere, reaching `reach` (past the
+  /// stock's radius and its free end), so that nothing limits the tool there.
+  geom::Region removal;
+  /// The finished surface: an open chain along the part, in the order a
+  /// finishing pass follows it (from the free end towards the chuck, or
+  /// from the outside in for a face). Every segment lies on the
+  /// boundary of `removal`.
+  std::vector<geom::Seg> contour;
+  /// A groove's extent along the axis and its floor radius (grooving
+  /// strategies plunge between the walls).
+  std::optional<std::pair<double, double>> grooveSpan;
+  double grooveFloor = 0;
+  /// Where the feature is placed (its placement's origin in the half plane)
+  /// and which way its axis runs along z (+1 or -1).
+  HalfPlanePoint at = HalfPlanePoint::Zero();
+  double axisSign = 1;
+};
+
+struct TurnedShapeResult {
+  std::optional<TurnedShape> shape;
+  std::string error;  ///< why the feature has no turned shape (not supported, missing data)
+};
+
+/// The turned shape of `feature` on a workpiece cut from `stock`: the
+/// window the removal reaches out to comes from the stock (its radius and
+/// free end, plus `margin`).
+TurnedShapeResult turnedShape(const ir::Node &feature, const TurnStock &stock, double margin = 10.0);
+
+} // namespace stepnc::ir

@@ -1,0 +1,294 @@
+// The lathe half of verify-toolpaths (see VerifyTurning.h).
+//
+// Everything happens in the half plane of the turning axis, points (z, r).
+// The part is the raw piece less what every turned feature of its workpiece
+// removes; the stock starts as the raw piece and loses what each feed move's
+// insert sweeps. The insert is a convex skeleton grown by its corner
+// radius: a turning insert's nose circle with its two cutting edges (the
+// side edge leaning from the radial direction by the side edge angle, the
+// end edge rising from the axis direction by the end edge angle, both as
+// long as the cutting edge); a grooving insert's two corners a cutting
+// width apart and its sides. The holder is not modelled. A tool past the
+// axis (r < 0) meets what lies at -r: the section of a body of revolution
+// is symmetric, so sweeps are mirrored before they meet the stock.
+//
+// Moves are read as written: their points are the chuck-side corner's
+// imaginary tip (docs/turning.md), the corner's centre a corner radius
+// further out in z and r.
+#include "passes/VerifyTurning.h"
+
+#include "geom/Boolean.h"
+#include "ir/Program.h"
+#include "ir/geom/MoveWalk.h"
+#include "ir/geom/TurnedShape.h"
+#include "support/Format.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <set>
+
+namespace stepnc::passes {
+
+namespace {
+
+using geom::Loop;
+using geom::Region;
+using geom::Seg;
+using geom::Vec2;
+using ir::Node;
+
+constexpr double kDegree = std::numbers::pi / 180;
+/// Edge length of an insert whose tool gives none (mm).
+constexpr double kDefaultEdge = 5.0;
+
+Vec2 halfPlane(const ir::Vec3 &p) { return {p.z(), p.x()}; }
+
+/// What a region swept in the half plane takes from material on both sides of the axis.
+Region folded(const Region &r) { return geom::unite(r, geom::mirroredAcrossX(r)); }
+
+/// Convex hull, counter-clockwise (Andrew's monotone chain).
+std::vector<Vec2> hull(std::vector<Vec2> p) {
+  std::sort(p.begin(), p.end(), [](const Vec2 &a, const Vec2 &b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
+  p.erase(std::unique(p.begin(), p.end(), [](const Vec2 &a, const Vec2 &b) { return (a - b).norm() < 1e-12; }),
+          p.end());
+  if (p.size() < 3)
+    return p;
+  std::vector<Vec2> h(2 * p.size());
+  size_t k = 0;
+  for (size_t i = 0; i < p.size(); ++i) {
+    while (k >= 2 && geom::cross(h[k - 1] - h[k - 2], p[i] - h[k - 2]) <= 1e-15)
+      --k;
+    h[k++] = p[i];
+  }
+  for (size_t i = p.size() - 1, t = k + 1; i > 0; --i) {
+    while (k >= t && geom::cross(h[k - 1] - h[k - 2], p[i - 1] - h[k - 2]) <= 1e-15)
+      --k;
+    h[k++] = p[i - 1];
+  }
+  h.resize(k - 1);
+  return h;
+}
+
+/// Material thicker than `t` somewhere in `r`.
+bool thick(const Region &r, double t) { return !r.empty() && !geom::offset(r, -t / 2).empty(); }
+
+std::string where(const Region &r) {
+  const geom::Box b = r.box();
+  return "z " + formatFixed(b.lo.x(), 3) + ".." + formatFixed(b.hi.x(), 3) + ", r " + formatFixed(std::max(b.lo.y(), 0.0), 3) +
+         ".." + formatFixed(b.hi.y(), 3) + " mm";
+}
+
+struct Insert {
+  std::vector<Vec2> skeleton;  ///< relative to the chuck-side corner's centre
+  double rc = 0;
+
+  /// The area the insert covers moving from `a` to `b` (corner centres).
+  Region sweep(const Vec2 &a, const Vec2 &b) const {
+    std::vector<Vec2> pts;
+    for (const Vec2 &s : skeleton) {
+      pts.push_back(a + s);
+      pts.push_back(b + s);
+    }
+    const std::vector<Vec2> h = hull(pts);
+    std::vector<Seg> edges;
+    Region body;
+    if (h.size() >= 3) {
+      body = Region{{geom::polygon(h)}};
+      for (size_t i = 0; i < h.size(); ++i)
+        edges.push_back(Seg::line(h[i], h[(i + 1) % h.size()]));
+    } else if (h.size() == 2) {
+      edges.push_back(Seg::line(h[0], h[1]));
+    } else if (!h.empty()) {
+      edges.push_back(Seg::line(h[0], h[0] + Vec2(1e-9, 0)));
+    }
+    if (rc <= 0)
+      return body;
+    const Region rounded = geom::sweptDisc(edges, rc);
+    return body.empty() ? rounded : geom::unite(body, rounded);
+  }
+};
+
+Insert insertOf(const Node &tool) {
+  Insert in;
+  in.rc = tool.number("corner_radius").value_or(0);
+  const double edge =
+      tool.number("cutting_edge_length").value_or(tool.number("max_cutting_depth").value_or(kDefaultEdge));
+  if (tool.text("type") == "grooving_tool") {
+    const double w = std::max(tool.number("cutting_width").value_or(2 * in.rc) - 2 * in.rc, 0.0);
+    const double depth = tool.number("max_cutting_depth").value_or(kDefaultEdge * 2);
+    in.skeleton = {Vec2(0, 0), Vec2(w, 0), Vec2(w, depth), Vec2(0, depth)};
+  } else {
+    const double side = tool.number("side_edge_angle").value_or(0) * kDegree;
+    const double end = tool.number("end_edge_angle").value_or(0) * kDegree;
+    in.skeleton = {Vec2(0, 0), Vec2(-std::sin(side), std::cos(side)) * edge, Vec2(std::cos(end), std::sin(end)) * edge};
+  }
+  return in;
+}
+
+struct Workpiece {
+  ir::TurnStock raw;
+  Region stock;
+  Region part;
+  Region chuck;
+};
+
+class Checker {
+public:
+  Checker(const ir::Module &m, DiagnosticEngine &d, PassStats &s, std::optional<double> t)
+      : module_(m), diags_(d), stats_(s), tolerance_(t) {}
+
+  bool run() {
+    for (const Node *e : ir::programOrder(module_))
+      if (ir::isTurningStep(*e))
+        if (const Node *moves = e->child(ir::Kind::Moves))
+          step(*e, *moves);
+    return ok_;
+  }
+
+private:
+  void error(const Node &ws, const std::string &message) {
+    diags_.error(ws.origin.loc, "workingstep " + ws.symbol + ": " + message).entity(ws.origin.entityId);
+    ok_ = false;
+  }
+
+  Workpiece *workpiece(const Node &ws, const Node &wp) {
+    if (auto it = pieces_.find(wp.symbol); it != pieces_.end())
+      return &it->second;
+    const ir::StockResult raw = ir::turnStock(&wp);
+    if (!raw.stock) {
+      // Nothing to check the moves against (an AP238 file that describes
+      // its bar in words): said once per workpiece.
+      if (unverified_.insert(wp.symbol).second)
+        diags_.warning(ws.origin.loc, "workingstep " + ws.symbol + ": lathe moves not verified: " + raw.error)
+            .entity(ws.origin.entityId);
+      return nullptr;
+    }
+    Workpiece w;
+    w.raw = *raw.stock;
+    w.stock = raw.stock->region();
+    std::vector<Region> removals;
+    for (const Node &f : wp.children)
+      if (f.category() == ir::Category::Feature && f.is(ir::Trait::Turning))
+        if (ir::TurnedShapeResult s = ir::turnedShape(f, w.raw); s.shape)
+          removals.push_back(s.shape->removal);
+    w.part = geom::subtract(w.stock, geom::uniteAll(removals));
+    w.chuck = Region{{geom::polygon({Vec2(w.raw.z0 - 1e4, -1e4), Vec2(w.raw.z0, -1e4), Vec2(w.raw.z0, 1e4),
+                                     Vec2(w.raw.z0 - 1e4, 1e4)})}};
+    return &pieces_.emplace(wp.symbol, std::move(w)).first->second;
+  }
+
+  void step(const Node &ws, const Node &moves) {
+    const Node *op = ir::operationOf(ws);
+    const Node *feature = ir::findFeature(module_, ws.text("feature").value_or(""));
+    const Node *tool = ir::findTool(module_, moves.text("tool").value_or(""));
+    const Node *wp = feature ? ir::workpieceOf(module_, *feature) : nullptr;
+    if (!op || !feature || !tool || !wp)
+      return;  // the IR verifier reports what is missing
+    Workpiece *w = workpiece(ws, *wp);
+    if (!w)
+      return;
+    const ir::TurnedShapeResult shape = ir::turnedShape(*feature, w->raw);
+    const bool pathsOnly = feature->kind == ir::Kind::ToolpathFeature;
+    if (!shape.shape && !pathsOnly) {
+      error(ws, shape.error);
+      return;
+    }
+    if (pathsOnly)
+      diags_.warning(ws.origin.loc, "workingstep " + ws.symbol + ": " + feature->symbol +
+                                        " gives only its toolpaths: its moves are checked against the stock only")
+          .entity(ws.origin.entityId);
+    const double t = tolerance_.value_or(wp->number("global_tolerance").value_or(0.01));
+    const double allowance = op->number("allowance").value_or(0);
+    const Insert insert = insertOf(*tool);
+    const Vec2 tipToCentre(insert.rc, insert.rc);
+    // What the step may not cut: the part grown by its allowance, and the chuck.
+    const Region guard = geom::unite(allowance > 0 ? geom::growExact(w->part, allowance) : w->part, w->chuck);
+    std::vector<Region> pending;
+    auto flush = [&] {
+      if (!pending.empty())
+        w->stock = geom::subtract(w->stock, folded(geom::uniteAll(pending)));
+      pending.clear();
+    };
+    bool gouged = false, crashed = false;
+    long long checked = 0;
+    for (const ir::Move &m : ir::walkMoves(moves)) {
+      if (m.kind == ir::MoveKind::Dwell || !m.from)
+        continue;
+      if (std::abs(m.to.y()) > 1e-9 || std::abs(m.from->y()) > 1e-9) {
+        error(ws, "a lathe move leaves the XZ plane (y " + formatFixed(m.to.y(), 4) + " mm)");
+        return;
+      }
+      const Vec2 a = halfPlane(*m.from) + tipToCentre, b = halfPlane(m.to) + tipToCentre;
+      if ((a - b).norm() < 1e-12)
+        continue;
+      const Region swept = insert.sweep(a, b);
+      ++checked;
+      if (m.kind == ir::MoveKind::Rapid) {
+        flush();
+        const Region hit = geom::intersect(folded(swept), geom::unite(w->stock, w->chuck));
+        if (!crashed && thick(hit, std::min(t, 0.001) * 2)) {
+          crashed = true;
+          error(ws, "a rapid to (x " + formatFixed(m.to.x(), 4) + ", z " + formatFixed(m.to.z(), 4) +
+                        ") mm meets the stock at " + where(hit));
+        }
+        continue;
+      }
+      pending.push_back(swept);
+      if (!gouged && !pathsOnly) {
+        const Region cut = geom::intersect(folded(swept), guard);
+        if (thick(cut, t)) {
+          gouged = true;
+          error(ws, "a cut to (x " + formatFixed(m.to.x(), 4) + ", z " + formatFixed(m.to.z(), 4) +
+                        ") mm reaches into the part" + (allowance > 0 ? " or its allowance" : std::string()) +
+                        " by more than " + formatFixed(t, 4) + " mm at " + where(cut));
+        }
+      }
+    }
+    flush();
+    stats_["turning moves checked"] += checked;
+    stats_["turning steps verified"]++;
+    if (op->is(ir::Trait::Finishing) && shape.shape)
+      finished(ws, *w, *shape.shape, insert, allowance, t);
+  }
+
+  /// After a finishing step: the material left in the feature's removal
+  /// beyond its allowance is an error where the insert could have reached
+  /// it, a warning in corners narrower than its nose.
+  void finished(const Node &ws, const Workpiece &w, const ir::TurnedShape &s, const Insert &insert, double allowance,
+                double t) {
+    const Region left = geom::subtract(geom::intersect(w.stock, s.removal), geom::growExact(w.part, allowance + t));
+    if (!thick(left, t))
+      return;
+    const double reach = insert.rc + allowance;
+    const Region corners =
+        reach > 0 ? geom::shrinkExact(geom::growExact(w.part, reach), reach) : w.part;
+    const Region missed = geom::subtract(left, corners);
+    if (thick(missed, t)) {
+      error(ws, s.symbol + " is left uncut beyond its allowance at " + where(missed));
+      return;
+    }
+    diags_.warning(ws.origin.loc, "workingstep " + ws.symbol + ": " + s.symbol + " keeps material at " + where(left) +
+                                      ": a corner narrower than the insert's nose radius " +
+                                      formatFixed(insert.rc, 4) + " mm")
+        .entity(ws.origin.entityId);
+  }
+
+  const ir::Module &module_;
+  DiagnosticEngine &diags_;
+  PassStats &stats_;
+  std::optional<double> tolerance_;
+  std::map<std::string, Workpiece> pieces_;
+  std::set<std::string> unverified_;  ///< workpieces said to have no raw piece to check against
+  bool ok_ = true;
+};
+
+} // namespace
+
+bool verifyTurning(const ir::Module &module, DiagnosticEngine &diags, PassStats &stats,
+                   std::optional<double> tolerance) {
+  return Checker(module, diags, stats, tolerance).run();
+}
+
+} // namespace stepnc::passes

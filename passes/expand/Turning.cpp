@@ -1,0 +1,922 @@
+// Turning strategies (ISO 14649-12): the moves of a lathe step, made in the
+// half plane of the turning axis (z along the axis, r the radius; points
+// are geom::Vec2(z, r)) from the feature's turned shape (ir/geom/TurnedShape.h)
+// and the workpiece's stock as the steps before left it.
+//
+// The tool is modelled by its cutting corner: a turning insert by its nose
+// circle, a grooving insert by its two corner circles a cutting width
+// apart. Paths are made for the centre of the (chuck-side) corner circle and
+// written for the point a lathe programs, the corner's imaginary tip (the
+// point touched off on X and Z): the centre moved by the corner radius
+// towards -z and towards the axis. The program thus stays G40: nose-radius
+// compensation is computed here (docs/turning.md).
+//
+// Every rapid is checked against the stock as it stands when the rapid is
+// made (the insert's corner circles clear of it); where the straight way is
+// blocked the tool goes out radially above the stock first.
+#include "passes/expand/Expand.h"
+
+#include "geom/Boolean.h"
+#include "ir/geom/Curves.h"
+#include "ir/geom/TurnedShape.h"
+#include "support/Format.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace stepnc::passes::expand {
+
+namespace {
+
+/// How far from the stock approaches start and retracts end (mm).
+constexpr double kLatheClearance = 1.0;
+/// Depth of cut when neither the strategy nor the tool gives one (mm).
+constexpr double kDefaultLatheDepth = 2.0;
+/// Lift off the surface after a roughing pass when the file gives none (mm).
+constexpr double kDefaultLift = 0.5;
+/// Roughing passes shorter than this (mm) are left to the contour pass after them.
+constexpr double kMinRoughPass = 0.1;
+
+Vec2 halfPlane(const Vec3 &v) { return Vec2(v.z(), v.x()); }
+Vec3 space(const Vec2 &p) { return Vec3(p.y(), 0, p.x()); }
+
+/// The insert as the paths see it.
+struct LatheTool {
+  bool grooving = false;
+  double rc = 0;     ///< nose (corner) radius
+  double width = 0;  ///< a grooving insert's cutting width
+  double maxDepth = 0;
+  /// The corner circles' centres relative to the chuck-side one (z only).
+  std::vector<double> corners{0.0};
+  /// The programmed point relative to the chuck-side corner's centre.
+  Vec2 tip = Vec2::Zero();
+};
+
+/// Writes the moves of one lathe step: points are corner centres in the
+/// half plane; the moves go to the programmed point in space.
+class LatheWriter {
+public:
+  LatheWriter(Node &moves, const LatheTool &t) : moves_(moves), tool_(t) {}
+
+  const Vec2 &position() const { return pos_; }
+
+  void rapid(const Vec2 &c, const char *role) {
+    if (positioned_ && (c - pos_).norm() <= geom::kEps)
+      return;
+    Node &m = moves_.add(Node(ir::Kind::Rapid));
+    m.set("to", Value::point(space(c + tool_.tip)));
+    m.set("role", Value::word(role));
+    pos_ = c;
+    positioned_ = true;
+  }
+
+  void feed(const Vec2 &c, double perRev, const char *role) {
+    if ((c - pos_).norm() <= geom::kEps)
+      return;
+    Node &m = moves_.add(Node(ir::Kind::Linear));
+    m.set("to", Value::point(space(c + tool_.tip)));
+    m.set("feed_per_rev", Value::feedPerRev(perRev));
+    m.set("role", Value::word(role));
+    pos_ = c;
+  }
+
+  void seg(const Seg &s, double perRev, const char *role) {
+    if (!s.isArc()) {
+      feed(s.b, perRev, role);
+      return;
+    }
+    // An arc in the ZX plane: counter-clockwise in (z, x) is
+    // counter-clockwise seen from +y (z x x = y).
+    Node &m = moves_.add(Node(ir::Kind::Arc));
+    m.set("to", Value::point(space(s.b + tool_.tip)));
+    m.set("center", Value::point(space(s.c + tool_.tip)));
+    m.set("dir", Value::word(s.turn > 0 ? "ccw" : "cw"));
+    m.set("feed_per_rev", Value::feedPerRev(perRev));
+    m.set("role", Value::word(role));
+    m.set("normal", Value::direction(Vec3::UnitY()));
+    pos_ = s.b;
+  }
+
+  void dwell(double seconds) {
+    if (seconds <= 0)
+      return;
+    moves_.add(Node(ir::Kind::Dwell)).set("time", Value::time(seconds));
+  }
+
+private:
+  Node &moves_;
+  const LatheTool &tool_;
+  Vec2 pos_ = Vec2::Zero();
+  bool positioned_ = false;
+};
+
+Region grown(const Region &r, double d) { return d > geom::kEps ? geom::offset(r, d) : r; }
+
+/// A rectangle (counter-clockwise) between two corners.
+Region box(const Vec2 &lo, const Vec2 &hi) {
+  return Region{{geom::polygon({lo, Vec2(hi.x(), lo.y()), hi, Vec2(lo.x(), hi.y())})}};
+}
+
+double maxR(const Region &r) { return r.empty() ? 0 : r.box().hi.y(); }
+
+/// A region and its mirror image across the axis. The half plane's section
+/// of a body of revolution is symmetric about the axis: a tool crossing the
+/// axis (facing to the centre) meets what lies at r on the other side.
+Region withMirror(const Region &r) { return geom::unite(r, geom::mirroredAcrossX(r)); }
+
+/// Where a corner centre may cut: on the near side of the axis (past it, the
+/// tool would cut what it cut already on the other side).
+Region nearSide(const Region &r) { return geom::intersect(r, box(Vec2(-1e5, 0), Vec2(1e5, 1e5))); }
+
+class TurningStep {
+public:
+  TurningStep(Expander &x, Node &ws, const Node &op, const Node &feature, const Node &toolNode, Region &stock,
+              const ir::TurnStock &raw, const ir::TurnedShape &shape, Node &moves)
+      : x_(x), ws_(ws), op_(op), feature_(feature), toolNode_(toolNode), stock_(stock), raw_(raw), shape_(shape),
+        moves_(moves), w_(moves, tool_), removal_(withMirror(shape.removal)),
+        chuck_(box(Vec2(raw.z0 - 1e4, -1e4), Vec2(raw.z0, 1e4))) {}
+
+  bool run() {
+    if (!readTool() || !readTechnology())
+      return false;
+    refreshObstacle();
+    // Outside the stock's corner at the free end: where every step starts
+    // and ends, reached from the tool change position at rapid.
+    home_ = Vec2(raw_.z1 + 5 * kLatheClearance + tool_.rc, raw_.radius + 5 * kLatheClearance + tool_.rc);
+    w_.rapid(home_, "position");
+    bool ok = false;
+    switch (op_.kind) {
+    case ir::Kind::ContouringRough: ok = rough(false); break;
+    case ir::Kind::FacingRough: ok = rough(true); break;
+    case ir::Kind::ContouringFinish:
+    case ir::Kind::FacingFinish: ok = finish(op_.number("allowance").value_or(0)); break;
+    case ir::Kind::GroovingRough: ok = grooveRough(); break;
+    case ir::Kind::GroovingFinish: ok = grooveFinish(); break;
+    case ir::Kind::CuttingIn: ok = cutIn(); break;
+    default:
+      x_.report(ws_, op_,
+                "its operation " + op_.kindName() + " '" + op_.label +
+                    "' has no lathe moves in stepnc yet (docs/turning.md lists the turning operations expanded)");
+      return false;
+    }
+    if (!ok)
+      return false;
+    travel(home_);
+    return x_.result.ok;
+  }
+
+private:
+  // --- reading the step ---------------------------------------------------------
+
+  bool readTool() {
+    const std::string type = toolNode_.text("type").value_or("");
+    tool_.rc = toolNode_.number("corner_radius").value_or(0);
+    tool_.maxDepth = toolNode_.number("max_cutting_depth").value_or(toolNode_.number("cutting_edge_length").value_or(0));
+    if (type == "grooving_tool") {
+      tool_.grooving = true;
+      tool_.width = toolNode_.number("cutting_width").value_or(0);
+      if (tool_.width <= 0 || 2 * tool_.rc > tool_.width + 1e-9) {
+        x_.report(ws_, toolNode_,
+                  "its grooving tool " + toolNode_.symbol + " needs a cutting width (at least twice its corner radius)");
+        return false;
+      }
+      tool_.corners = {0.0, (tool_.width - 2 * tool_.rc) / 2, tool_.width - 2 * tool_.rc};
+    } else if (type != "turning_tool") {
+      x_.report(ws_, toolNode_,
+                "its tool " + toolNode_.symbol + " is a " + type +
+                    ": stepnc turns with turning tools and grooves and cuts in with grooving tools");
+      return false;
+    }
+    tool_.tip = Vec2(-tool_.rc, -tool_.rc);
+    return true;
+  }
+
+  bool readTechnology() {
+    const Node *tech = op_.child(ir::Kind::Technology);
+    perRev_ = tech ? tech->number("feed_per_rev").value_or(0) : 0;
+    if (perRev_ <= 0) {
+      x_.report(ws_, tech ? *tech : op_, "its operation gives no feed per revolution: a lathe step is fed in mm/rev");
+      return false;
+    }
+    const std::optional<double> vc = tech->number("cutting_speed");
+    const std::optional<double> n = tech->number("spindle");
+    Node &moves = moves_;
+    if (vc && *vc > 0) {
+      const double clamp = tech->number("spindle_max").value_or(0);
+      if (clamp <= 0) {
+        x_.report(ws_, *tech,
+                  "its constant cutting speed has no maximum spindle speed: the spindle would race as the "
+                  "tool nears the axis");
+        return false;
+      }
+      // The spindle turns clockwise (M3) at the speed the stock's diameter
+      // asks for, and follows the diameter from there.
+      const double start = std::min(std::abs(clamp), *vc / (2 * kPi * raw_.radius));
+      moves.set("spindle", Value::spindle(-start));
+      Node state(ir::Kind::State);
+      state.set("surface_speed", Value::feed(*vc));
+      state.set("spindle_max", Value::spindle(std::abs(clamp)));
+      moves.children.insert(moves.children.begin(), std::move(state));
+    } else if (n && *n != 0) {
+      moves.set("spindle", Value::spindle(*n));
+    } else {
+      x_.report(ws_, tech ? *tech : op_, "its operation gives no spindle speed nor cutting speed");
+      return false;
+    }
+    moves.set("x_mode", Value::word("diameter"));
+    return true;
+  }
+
+  // --- safe travel ----------------------------------------------------------------
+
+  /// Whether the insert's corner circles, moved from `a` to `b`, stay clear of the stock.
+  bool clear(const Vec2 &a, const Vec2 &b) const {
+    for (double dz : tool_.corners) {
+      const Vec2 off(dz, 0);
+      for (const Seg &s : geom::clip(obstacle_, a + off, b + off))
+        if ((s.b - s.a).norm() > 1e-6)
+          return false;
+      if (obstacle_.contains(a + off) || obstacle_.contains(b + off))
+        return false;
+    }
+    return true;
+  }
+
+  /// Whether the corner circles moved from `a` to `b` keep out of what the
+  /// step must leave (the part, other features' material, the chuck).
+  bool spares(const Vec2 &a, const Vec2 &b) const {
+    const Region guard = grown(keepRegion(), std::max(tool_.rc, 1e-3) - 1e-4);
+    for (double dz : tool_.corners) {
+      const Vec2 off(dz, 0);
+      if (guard.contains(a + off) || guard.contains(b + off))
+        return false;
+      for (const Seg &s : geom::clip(guard, a + off, b + off))
+        if ((s.b - s.a).norm() > 1e-6)
+          return false;
+    }
+    return true;
+  }
+
+  /// Leaves the surface from `at`: out along `first` by the clearance when
+  /// that spares the part, else along `second`; false (after an error) when neither does.
+  bool leave(const Vec2 &at, const Vec2 &first, const Vec2 &second, double by, bool atFeed) {
+    for (const Vec2 &d : {first, second}) {
+      const Vec2 to = at + d * by;
+      if (spares(at, to)) {
+        if (atFeed)
+          w_.feed(to, perRev_, "retract");
+        else
+          w_.rapid(to, "retract");
+        return true;
+      }
+    }
+    x_.report(ws_, "no way off the surface at (z " + formatFixed(at.x(), 4) + ", r " + formatFixed(at.y(), 4) +
+                       ") mm that spares what the step must leave");
+    return false;
+  }
+
+  void refreshObstacle() { obstacle_ = grown(geom::unite(stock_, chuck_), std::max(tool_.rc, 1e-3) - 1e-4); }
+
+  /// What the step must leave: the stock outside the feature's removal, and the chuck.
+  Region keepRegion() const { return geom::unite(geom::subtract(stock_, removal_), chuck_); }
+
+  /// Rapids from where the tool is to `to`: straight when clear, else out
+  /// above the stock, across and in.
+  bool travel(const Vec2 &to) {
+    const Vec2 from = w_.position();
+    if (clear(from, to)) {
+      w_.rapid(to, "position");
+      return true;
+    }
+    const double above = maxR(stock_) + tool_.rc + kLatheClearance;
+    const Vec2 up(from.x(), std::max(above, from.y())), over(to.x(), std::max(above, from.y()));
+    if (clear(from, up) && clear(up, over) && clear(over, to)) {
+      w_.rapid(up, "retract");
+      w_.rapid(over, "position");
+      w_.rapid(to, "approach");
+      return true;
+    }
+    x_.report(ws_, "no way at rapid from (z " + formatFixed(from.x(), 4) + ", r " + formatFixed(from.y(), 4) +
+                       ") to (z " + formatFixed(to.x(), 4) + ", r " + formatFixed(to.y(), 4) +
+                       ") mm clear of the stock (insert corner centres)");
+    return false;
+  }
+
+  /// A cut from `s` to `e` entered from `entry` (outside the stock) at feed.
+  bool cut(const Vec2 &entry, const std::vector<Seg> &path, const char *role = "cut") {
+    if (!travel(entry))
+      return false;
+    if (!spares(entry, path.front().a)) {
+      x_.report(ws_, "its approach to (z " + formatFixed(path.front().a.x(), 4) + ", r " +
+                         formatFixed(path.front().a.y(), 4) + ") mm would cut into what the step must leave");
+      return false;
+    }
+    w_.feed(path.front().a, perRev_, "approach");
+    for (const Seg &s : path)
+      w_.seg(s, perRev_, role);
+    return true;
+  }
+
+  /// The stock less what the corner circles swept along `path`, and the band
+  /// outwards of it (`away`, up to the reach) that the insert's edge cuts.
+  void removeSwept(const std::vector<Seg> &path, const std::optional<Vec2> &away) {
+    std::vector<Region> parts;
+    for (double dz : tool_.corners)
+      for (const Seg &s : path) {
+        Seg t = s;
+        t.a += Vec2(dz, 0);
+        t.b += Vec2(dz, 0);
+        t.c += Vec2(dz, 0);
+        if (tool_.rc > geom::kEps)
+          for (Region &r : geom::sweptDiscParts(t, tool_.rc))
+            parts.push_back(std::move(r));
+      }
+    if (away)
+      for (const Seg &s : path) {
+        const Vec2 far = *away * 2 * (raw_.radius + raw_.z1 - raw_.z0 + 10);
+        Loop l = geom::polygon({s.a, s.b, s.b + far, s.a + far});
+        if (std::abs(l.area()) > 1e-12) {
+          if (l.area() < 0)
+            l = geom::polygon({s.a + far, s.b + far, s.b, s.a});
+          parts.push_back(Region{{l}});
+        }
+      }
+    if (!parts.empty())
+      stock_ = geom::subtract(stock_, withMirror(geom::uniteAll(parts)));
+    refreshObstacle();
+  }
+
+  // --- the strategies ----------------------------------------------------------
+
+  const Node *strategy() const { return op_.child(ir::Kind::TurningStrategy); }
+
+  std::optional<Vec2> strategyDir(const char *name) const {
+    const Node *s = strategy();
+    if (!s)
+      return std::nullopt;
+    if (auto v = s->vec(name)) {
+      const Vec2 d = halfPlane(*v);
+      if (d.norm() > 1e-9)
+        return d.normalized();
+    }
+    return std::nullopt;
+  }
+
+  std::vector<double> depths() {
+    if (const Node *s = strategy())
+      if (const ir::Value *v = s->get("cutting_depths"); v && !v->numbers.empty()) {
+        for (double d : v->numbers)
+          if (d <= 0) {
+            x_.report(ws_, *s, "its strategy's cutting depths must be positive (" + formatShortest(d) + " mm)");
+            return {};
+          }
+        return v->numbers;
+      }
+    if (tool_.maxDepth > 0)
+      return {tool_.maxDepth};
+    x_.assumed(ws_, op_,
+               "neither the strategy nor the tool gives a depth of cut: assumed " + formatFixed(kDefaultLatheDepth, 4) +
+                   " mm per pass");
+    return {kDefaultLatheDepth};
+  }
+
+  /// Roughing: passes along the feed direction, one depth of cut apart
+  /// across it, each clipped to where the nose has material to cut and
+  /// keeps the allowance off every surface the step must leave; then, for
+  /// contouring, one pass along the allowance contour.
+  bool rough(bool facing) {
+    if (tool_.grooving) {
+      x_.report(ws_, toolNode_, "roughing with the grooving tool " + toolNode_.symbol + " is not supported");
+      return false;
+    }
+    const double a = op_.number("allowance").value_or(0);
+    Vec2 d = strategyDir("feed_dir").value_or(facing ? Vec2(0, -1) : Vec2(-1, 0));
+    Vec2 s = strategyDir("stepover_dir").value_or(facing ? Vec2(-1, 0) : Vec2(0, -1));
+    const bool along = std::abs(std::abs(d.x()) - 1) < 1e-9 && std::abs(s.y()) > 1 - 1e-9;
+    const bool across = std::abs(std::abs(d.y()) - 1) < 1e-9 && std::abs(s.x()) > 1 - 1e-9;
+    if (!along && !across) {
+      x_.report(ws_, strategy() ? *strategy() : op_,
+                "its roughing passes run along " + formatTuple({d.x(), d.y()}, 6) + " (z, r) stepping over " +
+                    formatTuple({s.x(), s.y()}, 6) +
+                    ": stepnc roughs along the axis or across it, stepping over at right angles");
+      return false;
+    }
+    const bool bidirectional = strategy() && strategy()->text("type") == "bidirectional";
+    const std::vector<double> cuts = depths();
+    if (cuts.empty())
+      return false;
+    if (tool_.maxDepth > 0)
+      for (double c : cuts)
+        if (c > tool_.maxDepth + 1e-9) {
+          x_.report(ws_, strategy() ? *strategy() : op_,
+                    "its depth of cut " + formatFixed(c, 4) + " mm is more than its tool " + toolNode_.symbol +
+                        " cuts (" + formatFixed(tool_.maxDepth, 4) + " mm)");
+          return false;
+        }
+    const Region keep = keepRegion();
+    const Region material = geom::intersect(stock_, removal_);
+    if (material.empty() || material.area() < 1e-9) {
+      x_.warning(ws_, shape_.symbol + " has no material left to rough (the steps before removed it)");
+      return true;
+    }
+    const Region forbidden = grown(keep, tool_.rc + a);
+    const Region centres = nearSide(geom::subtract(grown(material, tool_.rc), forbidden));
+    const Vec2 out = -s;  // from the part towards the stock's outside
+    auto u = [&](const Vec2 &p) { return p.dot(out); };
+    const geom::Box cb = centres.box(), mb = material.box();
+    if (centres.empty()) {
+      x_.warning(ws_, shape_.symbol + ": the allowance leaves nothing to rough");
+      return true;
+    }
+    auto corners = [](const geom::Box &b) {
+      return std::vector<Vec2>{b.lo, b.hi, Vec2(b.lo.x(), b.hi.y()), Vec2(b.hi.x(), b.lo.y())};
+    };
+    double uTop = -1e300, uFloor = 1e300;
+    for (const Vec2 &p : corners(mb))
+      uTop = std::max(uTop, u(p));
+    for (const Vec2 &p : corners(cb))
+      uFloor = std::min(uFloor, u(p));
+    std::vector<double> levels;
+    double level = uTop + tool_.rc;
+    for (size_t k = 0; level > uFloor + 1e-6; ++k) {
+      level -= cuts[std::min(k, cuts.size() - 1)];
+      levels.push_back(std::max(level, uFloor + 1e-6));
+      if (static_cast<int>(levels.size()) > kMaxLevels) {
+        x_.report(ws_, "its depth of cut makes more than " + std::to_string(kMaxLevels) + " passes");
+        return false;
+      }
+    }
+    const double lift = liftHeight();
+    double dirSign = 1;
+    double span0 = 1e300, span1 = -1e300;
+    for (const Vec2 &p : corners(cb)) {
+      span0 = std::min(span0, p.dot(d));
+      span1 = std::max(span1, p.dot(d));
+    }
+    for (double lv : levels) {
+      const Vec2 dd = d * dirSign;
+      const Vec2 base = out * lv;
+      const Vec2 p0 = base + d * (span0 - 1) - out * out.dot(d * (span0 - 1));
+      const Vec2 p1 = base + d * (span1 + 1) - out * out.dot(d * (span1 + 1));
+      std::vector<Seg> pieces = geom::clip(centres, dirSign > 0 ? p0 : p1, dirSign > 0 ? p1 : p0);
+      for (const Seg &piece : pieces) {
+        // Slivers (the nose over a corner the contour pass takes) are left to it.
+        if ((piece.b - piece.a).norm() < kMinRoughPass)
+          continue;
+        const Vec2 entry = piece.a - dd * kLatheClearance;
+        if (!cut(entry, {Seg::line(piece.a, piece.b)}))
+          return false;
+        removeSwept({Seg::line(entry, piece.b)}, out);
+        if (!leave(piece.b, (out - dd).normalized(), out, lift * std::sqrt(2.0), false))
+          return false;
+      }
+      if (bidirectional)
+        dirSign = -dirSign;
+    }
+    if (!facing)
+      return contourPass(a, "cut");
+    return true;
+  }
+
+  double liftHeight() const {
+    if (const Node *s = strategy())
+      if (auto h = s->number("lift_height"); h && *h > 0)
+        return *h;
+    for (const char *k : {"x_return", "z_return"})
+      if (auto h = op_.number(k); h && *h > 0)
+        return *h;
+    return kDefaultLift;
+  }
+
+  /// The nose centre's path along the feature's surface, `a` off it: the
+  /// boundary of the region the nose must keep out of, where it runs along
+  /// the surface, in the surface's order; trimmed to where there is material.
+  std::optional<std::vector<Seg>> contourPath(double a) {
+    const Region keep = keepRegion();
+    const double off = tool_.rc + a;
+    const Region forbidden = grown(keep, off);
+    // The pieces of its boundary no farther from the surface than `off`
+    // (lines clipped to that band; arcs whole or not at all).
+    geom::SegIndex surface(shape_.contour);
+    const Region band = geom::sweptDisc(shape_.contour, off + 1e-5);
+    std::vector<Seg> along;
+    for (const Loop &l : forbidden.loops)
+      for (const Seg &s : l.segs) {
+        if (s.isArc()) {
+          if (std::abs(surface.distance(s.at(0.5)) - off) < 1e-5 && std::abs(surface.distance(s.a) - off) < 1e-5 &&
+              std::abs(surface.distance(s.b) - off) < 1e-5)
+            along.push_back(s);
+          continue;
+        }
+        for (const Seg &piece : geom::clip(band, s.a, s.b))
+          if ((piece.b - piece.a).norm() > 1e-7 && std::abs(surface.distance(piece.at(0.5)) - off) < 1e-5)
+            along.push_back(piece);
+      }
+    if (along.empty())
+      return std::nullopt;
+    // Chain the pieces (a loop's order is counter-clockwise about the
+    // forbidden region, which lies left of it; the surface's order may be
+    // the other way).
+    std::vector<Seg> chain{along.front()};
+    along.erase(along.begin());
+    for (bool grew = true; grew && !along.empty();) {
+      grew = false;
+      for (size_t k = 0; k < along.size(); ++k) {
+        if ((along[k].a - chain.back().b).norm() < 1e-7) {
+          chain.push_back(along[k]);
+        } else if ((along[k].b - chain.front().a).norm() < 1e-7) {
+          chain.insert(chain.begin(), along[k]);
+        } else {
+          continue;
+        }
+        along.erase(along.begin() + static_cast<long>(k));
+        grew = true;
+        break;
+      }
+    }
+    if (!along.empty()) {
+      x_.report(ws_, "the path along " + shape_.symbol + " falls apart in pieces: not supported yet");
+      return std::nullopt;
+    }
+    // The surface's own order: its first point nearest the chain's end?
+    const Vec2 first = shape_.contour.front().a;
+    if ((chain.back().b - first).norm() < (chain.front().a - first).norm()) {
+      std::reverse(chain.begin(), chain.end());
+      for (Seg &s : chain)
+        s = s.reversed();
+    }
+    // Trimmed to the pieces that touch material.
+    const Region material = geom::intersect(stock_, removal_);
+    const Region reach = grown(material, tool_.rc + 1e-3);
+    auto touches = [&](const Seg &s) {
+      if (reach.contains(s.at(0.5)) || reach.contains(s.a) || reach.contains(s.b))
+        return true;
+      return !s.isArc() && !geom::clip(reach, s.a, s.b).empty();
+    };
+    while (!chain.empty() && !touches(chain.front()))
+      chain.erase(chain.begin());
+    while (!chain.empty() && !touches(chain.back()))
+      chain.pop_back();
+    // The end lines from where they first reach the material to where they
+    // last do, on the near side of the axis.
+    const Region near = nearSide(reach);
+    if (!chain.empty() && !chain.front().isArc())
+      if (std::vector<Seg> in = geom::clip(near, chain.front().a, chain.front().b); !in.empty())
+        chain.front().a = in.front().a;
+    if (!chain.empty() && !chain.back().isArc())
+      if (std::vector<Seg> in = geom::clip(near, chain.back().a, chain.back().b); !in.empty())
+        chain.back().b = in.back().b;
+    return chain;
+  }
+
+  /// One pass along the surface `a` off it, entered and left along its ends' tangents.
+  bool contourPass(double a, const char *role) {
+    const std::optional<std::vector<Seg>> path = contourPath(a);
+    if (!x_.result.ok)
+      return false;
+    if (!path || path->empty()) {
+      x_.warning(ws_, shape_.symbol + " has no material left along its surface");
+      return true;
+    }
+    // No more than a depth of cut in one pass.
+    if (tool_.maxDepth > 0) {
+      std::vector<Region> parts;
+      for (const Seg &s : *path)
+        for (Region &r : geom::sweptDiscParts(s, tool_.rc + tool_.maxDepth))
+          parts.push_back(std::move(r));
+      const Region left = geom::subtract(geom::intersect(stock_, removal_), withMirror(geom::uniteAll(parts)));
+      if (left.area() > 1e-6) {
+        x_.report(ws_, "the pass along " + shape_.symbol + " would cut more than its tool " + toolNode_.symbol +
+                           " cuts in one pass (" + formatFixed(tool_.maxDepth, 4) + " mm): rough it first");
+        return false;
+      }
+    }
+    const Vec2 t0 = path->front().tangent(0), t1 = path->back().tangent(1);
+    const Vec2 entry = path->front().a - t0 * kLatheClearance;
+    if (!clearOfMaterial(entry)) {
+      x_.report(ws_, "the pass along " + shape_.symbol + " starts inside the stock: no way in along its tangent");
+      return false;
+    }
+    if (!cut(entry, *path, role))
+      return false;
+    // Off the surface along its normal away from the part, else on along its tangent.
+    const Vec2 end = path->back().b;
+    Vec2 normal(-t1.y(), t1.x());
+    if (!spares(end, end + normal * kLatheClearance))
+      normal = -normal;
+    if (!leave(end, normal, t1, kLatheClearance, true))
+      return false;
+    std::vector<Seg> swept = *path;
+    swept.insert(swept.begin(), Seg::line(entry, path->front().a));
+    swept.push_back(Seg::line(end, w_.position()));
+    removeSwept(swept, std::nullopt);
+    removeReachable(a);
+    return true;
+  }
+
+  /// After a pass along the surface `a` off it: all the nose reaches
+  /// outside that allowance is gone (the insert's edges cut what lies
+  /// beyond the nose circle; corners narrower than the nose stay).
+  void removeReachable(double a) {
+    const Region keep = keepRegion();
+    const geom::Box b = stock_.box();
+    const Region window = box(b.lo - Vec2(10, 10), b.hi + Vec2(10, 10));
+    const Region centres = geom::subtract(window, grown(keep, tool_.rc + a));
+    stock_ = geom::subtract(stock_, geom::intersect(grown(centres, tool_.rc), removal_));
+    refreshObstacle();
+  }
+
+  bool clearOfMaterial(const Vec2 &p) const { return !obstacle_.contains(p); }
+
+  bool finish(double a) {
+    if (tool_.grooving) {
+      x_.report(ws_, toolNode_, "finishing a contour with the grooving tool " + toolNode_.symbol + " is not supported");
+      return false;
+    }
+    return contourPass(a, "cut");
+  }
+
+  // --- grooves and cutting in ------------------------------------------------------
+
+  bool needsGroove() {
+    if (!tool_.grooving) {
+      x_.report(ws_, toolNode_, "grooving needs a grooving tool; " + toolNode_.symbol + " is a turning tool");
+      return false;
+    }
+    if (!shape_.grooveSpan) {
+      x_.report(ws_, feature_, "grooving operations cut grooves; " + shape_.symbol + " is a " + feature_.kindName());
+      return false;
+    }
+    return true;
+  }
+
+  double dwellSeconds() const {
+    if (auto t = op_.number("dwell"))
+      return *t;
+    if (auto revs = op_.number("dwell_revolutions")) {
+      const double n = std::abs(movesSpindle());
+      return n > 0 ? *revs * 60 / n : 0;
+    }
+    return 0;
+  }
+
+  double movesSpindle() const { return moves_.number("spindle").value_or(0); }
+
+  /// The radius above which the band [z, z + width] of the stock is clear.
+  double topOver(double zLeftEdge) const {
+    const Region band = geom::intersect(stock_, box(Vec2(zLeftEdge, -1), Vec2(zLeftEdge + tool_.width, 1e5)));
+    return maxR(band);
+  }
+
+  /// One plunge of the grooving insert with its chuck-side edge at `zEdge`
+  /// down to `bottom` (the insert's lowest point), and straight back out.
+  bool plunge(double zEdge, double bottom, const char *role) {
+    const double zc = zEdge + tool_.rc;
+    const double top = std::max(topOver(zEdge), bottom) + tool_.rc + kLatheClearance;
+    const Vec2 entry(zc, top), end(zc, bottom + tool_.rc);
+    if (!cut(entry, {Seg::line(entry, end)}, role))
+      return false;
+    w_.dwell(dwellSeconds());
+    w_.rapid(entry, "retract");
+    removeSwept({Seg::line(entry, end)}, Vec2(0, 1));
+    return true;
+  }
+
+  bool grooveRough() {
+    if (!needsGroove())
+      return false;
+    const double a = op_.number("allowance").value_or(0);
+    const auto [lo, hi] = *shape_.grooveSpan;
+    const double first = lo + a, last = hi - a - tool_.width;
+    if (last < first - 1e-9) {
+      x_.report(ws_, toolNode_,
+                "its grooving tool " + toolNode_.symbol + " (" + formatFixed(tool_.width, 4) +
+                    " mm wide) is wider than " + shape_.symbol + " less its allowances (" +
+                    formatFixed(hi - lo - 2 * a, 4) + " mm)");
+      return false;
+    }
+    // Plunges overlapping by a fifth of the width, the first and last at the walls.
+    const double step = 0.8 * tool_.width;
+    const int n = static_cast<int>(std::ceil((last - first) / step - 1e-9)) + 1;
+    for (int k = 0; k < n; ++k) {
+      const double z = n == 1 ? first : first + (last - first) * k / (n - 1);
+      if (!plunge(z, shape_.grooveFloor + a, "cut"))
+        return false;
+    }
+    return true;
+  }
+
+  bool grooveFinish() {
+    if (!needsGroove())
+      return false;
+    const auto [lo, hi] = *shape_.grooveSpan;
+    const double floor = shape_.grooveFloor;
+    if (hi - lo < tool_.width - 1e-9) {
+      x_.report(ws_, toolNode_,
+                "its grooving tool " + toolNode_.symbol + " is wider than " + shape_.symbol + " (" +
+                    formatFixed(hi - lo, 4) + " mm)");
+      return false;
+    }
+    // Down the free-end wall with the far corner, along the floor, up the
+    // chuck-side wall: the chuck-side corner's centre is the reference.
+    const double far = tool_.width - 2 * tool_.rc;
+    const double zHiWall = hi - tool_.rc - far, zLoWall = lo + tool_.rc, rFloor = floor + tool_.rc;
+    const double top = std::max(topOver(lo), floor) + tool_.rc + kLatheClearance;
+    std::vector<Seg> path{Seg::line(Vec2(zHiWall, top), Vec2(zHiWall, rFloor)),
+                          Seg::line(Vec2(zHiWall, rFloor), Vec2(zLoWall, rFloor)),
+                          Seg::line(Vec2(zLoWall, rFloor), Vec2(zLoWall, top))};
+    std::erase_if(path, [](const Seg &s) { return (s.b - s.a).norm() < 1e-9; });
+    if (!cut(path.front().a, path))
+      return false;
+    removeSwept(path, Vec2(0, 1));
+    return true;
+  }
+
+  bool cutIn() {
+    if (!tool_.grooving) {
+      x_.report(ws_, toolNode_, "cutting in needs a grooving (parting) tool; " + toolNode_.symbol + " is a turning tool");
+      return false;
+    }
+    const Vec3 dir = op_.vec("direction").value_or(Vec3(-1, 0, 0));
+    if (dir.x() > -1 + 1e-9) {
+      x_.report(ws_, op_, "cutting in along " + formatTuple({dir.x(), dir.y(), dir.z()}, 6) +
+                              " is not supported: stepnc cuts in towards the axis (-x)");
+      return false;
+    }
+    const double depth = op_.number("depth").value_or(0);
+    // The insert's free-end edge at the feature's placement: the part on
+    // the free-end side keeps its face.
+    const double zEdge = shape_.at.x() - tool_.width;
+    const double top = topOver(zEdge);
+    if (top <= 0) {
+      x_.warning(ws_, "no stock left where " + shape_.symbol + " is cut in");
+      return true;
+    }
+    const double bottom = std::max(top - depth, 0.0);
+    if (!plunge(zEdge, bottom, "cut"))
+      return false;
+    if (bottom <= 1e-9) {
+      // Cut off: what lies on the free-end side leaves the lathe.
+      stock_ = geom::intersect(stock_, box(Vec2(raw_.z0 - 1, -1), Vec2(zEdge, 1e5)));
+      refreshObstacle();
+    }
+    return true;
+  }
+
+  Expander &x_;
+  Node &ws_;
+  const Node &op_;
+  const Node &feature_;
+  const Node &toolNode_;
+  Region &stock_;
+  const ir::TurnStock &raw_;
+  const ir::TurnedShape &shape_;
+  LatheTool tool_;
+  Node &moves_;
+  LatheWriter w_;
+  Region obstacle_;
+  /// The feature's removal, mirrored across the axis; the chuck (all below
+  /// the raw piece's chuck-side end), which no tool may enter.
+  Region removal_, chuck_;
+  double perRev_ = 0;
+  Vec2 home_ = Vec2::Zero();
+};
+
+/// A lathe step's explicit toolpaths (AP238 files from CAM systems), in
+/// the XZ plane of the feature's frame, as the file gives them: the
+/// programmed point is the file's; feeds per revolution and the surface
+/// speed of each toolpath's technology (else the operation's).
+bool expandLatheToolpaths(Expander &x, Node &ws, const Node &op, const Node &feature, const Node &tool,
+                          const std::string &setup) {
+  const Vec3 at = feature.vec("at").value_or(Vec3::Zero());
+  const Vec3 axis = feature.vec("axis").value_or(Vec3::UnitZ());
+  const Vec3 ref = feature.vec("ref").value_or(Vec3::UnitX());
+  if ((axis - Vec3::UnitZ()).norm() > 1e-9 || (ref - Vec3::UnitX()).norm() > 1e-9 || std::abs(at.x()) > 1e-9 ||
+      std::abs(at.y()) > 1e-9) {
+    x.report(ws, feature,
+             "its lathe toolpaths are in the frame of " + feature.symbol +
+                 ", which is turned or off the turning axis: only a frame moved along the axis is supported");
+    return false;
+  }
+  Node moves = makeMoves(ws, tool.symbol, 0, coolant(op), setup);
+  moves.set("x_mode", Value::word("diameter"));
+  std::optional<std::pair<double, double>> css;  // surface speed, clamp in force
+  std::optional<Vec3> pos;
+  bool spindleSet = false;
+  for (const Node *tp : op.childrenOf(ir::Kind::Toolpath)) {
+    const Node *tech = tp->child(ir::Kind::Technology);
+    if (!tech)
+      tech = op.child(ir::Kind::Technology);
+    const bool rapid = tp->flag("rapid").value_or(false);
+    const Node *curve = tp->childIn(ir::Category::Curve);
+    if (!curve)
+      continue;
+    const double perRev = tech ? tech->number("feed_per_rev").value_or(0) : 0;
+    if (!rapid && perRev <= 0) {
+      x.report(ws, *tp, "its toolpath gives no feed per revolution: a lathe step is fed in mm/rev");
+      return false;
+    }
+    if (tech) {
+      if (auto vc = tech->number("cutting_speed"); vc && *vc > 0) {
+        const double clamp = tech->number("spindle_max").value_or(0);
+        if (clamp <= 0) {
+          x.report(ws, *tech, "its constant cutting speed has no maximum spindle speed");
+          return false;
+        }
+        if (!css || css->first != *vc || css->second != clamp) {
+          Node state(ir::Kind::State);
+          state.set("surface_speed", Value::feed(*vc));
+          state.set("spindle_max", Value::spindle(clamp));
+          moves.add(std::move(state));
+          css = {*vc, clamp};
+        }
+        if (!spindleSet)
+          moves.set("spindle", Value::spindle(-std::abs(clamp)));
+        spindleSet = true;
+      } else if (auto n = tech->number("spindle"); n && !spindleSet) {
+        moves.set("spindle", Value::spindle(*n));
+        spindleSet = true;
+      }
+    }
+    const ir::CurveResult cr = ir::curvePieces(*curve, ir::ArcPlanes::Principal);
+    if (!cr.error.empty()) {
+      x.report(ws, *curve, cr.error);
+      return false;
+    }
+    for (const ir::CurvePiece &c : cr.pieces) {
+      const Vec3 from = c.from + at, to = c.to + at;
+      if (c.arc && c.turns > 0) {
+        x.report(ws, *curve, "its lathe toolpath turns a whole circle about the y axis: not a lathe's move");
+        return false;
+      }
+      if (std::abs(from.y()) > 1e-9 || std::abs(to.y()) > 1e-9 || (c.arc && c.plane.normal != 1)) {
+        x.report(ws, *curve, "its lathe toolpath leaves the XZ plane (y " + formatFixed(to.y(), 4) +
+                                 " mm): a lathe's moves lie in the plane of the turning axis");
+        return false;
+      }
+      if (!pos || (*pos - from).norm() > 1e-6) {
+        Node &m = moves.add(Node(ir::Kind::Rapid));
+        m.set("to", Value::point(from));
+        m.set("role", Value::word("position"));
+      }
+      if (rapid) {
+        Node &m = moves.add(Node(ir::Kind::Rapid));
+        m.set("to", Value::point(to));
+        m.set("role", Value::word("position"));
+      } else if (c.arc) {
+        Node &m = moves.add(Node(ir::Kind::Arc));
+        m.set("to", Value::point(to));
+        m.set("center", Value::point(c.center + at));
+        m.set("dir", Value::word(c.ccw ? "ccw" : "cw"));
+        m.set("feed_per_rev", Value::feedPerRev(perRev));
+        m.set("role", Value::word("cut"));
+        m.set("normal", Value::direction(Vec3::UnitY()));
+      } else {
+        Node &m = moves.add(Node(ir::Kind::Linear));
+        m.set("to", Value::point(to));
+        m.set("feed_per_rev", Value::feedPerRev(perRev));
+        m.set("role", Value::word("cut"));
+      }
+      pos = to;
+    }
+  }
+  if (!spindleSet) {
+    x.report(ws, op, "its operation gives no spindle speed nor cutting speed");
+    return false;
+  }
+  x.attach(ws, std::move(moves));
+  return true;
+}
+
+} // namespace
+
+bool expandTurning(Expander &x, Node &ws, const Node &op, const std::string &setup) {
+  const Node *feature = ir::findFeature(*x.module, ws.text("feature").value_or(""));
+  const Node *tool = ir::findTool(*x.module, op.text("tool").value_or(""));
+  if (!feature || !tool)
+    return false;  // the IR verifier reports dangling references
+  if (!op.childrenOf(ir::Kind::Toolpath).empty())
+    return expandLatheToolpaths(x, ws, op, *feature, *tool, setup);
+  const Node *workpiece = ir::workpieceOf(*x.module, *feature);
+  const ir::StockResult raw = ir::turnStock(workpiece);
+  if (!raw.stock) {
+    x.report(ws, *feature, raw.error);
+    return false;
+  }
+  const ir::TurnedShapeResult shape = ir::turnedShape(*feature, *raw.stock);
+  if (!shape.shape) {
+    x.report(ws, *feature, shape.error);
+    return false;
+  }
+  auto [it, fresh] = x.turnedStock.try_emplace(workpiece->symbol, Region());
+  if (fresh)
+    it->second = withMirror(raw.stock->region());
+  Node moves = makeMoves(ws, tool->symbol, 0, coolant(op), setup);
+  TurningStep step(x, ws, op, *feature, *tool, it->second, *raw.stock, *shape.shape, moves);
+  if (!step.run())
+    return false;
+  x.attach(ws, std::move(moves));
+  return true;
+}
+
+} // namespace stepnc::passes::expand
