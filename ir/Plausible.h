@@ -15,6 +15,9 @@ inline constexpr double kPlausibleMinCuttingSpeedMPerMin = 1;
 inline constexpr double kPlausibleMaxCuttingSpeedMPerMin = 3000;
 inline constexpr double kPlausibleMinSpindleRpm = 1;
 inline constexpr double kPlausibleMaxSpindleRpm = 100000;
+/// mm/rev: a lathe's feed per revolution (a thread's lead at most).
+inline constexpr double kPlausibleMinFeedPerRev = 0.001;
+inline constexpr double kPlausibleMaxFeedPerRev = 50;
 /// Feed per tooth, at most this share of the tool's diameter.
 inline constexpr double kPlausibleChipLoadShare = 0.1;
 /// The largest magnitudes an IR value can have and still mean something on

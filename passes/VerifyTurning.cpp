@@ -71,8 +71,20 @@ std::vector<Vec2> hull(std::vector<Vec2> p) {
   return h;
 }
 
-/// Material thicker than `t` somewhere in `r`.
-bool thick(const Region &r, double t) { return !r.empty() && !geom::offset(r, -t / 2).empty(); }
+/// Material thicker than `t` somewhere in `r`: a loop whose mean width
+/// (twice its area over its perimeter) is more than a quarter of `t` (the
+/// slivers Booleans leave along a shared edge are far thinner), and that
+/// keeps something when shrunk by t/2.
+bool thick(const Region &r, double t) {
+  bool wide = false;
+  for (const Loop &l : r.loops) {
+    double perimeter = 0;
+    for (const Seg &s : l.segs)
+      perimeter += s.length();
+    wide = wide || (perimeter > 0 && 2 * std::abs(l.area()) / perimeter > t / 4);
+  }
+  return wide && !geom::offset(r, -t / 2).empty();
+}
 
 std::string where(const Region &r) {
   const geom::Box b = r.box();

@@ -34,7 +34,7 @@ public:
         for (const ir::Node *e : ir::programOrder(module))
           if (ir::isTurningStep(*e)) {
             diags.error(e->origin.loc, "workingstep " + e->symbol + " turns: " + descriptor().name +
-                                           " does not write lathe programs (docs/turning.md: rs274 does)")
+                                           " does not write lathe programs (docs/turning.md: rs274 and siemens-840d do)")
                 .entity(e->origin.entityId);
             break;
           }

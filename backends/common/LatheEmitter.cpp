@@ -5,6 +5,7 @@
 #include "support/Format.h"
 
 #include <cmath>
+#include <numbers>
 
 namespace stepnc::backends {
 
@@ -44,8 +45,12 @@ int LatheEmitter::toolNumber(const ir::Node &tool) {
   return n;
 }
 
+std::string LatheEmitter::arcCentre(const geom::Vec2 &offsetXZ, double, bool) const {
+  return word("I", num(offsetXZ.x())) + " " + word("K", num(offsetXZ.y()));
+}
+
 std::optional<std::string> LatheEmitter::run(const ir::Module &module) {
-  out_.raw("%");
+  opening();
   const ir::Node &root = module.root;
   out_.block(comment("stepnc: " + root.label + " from " + o_.source));
   out_.block(comment("target " + d_.name + (o_.optionsText.empty() ? "" : ", options " + o_.optionsText)));
@@ -99,7 +104,7 @@ std::optional<std::string> LatheEmitter::run(const ir::Module &module) {
       return std::nullopt;
   }
   postamble();
-  out_.raw("%");
+  closing();
   if (!out_.overlong().empty()) {
     diags_.error(SourceLoc{}, "line " + std::to_string(out_.overlong().front()) + " of the " + d_.name +
                                   " program is longer than the controller reads");
@@ -172,7 +177,18 @@ void LatheEmitter::move(const ir::Move &m) {
     modal_.forget("F");
   }
   const double f = byRev ? perRev : m.feed;
-  if (m.kind == ir::MoveKind::Arc) {
+  bool arc = m.kind == ir::MoveKind::Arc;
+  if (arc) {
+    // An arc under half a turn whose ends print as one point would read as
+    // a whole circle: it is the line it is within the printed resolution.
+    const geom::Vec2 a(m.from->z() - m.center.z(), m.from->x() - m.center.x());
+    const geom::Vec2 b(m.to.z() - m.center.z(), m.to.x() - m.center.x());
+    const double sweep = turnAngle(a, b, m.ccw);
+    if (arcPrintsClosed(geom::Vec2(m.from->z(), readX(m.from->x())), geom::Vec2(m.to.z(), readX(m.to.x())), sweep,
+                        d_.coordDecimals))
+      arc = false;
+  }
+  if (arc) {
     // In the ZX plane (G18): I the radius offset of the centre, K its z offset, from the start as read.
     const geom::Vec2 from(readX(m.from->x()), roundTo(m.from->z(), d_.coordDecimals));
     const geom::Vec2 to(readX(m.to.x()), roundTo(m.to.z(), d_.coordDecimals));
@@ -186,7 +202,10 @@ void LatheEmitter::move(const ir::Move &m) {
     modal_.forget("Z");
     axis("X", x);
     axis("Z", z);
-    text += " " + word("I", num(ik.x())) + " " + word("K", num(ik.y()));
+    // The sweep in (z, x), counter-clockwise seen from +y.
+    const geom::Vec2 a(from.y() - centre.y(), from.x() - centre.x()), b(to.y() - centre.y(), to.x() - centre.x());
+    const bool moreThanHalf = turnAngle(a, b, g3) > std::numbers::pi;
+    text += " " + arcCentre(ik, (centre - from).norm(), moreThanHalf);
   } else {
     if (modal_.change("G", "1"))
       text = "G1";

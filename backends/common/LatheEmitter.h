@@ -33,6 +33,13 @@ public:
 protected:
   // --- The dialect's words -------------------------------------------------------
   virtual std::string comment(const std::string &text) const = 0;
+  /// What comes before the header comments ("%", a program name) and after the end.
+  virtual void opening() = 0;
+  virtual void closing() {}
+  /// The words of an arc's centre: its offset from the start as the
+  /// controller reads it (x the radius, z), or its radius and whether it
+  /// sweeps more than half a turn (all given).
+  virtual std::string arcCentre(const geom::Vec2 &offsetXZ, double radius, bool moreThanHalf) const;
   /// After the header comments: plane, X mode, units, absolute, no compensation.
   virtual void preamble() = 0;
   /// The end: spindle and coolant off, program end.

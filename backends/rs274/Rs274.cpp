@@ -169,6 +169,8 @@ public:
 
 private:
   std::string comment(const std::string &text) const override { return rs274Comment(text); }
+  void opening() override { out_.raw("%"); }
+  void closing() override { out_.raw("%"); }
   void preamble() override {
     out_.block("G18 G7 G21 G90 G40 G80");
     out_.block("G64 " + word("P", num(o_.tolerance.value_or(d_.tolerance))));

@@ -10,6 +10,7 @@
 #include "backends/common/EmitterBackend.h"
 #include "backends/common/IsoEmitter.h"
 #include "backends/common/IsoReader.h"
+#include "backends/common/LatheEmitter.h"
 
 #include <algorithm>
 #include <cctype>
@@ -193,6 +194,9 @@ public:
     return readSiemens840d(text, d);
   }
 
+  static std::optional<std::string> lathe(const ir::Module &module, const TargetDescriptor &d, const EmitOptions &o,
+                                          DiagnosticEngine &diags);
+
 private:
   /// A tap written as moves would feed out without reversing the spindle and
   /// break: every tapping step must be a CYCLE84, else nothing is written.
@@ -292,6 +296,55 @@ private:
     return true;
   }
 };
+
+/// SINUMERIK 840D lathe programs (docs/turning.md): G18, DIAMON, G96 S
+/// LIMS= with G95 feeds per revolution (the words as the 840D manuals give
+/// them); arcs by their radius (CR=), which DIAMON leaves as it is.
+class SiemensLatheEmitter final : public LatheEmitter {
+public:
+  using LatheEmitter::LatheEmitter;
+
+private:
+  std::string comment(const std::string &text) const override {
+    const size_t room = d_.maxLineLength > 32 ? d_.maxLineLength - 16 : std::string::npos;
+    return "; " + printable(text, room);
+  }
+  void opening() override {
+    out_.raw(word("%_N_", siemensProgramName(o_.programName)) + "_MPF");
+    out_.raw(";$PATH=/_N_MPF_DIR");
+  }
+  void preamble() override {
+    out_.block("G18 G90 G71 DIAMON G40");
+    out_.block("G64");
+  }
+  void postamble() override {
+    out_.block("M5");
+    out_.block("M9");
+    out_.block("M30");
+  }
+  void toolChange(int number) override {
+    out_.block(word("T", std::to_string(number)) + " D1");
+    out_.block("M6");
+  }
+  std::string surfaceSpeed(double metresPerMinute, double maxRpm, bool clockwise) const override {
+    return "G96 " + word("S", formatNumber(metresPerMinute, {0, false, false})) + " " +
+           word("LIMS=", formatNumber(maxRpm, {0, false, false})) + (clockwise ? " M3" : " M4");
+  }
+  std::string spindleSpeed(double rpm) const override {
+    return "G97 " + word("S", formatNumber(std::abs(rpm), {0, false, false})) + (rpm < 0 ? " M3" : " M4");
+  }
+  std::string feedMode(bool perRevolution) const override { return perRevolution ? "G95" : "G94"; }
+  std::string dwell(double seconds) const override { return "G4 F" + formatNumber(seconds, {3, false, true}); }
+  void message(const std::string &text) override { out_.block("MSG(\"" + printable(text, kMaxMessage) + "\")"); }
+  std::string arcCentre(const geom::Vec2 &, double radius, bool moreThanHalf) const override {
+    return word("CR=", num(moreThanHalf ? -radius : radius));
+  }
+};
+
+std::optional<std::string> SiemensEmitter::lathe(const ir::Module &module, const TargetDescriptor &d,
+                                                 const EmitOptions &o, DiagnosticEngine &diags) {
+  return SiemensLatheEmitter(d, o, diags).run(module);
+}
 
 } // namespace
 

@@ -341,10 +341,15 @@ Node turningTechnology(Lowerer &l, const Instance &tech) {
   if (auto f = tech.real("feedrate"))
     n.set("feed", Value::feed(l.feedMmPerMin(*f)));
   if (auto f = tech.real("feedrate_per_revolution")) {
-    if (*f > 0)
-      n.set("feed_per_rev", Value::feedPerRev(*f));
-    else
+    if (*f <= 0)
       l.missing(tech, "feedrate_per_revolution", "is not positive: a feed per revolution is a length (mm) above 0");
+    else if (*f < ir::kPlausibleMinFeedPerRev || *f > ir::kPlausibleMaxFeedPerRev)
+      l.missing(tech, "feedrate_per_revolution",
+                "is " + formatShortest(*f) + " mm/rev, outside what a lathe feeds (" +
+                    formatShortest(ir::kPlausibleMinFeedPerRev) + " to " + formatShortest(ir::kPlausibleMaxFeedPerRev) +
+                    " mm per revolution)");
+    else
+      n.set("feed_per_rev", Value::feedPerRev(*f));
   }
   Instance speed = tech.ref("spindle_speed");
   if (speed.isA("const_spindle_speed")) {

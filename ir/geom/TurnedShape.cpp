@@ -87,7 +87,7 @@ namespace {
 class Builder {
 public:
   Builder(const Node &f, const TurnStock &stock, double margin)
-      : f_(f), reachR_(stock.radius + margin), reachZ_(stock.z1 + margin) {}
+      : f_(f), reachR_(stock.radius + margin), reachZ_(stock.z1 + margin), lowZ_(stock.z0 - margin) {}
 
   TurnedShapeResult build() {
     const std::optional<Placed> p = placedOnAxis(f_, error_);
@@ -204,14 +204,19 @@ private:
                " is not along the axis: a face across the axis has its material on one side of it";
       return false;
     }
-    if (side.z() > 0) {
-      error_ = named(f_) + " has its material on the free end's side (+z): only faces looking towards the free "
-                           "end are turned yet";
-      return false;
-    }
     if (inner < 0 || extent <= 0) {
       error_ = named(f_) + " needs its radius and a linear profile with a length (the face's radial extent)";
       return false;
+    }
+    if (side.z() > 0) {
+      // A face looking towards the chuck (the part on the free end's side):
+      // what it removes is the bar between it and the chuck, as parting
+      // off does; no tool faces it from the chuck's side.
+      const double z0 = p.at.x();
+      s_.removal = Region{{ccwPolygon({{lowZ_, inner}, {z0, inner}, {z0, reachR_}, {lowZ_, reachR_}})}};
+      s_.contour = {Seg::line(Vec2(z0, reachR_), Vec2(z0, inner))};
+      s_.towardsChuck = true;
+      return true;
     }
     // Cleared from its inner radius out to the reach, whatever the profile's
     // length: the tool comes in across the face from the outside.
@@ -275,7 +280,7 @@ private:
   }
 
   const Node &f_;
-  double reachR_, reachZ_;
+  double reachR_, reachZ_, lowZ_;
   TurnedShape s_;
   std::string error_;
 };

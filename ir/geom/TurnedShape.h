@@ -55,6 +55,9 @@ struct TurnedShape {
   /// strategies plunge between the walls).
   std::optional<std::pair<double, double>> grooveSpan;
   double grooveFloor = 0;
+  /// A face whose material is on the free end's side: it looks towards the
+  /// chuck, and only parting off (cutting in) makes it.
+  bool towardsChuck = false;
   /// Where the feature is placed (its placement's origin in the half plane)
   /// and which way its axis runs along z (+1 or -1).
   HalfPlanePoint at = HalfPlanePoint::Zero();

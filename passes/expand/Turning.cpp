@@ -18,6 +18,7 @@
 
 #include "geom/Boolean.h"
 #include "ir/geom/Curves.h"
+#include "ir/Plausible.h"
 #include "ir/geom/TurnedShape.h"
 #include "support/Format.h"
 
@@ -144,6 +145,12 @@ public:
     // and ends, reached from the tool change position at rapid.
     home_ = Vec2(raw_.z1 + 5 * kLatheClearance + tool_.rc, raw_.radius + 5 * kLatheClearance + tool_.rc);
     w_.rapid(home_, "position");
+    if (shape_.towardsChuck && op_.kind != ir::Kind::CuttingIn) {
+      x_.report(ws_, feature_,
+                shape_.symbol + " looks towards the chuck (its material on the free end's side): no tool faces it "
+                                "from there; it is made by parting off (cutting_in)");
+      return false;
+    }
     bool ok = false;
     switch (op_.kind) {
     case ir::Kind::ContouringRough: ok = rough(false); break;
@@ -453,6 +460,16 @@ private:
       span0 = std::min(span0, p.dot(d));
       span1 = std::max(span1, p.dot(d));
     }
+    // Bidirectional passes are linked at feed where the step over from one
+    // pass's end to the next one's start spares the part: `held` is where
+    // the tool stays in the cut, and the way it came.
+    std::optional<std::pair<Vec2, Vec2>> held;
+    auto release = [&] {
+      if (held && !leave(held->first, (out - held->second).normalized(), out, lift * std::sqrt(2.0), false))
+        return false;
+      held.reset();
+      return true;
+    };
     for (double lv : levels) {
       const Vec2 dd = d * dirSign;
       const Vec2 base = out * lv;
@@ -463,16 +480,27 @@ private:
         // Slivers (the nose over a corner the contour pass takes) are left to it.
         if ((piece.b - piece.a).norm() < kMinRoughPass)
           continue;
-        const Vec2 entry = piece.a - dd * kLatheClearance;
-        if (!cut(entry, {Seg::line(piece.a, piece.b)}))
-          return false;
-        removeSwept({Seg::line(entry, piece.b)}, out);
-        if (!leave(piece.b, (out - dd).normalized(), out, lift * std::sqrt(2.0), false))
+        if (held && spares(held->first, piece.a)) {
+          w_.feed(piece.a, perRev_, "link");
+          w_.feed(piece.b, perRev_, "cut");
+          removeSwept({Seg::line(held->first, piece.a), Seg::line(piece.a, piece.b)}, out);
+        } else {
+          if (!release())
+            return false;
+          const Vec2 entry = piece.a - dd * kLatheClearance;
+          if (!cut(entry, {Seg::line(piece.a, piece.b)}))
+            return false;
+          removeSwept({Seg::line(entry, piece.b)}, out);
+        }
+        held = {piece.b, dd};
+        if (!bidirectional && !release())
           return false;
       }
       if (bidirectional)
         dirSign = -dirSign;
     }
+    if (!release())
+      return false;
     if (!facing)
       return contourPass(a, "cut");
     return true;
@@ -544,6 +572,23 @@ private:
       std::reverse(chain.begin(), chain.end());
       for (Seg &s : chain)
         s = s.reversed();
+    }
+    // Pieces shorter than a micrometre (where offsets of two corners nearly
+    // meet) joined into their neighbours: a controller may read a tiny
+    // arc whose ends print as one point as a whole circle.
+    for (size_t k = 0; k < chain.size() && chain.size() > 1;) {
+      if (chain[k].length() >= 1e-3) {
+        ++k;
+        continue;
+      }
+      const Vec2 from = chain[k].a, to = chain[k].b;
+      chain.erase(chain.begin() + static_cast<long>(k));
+      if (k < chain.size() && !chain[k].isArc())
+        chain[k].a = from;
+      else if (k > 0 && !chain[k - 1].isArc())
+        chain[k - 1].b = to;
+      else if (k < chain.size())
+        chain.insert(chain.begin() + static_cast<long>(k), Seg::line(from, chain[k].a));
     }
     // Trimmed to the pieces that touch material.
     const Region material = geom::intersect(stock_, removal_);
@@ -660,6 +705,22 @@ private:
     return 0;
   }
 
+  /// The operation's dwell at the bottom of a plunge; one shorter than a
+  /// controller dwells (a dwell in revolutions at a fast spindle) is said
+  /// once and not written.
+  void dwell() {
+    const double s = dwellSeconds();
+    if (s > 0 && s < ir::kMinDwellS) {
+      if (!saidShortDwell_)
+        x_.assumed(ws_, op_,
+                   "its dwell of " + formatShortest(s) + " s is shorter than a controller dwells (" +
+                       formatShortest(ir::kMinDwellS) + " s): not written");
+      saidShortDwell_ = true;
+      return;
+    }
+    w_.dwell(s);
+  }
+
   double movesSpindle() const { return moves_.number("spindle").value_or(0); }
 
   /// The radius above which the band [z, z + width] of the stock is clear.
@@ -676,7 +737,7 @@ private:
     const Vec2 entry(zc, top), end(zc, bottom + tool_.rc);
     if (!cut(entry, {Seg::line(entry, end)}, role))
       return false;
-    w_.dwell(dwellSeconds());
+    dwell();
     w_.rapid(entry, "retract");
     removeSwept({Seg::line(entry, end)}, Vec2(0, 1));
     return true;
@@ -779,6 +840,7 @@ private:
   /// the raw piece's chuck-side end), which no tool may enter.
   Region removal_, chuck_;
   double perRev_ = 0;
+  bool saidShortDwell_ = false;
   Vec2 home_ = Vec2::Zero();
 };
 

@@ -25,7 +25,12 @@ and reports what would be wrong there:
     too); with CR= the radius reaches across the chord; TURN= only with I/J;
   * the first move of the program, and the first after each tool change,
     is Z alone (up to the clearance height): where the tool is then is the
-    machine's business, so X and Y only move once it is up;
+    machine's business, so X and Y only move once it is up (not in a lathe
+    program, whose tool comes from its turret outside the stock);
+  * lathe programs (docs/turning.md): G18 (the ZX plane: arcs in Z and X,
+    G3 counter-clockwise seen from +Y), DIAMON (X a diameter), G95 (F per
+    revolution), G96 with S and LIMS= (constant cutting speed and its
+    spindle limit), G97; Y is not written;
   * modal cycles: `MCALL CYCLE..` then position blocks (X/Y only, from above
     the reference plane) then a bare `MCALL`, nothing else in between;
   * cubic splines: `CSPLINE BAUTO EAUTO` (no end condition taken from the
@@ -67,10 +72,13 @@ MAX_NAME = 24
 # G54..G57 and the user frames G505..G599: the work offset of each clamping
 # of a program that re-clamps the workpiece (docs/setups.md).
 G_CODES = {0, 1, 2, 3, 4, 17, 40, 64, 71, 90, 94, 642} | set(range(54, 58)) | set(range(505, 600))
+# Lathe programs (docs/turning.md): the ZX plane, feed per revolution,
+# constant cutting speed and its end.
+G_CODES |= {18, 95, 96, 97}
 MOTION = {0, 1, 2, 3}
 M_CODES = {0, 1, 3, 4, 5, 6, 7, 8, 9, 30}
 LENGTH_WORDS = set("XYZIJK") | {"CR", "F"}
-INTEGER_WORDS = {"S", "T", "D", "TURN"}
+INTEGER_WORDS = {"S", "T", "D", "TURN", "LIMS"}
 # Cycle: (fewest arguments, most arguments or None).
 CYCLES = {"CYCLE81": (5, 5), "CYCLE82": (6, 6), "CYCLE83": (12, None), "CYCLE84": (12, None)}
 
@@ -79,8 +87,8 @@ TOKEN_RE = re.compile(
     r'\s*(?:(?P<msg>MSG\("[^"]*"\))'
     r"|(?P<call>(?:CYCLE\d+)\([^()]*\))"
     r"|(?P<mcall>MCALL)(?![A-Z0-9_])"
-    r"|(?P<keyword>CSPLINE|BAUTO|EAUTO)(?![A-Z0-9_])"
-    r"|(?P<assign>(?:CR|TURN)=(?P<avalue>" + NUMBER + r"))"
+    r"|(?P<keyword>CSPLINE|BAUTO|EAUTO|DIAMON)(?![A-Z0-9_])"
+    r"|(?P<assign>(?:CR|TURN|LIMS)=(?P<avalue>" + NUMBER + r"))"
     r"|(?P<letter>[A-Z])(?P<value>" + NUMBER + r"))")
 
 
@@ -231,6 +239,14 @@ class Checker:
         self.problems = []
         self.pos = {"X": None, "Y": None, "Z": None}
         self.modal = {"absolute": False, "metric": False, "plane": False}
+        # A lathe program: G18 (the ZX plane), X a diameter under DIAMON,
+        # F per revolution under G95, S a cutting speed under G96 (with
+        # LIMS= its spindle limit).
+        self.plane = "xy"
+        self.lathe = False
+        self.diameter = False
+        self.per_rev = False
+        self.css = False
         self.motion = None
         self.feed = None
         self.spindle_speed = 0
@@ -340,7 +356,7 @@ class Checker:
         gs, ms = [], []
         bad = False
         for address, value in words:
-            if address in ("MSG", "CALL", "MCALL", "CSPLINE", "BAUTO", "EAUTO"):
+            if address in ("MSG", "CALL", "MCALL", "CSPLINE", "BAUTO", "EAUTO", "DIAMON"):
                 continue
             if address in LENGTH_WORDS or address in INTEGER_WORDS or address in "GM":
                 problem = number_problem(address, value)
@@ -354,6 +370,9 @@ class Checker:
             return
         for address, value in words:
             if address in ("MSG", "CALL", "MCALL", "CSPLINE", "BAUTO", "EAUTO"):
+                continue
+            if address == "DIAMON":
+                self.diameter = True
                 continue
             if address == "G":
                 g = float(value)
@@ -413,6 +432,23 @@ class Checker:
                 self.modal["metric"] = True
             elif g == 17:
                 self.modal["plane"] = True
+                self.plane = "xy"
+            elif g == 18:
+                self.modal["plane"] = True
+                self.plane = "zx"
+                self.lathe = True
+            elif g in (94, 95):
+                self.per_rev = g == 95
+            elif g == 96:
+                if "S" not in seen or seen["S"] <= 0:
+                    self.problem(n, "G96 without a cutting speed S")
+                if "LIMS" not in seen or seen["LIMS"] <= 0:
+                    self.problem(n, "G96 without LIMS= (the spindle would race as the tool nears the axis)")
+                self.css = True
+                # G96 turns G95 on (the manual's words)
+                self.per_rev = True
+            elif g == 97:
+                self.css = False
         if "F" in seen:
             if seen["F"] <= 0:
                 self.problem(n, "feed F%s" % seen["F"])
@@ -423,6 +459,8 @@ class Checker:
             self.tool_selected = int(seen["T"])
         for m in ms:
             self.m_code(n, m)
+        if "LIMS" in seen and 96 not in gs:
+            self.problem(n, "LIMS= outside a G96 block")
         if "D" in seen:
             # D before the M6 that changes in the selected tool is that tool's
             # offset, taken on by the M6; otherwise it applies at once.
@@ -488,6 +526,9 @@ class Checker:
             self.problem(n, "axis words with no motion G code (G0 G1 G2 G3)")
             return
         self.counts["moves"] += 1
+        if self.up_first and self.lathe:
+            # A lathe's tool comes from its turret outside the stock: no Z first.
+            self.up_first = None
         if self.up_first:
             if self.motion != 0 or any(a in seen for a in ("X", "Y", "I", "J", "CR", "TURN")):
                 self.problem(n, "the first move after %s is not G0 with Z alone (up to the clearance height "
@@ -505,10 +546,19 @@ class Checker:
         for bad in ("I", "J", "K", "CR", "TURN"):
             if bad in seen:
                 self.problem(n, "%s on a straight move" % bad)
+        self.advance(n, seen)
+        self.make(n, "rapid" if self.motion == 0 else "linear", self.feed if self.motion else 0)
+
+    def advance(self, n, seen):
+        """The tracked position after a block's axis words: X halved under DIAMON;
+        a lathe's Y is 0."""
         for axis in "XYZ":
             if axis in seen:
-                self.pos[axis] = seen[axis]
-        self.make(n, "rapid" if self.motion == 0 else "linear", self.feed if self.motion else 0)
+                self.pos[axis] = seen[axis] / 2 if axis == "X" and self.diameter else seen[axis]
+        if self.lathe:
+            if "Y" in seen:
+                self.problem(n, "Y in a lathe program")
+            self.pos["Y"] = 0.0
 
     def make(self, n, kind, feed, at=None, **arc):
         to = at if at is not None else (self.pos["X"], self.pos["Y"], self.pos["Z"])
@@ -517,10 +567,20 @@ class Checker:
     def arc(self, n, seen):
         if not self.modal["plane"]:
             self.problem(n, "an arc before G17 (XY plane)")
-        if "K" in seen:
-            self.problem(n, "K on an arc in the XY plane")
-        start = (self.pos["X"], self.pos["Y"])
-        end = (seen.get("X", self.pos["X"]), seen.get("Y", self.pos["Y"]))
+        if self.plane == "zx":
+            # (Z, X): G3 counter-clockwise seen from +Y; X a radius here.
+            x_end = seen["X"] / 2 if "X" in seen and self.diameter else seen.get("X", self.pos["X"])
+            start = (self.pos["Z"], self.pos["X"])
+            end = (seen.get("Z", self.pos["Z"]), x_end)
+            if "J" in seen or "Y" in seen:
+                self.problem(n, "J or Y on an arc in the ZX plane")
+            offset = (seen.get("K", 0.0), seen.get("I", 0.0))
+        else:
+            if "K" in seen:
+                self.problem(n, "K on an arc in the XY plane")
+            start = (self.pos["X"], self.pos["Y"])
+            end = (seen.get("X", self.pos["X"]), seen.get("Y", self.pos["Y"]))
+            offset = (seen.get("I", 0.0), seen.get("J", 0.0))
         ccw = self.motion == 3
         centre = None
         if None in start or None in end:
@@ -544,11 +604,11 @@ class Checker:
                 left = (-(end[1] - start[1]) / chord, (end[0] - start[0]) / chord)
                 side = (1 if ccw else -1) * (1 if seen["CR"] > 0 else -1)
                 centre = ((start[0] + end[0]) / 2 + side * h * left[0], (start[1] + end[1]) / 2 + side * h * left[1])
-        elif "I" in seen or "J" in seen:
+        elif "I" in seen or "J" in seen or ("K" in seen and self.plane == "zx"):
             self.counts["ijk"] += 1
             if "TURN" in seen:
                 self.counts["turn"] += 1
-            centre = (start[0] + seen.get("I", 0.0), start[1] + seen.get("J", 0.0))
+            centre = (start[0] + offset[0], start[1] + offset[1])
             r0, r1 = math.dist(start, centre), math.dist(end, centre)
             if r0 < 1e-9:
                 centre = None
@@ -559,9 +619,7 @@ class Checker:
                              % (r0, r1, abs(r0 - r1), RADIUS_TOL))
         else:
             self.problem(n, "an arc with neither I/J nor CR=")
-        for axis in "XYZ":
-            if axis in seen:
-                self.pos[axis] = seen[axis]
+        self.advance(n, seen)
         if centre is not None:
             sweep = arc_sweep(start, end, centre, ccw) + 2 * math.pi * seen.get("TURN", 0)
             self.make(n, "arc", self.feed, centre=centre, ccw=ccw, sweep=sweep, radius=math.dist(start, centre),
