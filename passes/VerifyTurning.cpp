@@ -95,6 +95,9 @@ std::string where(const Region &r) {
 struct Insert {
   std::vector<Vec2> skeleton;  ///< relative to the chuck-side corner's centre
   double rc = 0;
+  /// From the point moves program to that centre: the corner's imaginary
+  /// tip (turning, grooving) or the point of a threading insert's V.
+  Vec2 tipToCentre = Vec2::Zero();
 
   /// The area the insert covers moving from `a` to `b` (corner centres).
   Region sweep(const Vec2 &a, const Vec2 &b) const {
@@ -127,7 +130,14 @@ Insert insertOf(const Node &tool) {
   in.rc = tool.number("corner_radius").value_or(0);
   const double edge =
       tool.number("cutting_edge_length").value_or(tool.number("max_cutting_depth").value_or(kDefaultEdge));
-  if (tool.text("type") == "grooving_tool") {
+  in.tipToCentre = Vec2(in.rc, in.rc);
+  if (tool.text("type") == "threading_tool") {
+    // A V of the thread's angle pointing at the axis, as deep as the tool cuts.
+    const double half = tool.number("thread_angle").value_or(60) * kDegree / 2;
+    const double depth = tool.number("max_cutting_depth").value_or(kDefaultEdge);
+    in.skeleton = {Vec2(0, 0), Vec2(-std::tan(half), 1) * depth, Vec2(std::tan(half), 1) * depth};
+    in.tipToCentre = Vec2(0, in.rc);
+  } else if (tool.text("type") == "grooving_tool") {
     const double w = std::max(tool.number("cutting_width").value_or(2 * in.rc) - 2 * in.rc, 0.0);
     const double depth = tool.number("max_cutting_depth").value_or(kDefaultEdge * 2);
     in.skeleton = {Vec2(0, 0), Vec2(w, 0), Vec2(w, depth), Vec2(0, depth)};
@@ -214,7 +224,7 @@ private:
     const double t = tolerance_.value_or(wp->number("global_tolerance").value_or(0.01));
     const double allowance = op->number("allowance").value_or(0);
     const Insert insert = insertOf(*tool);
-    const Vec2 tipToCentre(insert.rc, insert.rc);
+    const Vec2 tipToCentre = insert.tipToCentre;
     // What the step may not cut: the part grown by its allowance, and the chuck.
     const Region guard = geom::unite(allowance > 0 ? geom::growExact(w->part, allowance) : w->part, w->chuck);
     std::vector<Region> pending;
@@ -261,7 +271,9 @@ private:
     flush();
     stats_["turning moves checked"] += checked;
     stats_["turning steps verified"]++;
-    if (op->is(ir::Trait::Finishing) && shape.shape)
+    // A thread's flanks are not a body of revolution: its band is the part's
+    // by the features' reading, and nothing is asked of what a pass leaves.
+    if (op->is(ir::Trait::Finishing) && shape.shape && !shape.shape->thread)
       finished(ws, *w, *shape.shape, insert, allowance, t);
   }
 

@@ -58,9 +58,9 @@ std::optional<std::string> LatheEmitter::run(const ir::Module &module) {
                      ", Z along the spindle axis; feeds mm/rev, cutting speeds m/min, spindle rev/min"));
   out_.block(comment("coordinates are the workpiece's: X0 on the spindle axis; set the work offset's Z to the "
                      "workpiece's origin"));
-  out_.block(comment("moves stepnc plans program each insert's imaginary tip (its chuck-side corner), touched off "
-                     "on X and Z, with the nose radius in the path (G40); toolpaths the file gives are written as "
-                     "given"));
+  out_.block(comment("moves stepnc plans program each turning or grooving insert's imaginary tip (its chuck-side "
+                     "corner), a threading insert's point, touched off on X and Z, with the nose radius in the path "
+                     "(G40); toolpaths the file gives are written as given"));
   out_.block(comment(o_.toolTable ? "tool numbers from the tool table" : "no tool table: tools numbered in order "
                                                                          "of first use"));
   // The tools, numbered in order of first use (or by the table).
@@ -74,6 +74,9 @@ std::optional<std::string> LatheEmitter::run(const ir::Module &module) {
                              formatFixed(tool->number("corner_radius").value_or(0), 3) + " mm" +
                              (tool->has("cutting_width")
                                   ? ", width " + formatFixed(*tool->number("cutting_width"), 3) + " mm"
+                                  : std::string()) +
+                             (tool->has("thread_pitch")
+                                  ? ", pitch " + formatFixed(*tool->number("thread_pitch"), 3) + " mm"
                                   : std::string())));
         }
   if (!ok_)
@@ -170,6 +173,18 @@ void LatheEmitter::move(const ir::Move &m) {
     return;
   }
   const double perRev = m.node ? m.node->number("feed_per_rev").value_or(0) : 0;
+  if (m.role == "thread") {
+    // Synchronised with the spindle: G33 with the lead as K (LinuxCNC and
+    // the 840D alike); the feed is the lead, F stays as it was.
+    modal_.change("G", "33");
+    text = "G33";
+    modal_.forget("X");
+    modal_.forget("Z");
+    axis("X", x);
+    axis("Z", z);
+    out_.block(text + " " + word("K", formatNumber(perRev, {4, false, true})));
+    return;
+  }
   const bool byRev = perRev > 0;
   if (!perRev_ || *perRev_ != byRev) {
     out_.block(feedMode(byRev));

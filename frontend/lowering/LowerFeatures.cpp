@@ -404,6 +404,48 @@ std::optional<std::string> Lowerer::feature(const Instance &f) {
         missing(f, "feature_length");
       addTaper("reduced_size", "reduced_diameter", "taper of an outer diameter");
     }
+  } else if (f.isA("defined_thread")) {
+    // A thread on the turning axis: its diameters and length; the pitch
+    // follows from them and the form (docs/turning.md).
+    n.kind = ir::Kind::Thread;
+    commonPlacement();
+    length("major_diameter", "major_diameter");
+    if (!n.has("major_diameter"))
+      missing(f, "major_diameter");
+    length("pitch_diameter", "pitch_diameter");
+    length("minor_diameter", "minor_diameter");
+    if (Instance partial = f.ref("partial_profile")) {
+      if (auto l = toleranced(partial, "effective_length"))
+        n.set("length", Value::length(*l));
+      else
+        missing(partial, "effective_length");
+    } else {
+      missing(f, "partial_profile");
+    }
+    if (Instance starts = f.ref("number_of_threads"))
+      if (auto v = starts.real("its_parameter_value")) {
+        if (*v >= 1 && *v <= 100 && *v == std::floor(*v))
+          n.set("starts", Value::integer(static_cast<int64_t>(*v)));
+        else
+          missing(starts, "its_parameter_value", "is not a number of thread starts (a whole number from 1)");
+      }
+    if (Instance hand = f.ref("thread_hand")) {
+      std::string h = hand.string("descriptive_string").value_or("");
+      std::transform(h.begin(), h.end(), h.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+      if (h == "right" || h == "left")
+        n.set("hand", Value::word(h));
+      else
+        missing(hand, "descriptive_string", "is not a thread's hand (right or left)");
+    }
+    if (auto inner = f.boolean("inner_or_outer_thread"))
+      n.set("inner", Value::boolean(*inner));
+    if (Instance form = f.ref("form"))
+      if (auto text = form.string("descriptive_string"))
+        n.set("form", Value::string(*text));
+  } else if (f.isA("thread")) {
+    unsupported(f, "thread (a catalogue thread gives its size by a reference to a standard; stepnc turns defined "
+                   "threads, whose diameters the file gives)");
+    return std::nullopt;
   } else if (f.isA("revolved_feature")) {
     static constexpr std::tuple<std::string_view, ir::Kind, std::string_view> kRevolved[] = {
         {"revolved_flat", ir::Kind::RevolvedFlat, "flat_edge_shape"},

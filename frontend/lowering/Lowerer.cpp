@@ -327,7 +327,10 @@ std::optional<Node> Lowerer::workingstep(const Instance &ws) {
   else
     missing(ws, "its_feature");
   const Node *featureNode = f ? ir::findFeature(*module_, *f) : nullptr;
-  const bool onTop = !featureNode || (featureNode->vec("axis").value_or(Vec3::UnitZ()) - Vec3::UnitZ()).norm() < 1e-9;
+  // A turned feature's axis is the turning axis, either way: a lathe turns
+  // the part about it, no re-clamping (docs/turning.md).
+  const bool onTop = !featureNode || featureNode->is(ir::Trait::Turning) ||
+                     (featureNode->vec("axis").value_or(Vec3::UnitZ()) - Vec3::UnitZ()).norm() < 1e-9;
   if (onTop)
     if (auto h = planeHeight(ws, "its_secplane", "security plane"))
       node.set("secplane", Value::length(*h));

@@ -102,6 +102,7 @@ public:
     case Kind::OuterDiameterToShoulder: return toShoulder(*p) ? ok() : fail();
     case Kind::RevolvedFlat: return revolvedFlat(*p) ? ok() : fail();
     case Kind::Groove: return groove(*p) ? ok() : fail();
+    case Kind::Thread: return thread(*p) ? ok() : fail();
     default:
       error_ = named(f_) + " has no turned shape in stepnc yet (docs/turning.md lists the features turned)";
       return fail();
@@ -276,6 +277,47 @@ private:
     s_.contour = path;  // from the low z wall's top round to the high one's
     s_.grooveSpan = {lo, hi};
     s_.grooveFloor = floor;
+    return true;
+  }
+
+  bool thread(const Placed &p) {
+    // ISO 68-1's basic profile of a 60 degree thread: the pitch diameter is
+    // d - 0.649519 P; an outer thread's root (minor) diameter is
+    // d - 1.226869 P, the depth 0.613435 P (ISO 965-1's d3).
+    if (f_.flag("inner").value_or(false)) {
+      error_ = named(f_) + " is an inner thread: only outer threads are turned yet";
+      return false;
+    }
+    const double major = f_.number("major_diameter").value_or(0), length = f_.number("length").value_or(0);
+    const std::optional<double> pitchD = f_.number("pitch_diameter"), minor = f_.number("minor_diameter");
+    if (major <= 0 || length <= 0) {
+      error_ = named(f_) + " needs its major diameter and its length";
+      return false;
+    }
+    TurnedShape::ThreadSpan t;
+    if (pitchD) {
+      t.pitch = (major - *pitchD) / 0.649519;
+      if (!(t.pitch > 0) || *pitchD <= 0) {
+        error_ = named(f_) + ": its pitch diameter " + formatFixed(*pitchD, 4) + " mm is not below its major diameter " +
+                 formatFixed(major, 4) + " mm";
+        return false;
+      }
+    }
+    double root = minor ? *minor / 2 : (t.pitch > 0 ? (major - 1.226869 * t.pitch) / 2 : 0);
+    if (root <= 0 || root >= major / 2) {
+      error_ = named(f_) + " needs a minor diameter below its major one, or its pitch diameter (to derive the pitch "
+                           "and root of its 60 degree profile)";
+      return false;
+    }
+    t.lo = std::min(p.at.x(), p.at.x() + p.sign * length);
+    t.hi = std::max(p.at.x(), p.at.x() + p.sign * length);
+    t.majorRadius = major / 2;
+    t.rootRadius = root;
+    t.starts = static_cast<int>(f_.count("starts").value_or(1));
+    t.leftHand = f_.text("hand") == "left";
+    s_.removal = Region{{ccwPolygon({{t.lo, root}, {t.hi, root}, {t.hi, reachR_}, {t.lo, reachR_}})}};
+    s_.contour = {Seg::line(Vec2(t.hi, root), Vec2(t.lo, root))};
+    s_.thread = t;
     return true;
   }
 

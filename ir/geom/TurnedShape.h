@@ -55,6 +55,16 @@ struct TurnedShape {
   /// strategies plunge between the walls).
   std::optional<std::pair<double, double>> grooveSpan;
   double grooveFloor = 0;
+  /// An outer thread: its extent along the axis (lo < hi), its major and
+  /// root (minor) radii, its pitch and starts (docs/turning.md).
+  struct ThreadSpan {
+    double lo = 0, hi = 0;
+    double majorRadius = 0, rootRadius = 0;
+    double pitch = 0;
+    int starts = 1;
+    bool leftHand = false;
+  };
+  std::optional<ThreadSpan> thread;
   /// A face whose material is on the free end's side: it looks towards the
   /// chuck, and only parting off (cutting in) makes it.
   bool towardsChuck = false;

@@ -44,6 +44,7 @@ Vec3 space(const Vec2 &p) { return Vec3(p.y(), 0, p.x()); }
 /// The insert as the paths see it.
 struct LatheTool {
   bool grooving = false;
+  bool threading = false;
   double rc = 0;     ///< nose (corner) radius
   double width = 0;  ///< a grooving insert's cutting width
   double maxDepth = 0;
@@ -98,6 +99,9 @@ public:
     pos_ = s.b;
   }
 
+  /// The tool is at `c` after a move written by hand.
+  void moved(const Vec2 &c) { pos_ = c; }
+
   void dwell(double seconds) {
     if (seconds <= 0)
       return;
@@ -151,6 +155,14 @@ public:
                                 "from there; it is made by parting off (cutting_in)");
       return false;
     }
+    const bool threadOp = op_.kind == ir::Kind::ThreadingRough || op_.kind == ir::Kind::ThreadingFinish;
+    if (tool_.threading != threadOp) {
+      x_.report(ws_, toolNode_,
+                threadOp ? "threading needs a threading tool; " + toolNode_.symbol + " is a " +
+                               toolNode_.text("type").value_or("")
+                         : "its threading tool " + toolNode_.symbol + " only cuts threads");
+      return false;
+    }
     bool ok = false;
     switch (op_.kind) {
     case ir::Kind::ContouringRough: ok = rough(false); break;
@@ -160,6 +172,8 @@ public:
     case ir::Kind::GroovingRough: ok = grooveRough(); break;
     case ir::Kind::GroovingFinish: ok = grooveFinish(); break;
     case ir::Kind::CuttingIn: ok = cutIn(); break;
+    case ir::Kind::ThreadingRough: ok = threading(false); break;
+    case ir::Kind::ThreadingFinish: ok = threading(true); break;
     default:
       x_.report(ws_, op_,
                 "its operation " + op_.kindName() + " '" + op_.label +
@@ -188,10 +202,16 @@ private:
         return false;
       }
       tool_.corners = {0.0, (tool_.width - 2 * tool_.rc) / 2, tool_.width - 2 * tool_.rc};
+    } else if (type == "threading_tool") {
+      // Programmed at the point of its V, the tip circle's lowest point.
+      tool_.threading = true;
+      tool_.tip = Vec2(0, -tool_.rc);
+      return true;
     } else if (type != "turning_tool") {
       x_.report(ws_, toolNode_,
                 "its tool " + toolNode_.symbol + " is a " + type +
-                    ": stepnc turns with turning tools and grooves and cuts in with grooving tools");
+                    ": stepnc turns with turning tools, grooves and cuts in with grooving tools, threads with "
+                    "threading tools");
       return false;
     }
     tool_.tip = Vec2(-tool_.rc, -tool_.rc);
@@ -821,6 +841,143 @@ private:
       stock_ = geom::intersect(stock_, box(Vec2(raw_.z0 - 1, -1), Vec2(zEdge, 1e5)));
       refreshObstacle();
     }
+    return true;
+  }
+
+  // --- threads ---------------------------------------------------------------------
+
+  /// The cumulative depths of a threading step's passes, the last at `target`:
+  /// the strategy's depths per pass, else its infeed law from a first pass
+  /// of at most 0.3 mm (constant depth: equal passes; otherwise constant
+  /// removal: the depth after pass n is d1 sqrt(n), LinuxCNC's G76 with R 2).
+  std::vector<double> threadDepths(double from, double target) {
+    std::vector<double> out;
+    double at = from;
+    const Node *st = strategy();
+    if (st)
+      if (const ir::Value *v = st->get("cutting_depths"); v && !v->numbers.empty()) {
+        for (double d : v->numbers) {
+          if (d <= 0) {
+            x_.report(ws_, *st, "its strategy's cutting depths must be positive (" + formatShortest(d) + " mm)");
+            return {};
+          }
+          if (at >= target - 1e-9)
+            break;
+          at = std::min(at + d, target);
+          out.push_back(at);
+        }
+        if (at < target - 1e-9) {
+          x_.assumed(ws_, *st,
+                     "its cutting depths reach " + formatFixed(at, 4) + " mm of the thread's " +
+                         formatFixed(target, 4) + " mm: one more pass to the full depth");
+          out.push_back(target);
+        }
+        return out;
+      }
+    const double span = target - from;
+    if (span <= 1e-9)
+      return out;
+    const double first = std::min(0.3, span);
+    const bool constantDepth = st && st->text("infeed") == "constant_depth";
+    for (int n = 1; at < target - 1e-9 && n <= kMaxLevels; ++n) {
+      at = std::min(from + (constantDepth ? first * n : first * std::sqrt(static_cast<double>(n))), target);
+      out.push_back(at);
+    }
+    return out;
+  }
+
+  /// Threading: passes along the thread from a run-in of two pitches before
+  /// its free-end end to its chuck-side end, each deeper (radial infeed),
+  /// the spindle and the feed synchronised (`role=thread`, the feed per
+  /// revolution the lead); out radially, where nothing is left to cut (a
+  /// groove or the part's end), and back. Roughing stops the allowance
+  /// short of the full depth; finishing cuts to the full depth (less its
+  /// own allowance), then once more there (a spring pass).
+  bool threading(bool finishing) {
+    if (!shape_.thread) {
+      x_.report(ws_, feature_, "threading cuts threads; " + shape_.symbol + " is a " + feature_.kindName());
+      return false;
+    }
+    const ir::TurnedShape::ThreadSpan &t = *shape_.thread;
+    if (t.starts != 1 || t.leftHand) {
+      x_.report(ws_, feature_,
+                shape_.symbol + (t.leftHand ? " is a left-hand thread" : " has several starts") +
+                    ": stepnc cuts single-start right-hand threads yet");
+      return false;
+    }
+    // The tool's pitch is exact; the one a thread's diameters give is as
+    // exact as their decimals (1 % agreement asked).
+    const double toolPitch = toolNode_.number("thread_pitch").value_or(0);
+    const double pitch = toolPitch > 0 ? toolPitch : t.pitch;
+    if (pitch <= 0) {
+      x_.report(ws_, feature_, shape_.symbol + " gives no pitch (no pitch diameter) and its tool " + toolNode_.symbol +
+                                   " none either");
+      return false;
+    }
+    if (t.pitch > 0 && toolPitch > 0 && std::abs(t.pitch - toolPitch) > 0.01 * toolPitch) {
+      x_.report(ws_, toolNode_,
+                "its threading tool " + toolNode_.symbol + " cuts a " + formatFixed(toolPitch, 4) + " mm pitch, " +
+                    shape_.symbol + " has " + formatFixed(t.pitch, 4) + " mm (from its diameters)");
+      return false;
+    }
+    if (perRev_ > 0 && std::abs(perRev_ - pitch) > 1e-6)
+      x_.assumed(ws_, *op_.child(ir::Kind::Technology),
+                 "its feed per revolution " + formatFixed(perRev_, 4) + " mm is not the thread's lead " +
+                     formatFixed(pitch, 4) + " mm: the passes follow the lead");
+    for (const Node &c : moves_.children)
+      if (c.kind == ir::Kind::State && c.has("surface_speed")) {
+        const Node *tech = op_.child(ir::Kind::Technology);
+        x_.report(ws_, tech ? *tech : op_,
+                  "threading follows the spindle: it needs a constant spindle speed, not a constant cutting speed");
+        return false;
+      }
+    const double depth = t.majorRadius - t.rootRadius;
+    const double allowance = op_.number("allowance").value_or(0);
+    if (allowance < 0 || allowance >= depth) {
+      x_.report(ws_, op_, "its allowance " + formatFixed(allowance, 4) + " mm is not within the thread's depth " +
+                              formatFixed(depth, 4) + " mm");
+      return false;
+    }
+    std::vector<double> passes;
+    if (finishing) {
+      // To the full depth less its own allowance (none, as a rule), then a
+      // spring pass there.
+      passes = {depth - allowance, depth - allowance};
+    } else {
+      passes = threadDepths(0, depth - allowance);
+      if (!x_.result.ok)
+        return false;
+    }
+    const double runIn = t.hi + 2 * pitch, clearR = t.majorRadius + kLatheClearance + tool_.rc;
+    const Vec2 outAtStart(runIn, clearR);
+    for (double d : passes) {
+      const double r = t.majorRadius - d + tool_.rc;  // the tip circle's centre
+      const Vec2 start(runIn, r), end(t.lo, r), outAtEnd(t.lo, clearR);
+      if (!travel(outAtStart))
+        return false;
+      if (!clear(outAtStart, start)) {
+        x_.report(ws_, feature_,
+                  "no room to run in before " + shape_.symbol + ": the stock reaches past its free-end end");
+        return false;
+      }
+      w_.rapid(start, "approach");
+      Node &m = moves_.add(Node(ir::Kind::Linear));
+      m.set("to", Value::point(space(end + tool_.tip)));
+      m.set("feed_per_rev", Value::feedPerRev(pitch));
+      m.set("role", Value::word("thread"));
+      w_.moved(end);
+      if (!clear(end, outAtEnd)) {
+        x_.report(ws_, feature_,
+                  shape_.symbol + " ends in material at z " + formatFixed(t.lo, 4) +
+                      " mm: the tool cannot leave the thread there (give it a groove to run out into)");
+        return false;
+      }
+      w_.rapid(outAtEnd, "retract");
+    }
+    // The thread's band is cut when the step ends (passes do not clear it
+    // for one another's way out).
+    const double deepest = t.majorRadius - passes.back() + tool_.rc;
+    removeSwept({Seg::line(Vec2(runIn, deepest), Vec2(t.lo, deepest))}, Vec2(0, 1));
     return true;
   }
 

@@ -45,7 +45,8 @@ from toolpath_ir import arc_sweep, local, world
 
 TOL = 1e-3
 
-CANON_RE = re.compile(r"(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED|SET_FEED_RATE|NURBS_FEED|DWELL|SELECT_PLANE)\(([^)]*)\)")
+CANON_RE = re.compile(r"(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED|SET_FEED_RATE|NURBS_FEED|DWELL|SELECT_PLANE|"
+                      r"START_SPEED_FEED_SYNC|STOP_SPEED_FEED_SYNCH)\(([^)]*)\)")
 CANON_PLANES = {"CANON_PLANE_XY": "xy", "CANON_PLANE_XZ": "zx", "CANON_PLANE_YZ": "yz"}
 G5_RE = re.compile(r"^G5 X(\S+) Y(\S+) I(\S+) J(\S+) P(\S+) Q(\S+)")
 SPLINE_TOL = 0.01
@@ -62,6 +63,7 @@ def g5_blocks(program):
 def canon_moves(path, program):
     out = []
     feed = 0.0
+    synced = None
     splines = iter(g5_blocks(program))
     at = (0.0, 0.0, 0.0)
     plane = "xy"
@@ -76,6 +78,15 @@ def canon_moves(path, program):
                 continue
             if m.group(1) == "SET_FEED_RATE":
                 feed = float(args[0])
+                continue
+            # G33: the moves until the sync stops advance K per revolution,
+            # whatever F says; they are the IR's `role=thread` lines, their
+            # feed per revolution the lead.
+            if m.group(1) == "START_SPEED_FEED_SYNC":
+                synced = float(args[0])
+                continue
+            if m.group(1) == "STOP_SPEED_FEED_SYNCH":
+                synced = None
                 continue
             if m.group(1) == "DWELL" and float(args[0]) == 0:
                 continue  # G84 waits 0 s at the bottom: no wait
@@ -105,7 +116,7 @@ def canon_moves(path, program):
                 move = {"kind": kind, "to": tuple(float(a) for a in args[:3]),
                         "text": "canon line %d: %s" % (n, line.strip())}
                 if kind == "linear":
-                    move["feed"] = feed
+                    move["feed"] = feed if synced is None else synced
                 out.append(move)
             at = out[-1]["to"]
     return out

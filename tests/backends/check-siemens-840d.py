@@ -74,8 +74,9 @@ MAX_NAME = 24
 G_CODES = {0, 1, 2, 3, 4, 17, 40, 64, 71, 90, 94, 642} | set(range(54, 58)) | set(range(505, 600))
 # Lathe programs (docs/turning.md): the ZX plane, feed per revolution,
 # constant cutting speed and its end.
-G_CODES |= {18, 95, 96, 97}
-MOTION = {0, 1, 2, 3}
+G_CODES |= {18, 33, 95, 96, 97}
+# G33: a thread, the feed K per spindle revolution along the path.
+MOTION = {0, 1, 2, 3, 33}
 M_CODES = {0, 1, 3, 4, 5, 6, 7, 8, 9, 30}
 LENGTH_WORDS = set("XYZIJK") | {"CR", "F"}
 INTEGER_WORDS = {"S", "T", "D", "TURN", "LIMS"}
@@ -540,6 +541,18 @@ class Checker:
         self.ready_to_move(n, self.motion != 0)
         if self.motion in (2, 3):
             self.arc(n, seen)
+            return
+        if self.motion == 33:
+            # A thread: K the lead (mm per revolution), at a constant spindle
+            # speed (G97: the feed follows the spindle).
+            if not self.lathe:
+                self.problem(n, "G33 outside a lathe program (G18)")
+            if "K" not in seen or seen["K"] <= 0:
+                self.problem(n, "G33 without its lead K")
+            if self.css:
+                self.problem(n, "G33 under G96: a thread needs a constant spindle speed (G97)")
+            self.advance(n, seen)
+            self.make(n, "linear", seen.get("K", 0))
             return
         if self.motion == "cspline" and any(a not in ("X", "Y", "F") for a in seen):
             self.problem(n, "a spline point with more than X, Y and F")
