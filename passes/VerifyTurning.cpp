@@ -46,7 +46,11 @@ constexpr double kDefaultEdge = 5.0;
 Vec2 halfPlane(const ir::Vec3 &p) { return {p.z(), p.x()}; }
 
 /// What a region swept in the half plane takes from material on both sides of the axis.
-Region folded(const Region &r) { return geom::unite(r, geom::mirroredAcrossX(r)); }
+Region folded(const Region &r) {
+  if (r.empty() || r.box().lo.y() >= 0)
+    return r;  // nothing past the axis
+  return geom::unite(r, geom::mirroredAcrossX(r));
+}
 
 /// Convex hull, counter-clockwise (Andrew's monotone chain).
 std::vector<Vec2> hull(std::vector<Vec2> p) {
@@ -249,7 +253,10 @@ private:
       ++checked;
       if (m.kind == ir::MoveKind::Rapid) {
         flush();
-        const Region hit = geom::intersect(folded(swept), geom::unite(w->stock, w->chuck));
+        const Region f = folded(swept);
+        const Region hit = f.box().overlaps(w->stock.box().grown(1e-6)) || f.box().lo.x() < w->raw.z0
+                               ? geom::intersect(f, geom::unite(w->stock, w->chuck))
+                               : Region();
         if (!crashed && thick(hit, std::min(t, 0.001) * 2)) {
           crashed = true;
           error(ws, "a rapid to (x " + formatFixed(m.to.x(), 4) + ", z " + formatFixed(m.to.z(), 4) +

@@ -396,11 +396,12 @@ std::optional<Machine> readMachine(const SourceFile &file, DiagnosticEngine &dia
     m.maxFeed = r.number(*c, "max_feed", "controller", "mm/min", 1, 1e7, false);
   }
   if (const toml::table *s = r.table(root, "spindle", "spindle")) {
-    r.onlyKnown(*s, {"min_speed", "max_speed", "power", "torque"}, "[spindle]");
+    r.onlyKnown(*s, {"min_speed", "max_speed", "power", "torque", "acceleration"}, "[spindle]");
     m.spindleMin = r.number(*s, "min_speed", "spindle", "rev/min", 0, 2e5, true).value_or(0);
     m.spindleMax = r.number(*s, "max_speed", "spindle", "rev/min", 1, 2e5, true).value_or(0);
     m.spindlePower = r.number(*s, "power", "spindle", "kW", 0.01, 1e4, true).value_or(0);
     m.spindleTorque = r.number(*s, "torque", "spindle", "N m", 0.01, 1e6, false);
+    m.spindleAcceleration = r.number(*s, "acceleration", "spindle", "rev/min per s", 1, 1e6, false);
     if (r.ok() && m.spindleMin >= m.spindleMax)
       r.error(s->get("min_speed")->source(), "spindle.min_speed " + formatTrimmed(m.spindleMin, 6) +
                                                  " rev/min is not below max_speed " + formatTrimmed(m.spindleMax, 6));

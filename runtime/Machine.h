@@ -98,6 +98,9 @@ struct Machine {
   double spindleMax = 0;   ///< rev/min
   double spindlePower = 0;  ///< kW at the spindle
   std::optional<double> spindleTorque;  ///< N m, when the file gives it
+  /// rev/min per second, how fast the spindle changes speed, when the file
+  /// gives it (a lathe's constant surface speed follows it).
+  std::optional<double> spindleAcceleration;
   double cycleTime = 0.001;    ///< s, the interpolator's period
   int lookahead = 100;         ///< segments the planner may look ahead
   double pathTolerance = 0.01;  ///< mm, how far blending may leave the programmed path

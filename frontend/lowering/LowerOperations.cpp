@@ -240,7 +240,10 @@ void checkPlausible(Lowerer &l, const Instance &tech, std::string_view attribute
   char text[200];
   std::snprintf(text, sizeof text, "%s %g read as %.1f %s, outside %g..%g %s: the file may use another unit",
                 std::string(attribute).c_str(), *tech.real(attribute), value, unit, low, high, unit);
-  l.diags().warning(tech.attrLoc(attribute), text).entity(tech.id(), "MILLING_TECHNOLOGY");
+  std::string entity(tech.entityName());
+  std::transform(entity.begin(), entity.end(), entity.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+  l.diags().warning(tech.attrLoc(attribute), text).entity(tech.id(), entity);
 }
 
 /// A strategy node of `kind` whose `type` is the word `table` gives the

@@ -93,6 +93,32 @@ void reportApproachRetract(Expander &x, const Step &step, const Family &family) 
 
 } // namespace
 
+/// True when every point and length of the expanded moves is one a
+/// machine tool can go to (ir::kMaxLengthMm either way); else an error at
+/// the workingstep naming the first coordinate beyond: a feature whose
+/// dimensions run past it (a length in another unit, a typo) would make
+/// IR the verifier refuses, and nothing is written.
+bool withinMachine(Expander &x, const Node &ws, const Node &feature, const Node &moves) {
+  std::optional<double> beyond;
+  auto scan = [&](const Node &n, auto &self) -> void {
+    for (const ir::Attr &a : n.attrs)
+      if (a.value.type == ir::ValueType::Point || a.value.type == ir::ValueType::Length)
+        if ((beyond = ir::beyondMachine(a.value)))
+          return;
+    for (const Node &c : n.children)
+      if (!beyond)
+        self(c, self);
+  };
+  scan(moves, scan);
+  if (!beyond)
+    return true;
+  x.report(ws, ws,
+            "its toolpath for " + feature.symbol + " reaches " + formatFixed(*beyond, 4) +
+                " mm, beyond what a machine tool does (at most " + formatShortest(ir::kMaxLengthMm) +
+                " mm either way): check the feature's placement and dimensions (a length in another unit?)");
+  return false;
+}
+
 std::string coolant(const Node &op) {
   const Node *mf = op.child(ir::Kind::MachineFunctions);
   if (!mf)
@@ -297,34 +323,8 @@ private:
       p.clearanceZ = clearanceAbove(s.top);
       expanded = dispatch(*family, Step{ws, *op, sel.node, &s, nullptr, p, moves});
     }
-    if (expanded && withinMachine(ws, *feature, moves))
+    if (expanded && withinMachine(x_, ws, *feature, moves))
       x_.attach(ws, std::move(moves));
-  }
-
-  /// True when every point and length of the expanded moves is one a
-  /// machine tool can go to (ir::kMaxLengthMm either way); else an error at
-  /// the workingstep naming the first coordinate beyond: a feature whose
-  /// dimensions run past it (a length in another unit, a typo) would make
-  /// IR the verifier refuses, and nothing is written.
-  bool withinMachine(const Node &ws, const Node &feature, const Node &moves) {
-    std::optional<double> beyond;
-    auto scan = [&](const Node &n, auto &self) -> void {
-      for (const ir::Attr &a : n.attrs)
-        if (a.value.type == ir::ValueType::Point || a.value.type == ir::ValueType::Length)
-          if ((beyond = ir::beyondMachine(a.value)))
-            return;
-      for (const Node &c : n.children)
-        if (!beyond)
-          self(c, self);
-    };
-    scan(moves, scan);
-    if (!beyond)
-      return true;
-    x_.report(ws, ws,
-              "its toolpath for " + feature.symbol + " reaches " + formatFixed(*beyond, 4) +
-                  " mm, beyond what a machine tool does (at most " + formatShortest(ir::kMaxLengthMm) +
-                  " mm either way): check the feature's placement and dimensions (a length in another unit?)");
-    return false;
   }
 
   /// The operation's retract plane: the height above the feature's top at

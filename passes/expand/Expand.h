@@ -221,6 +221,10 @@ bool expandTrochoidal(Expander &x, const Step &step);
 /// Turning.cpp: the lathe moves of a turning workingstep, from its turned
 /// feature and the stock the steps before left; false after a diagnostic.
 bool expandTurning(Expander &x, Node &ws, const Node &op, const std::string &setup);
+/// Expand.cpp: true when every point and length of the expanded moves is
+/// one a machine tool can go to, else an error at the workingstep naming the
+/// first coordinate beyond (a feature whose dimensions run past it).
+bool withinMachine(Expander &x, const Node &ws, const Node &feature, const Node &moves);
 /// Expand.cpp: the coolant an operation's machine functions ask for (off,
 /// flood, mist, through_tool).
 std::string coolant(const Node &op);

@@ -133,6 +133,28 @@ Region withMirror(const Region &r) { return geom::unite(r, geom::mirroredAcrossX
 /// tool would cut what it cut already on the other side).
 Region nearSide(const Region &r) { return geom::intersect(r, box(Vec2(-1e5, 0), Vec2(1e5, 1e5))); }
 
+/// Whether a turning technology's speeds are ones a lathe turns at; else an
+/// error at it (a controller would refuse a feed per revolution at no
+/// spindle speed): nothing outside physical sense is written.
+bool latheSpeedsInRange(Expander &x, const Node &ws, const Node &tech) {
+  auto outside = [&](std::optional<double> v, double scale, double low, double high, const char *what,
+                     const char *unit) {
+    if (!v || *v == 0 || (std::abs(*v * scale) >= low && std::abs(*v * scale) <= high))
+      return false;
+    x.report(ws, tech,
+             std::string(what) + " " + formatShortest(std::abs(*v * scale)) + " " + unit +
+                 " is outside what a lathe turns at (" + formatShortest(low) + " to " + formatShortest(high) + " " +
+                 unit + ")");
+    return true;
+  };
+  return !outside(tech.number("cutting_speed"), 1e-3, ir::kPlausibleMinCuttingSpeedMPerMin,
+                  ir::kPlausibleMaxCuttingSpeedMPerMin, "its cutting speed", "m/min") &&
+         !outside(tech.number("spindle_max"), 1, ir::kPlausibleMinSpindleRpm, ir::kPlausibleMaxSpindleRpm,
+                  "its maximum spindle speed", "rev/min") &&
+         !outside(tech.number("spindle"), 1, ir::kPlausibleMinSpindleRpm, ir::kPlausibleMaxSpindleRpm,
+                  "its spindle speed", "rev/min");
+}
+
 class TurningStep {
 public:
   TurningStep(Expander &x, Node &ws, const Node &op, const Node &feature, const Node &toolNode, Region &stock,
@@ -228,6 +250,8 @@ private:
     const std::optional<double> vc = tech->number("cutting_speed");
     const std::optional<double> n = tech->number("spindle");
     Node &moves = moves_;
+    if (!latheSpeedsInRange(x_, ws_, *tech))
+      return false;
     if (vc && *vc > 0) {
       const double clamp = tech->number("spindle_max").value_or(0);
       if (clamp <= 0) {
@@ -236,6 +260,7 @@ private:
                   "tool nears the axis");
         return false;
       }
+
       // The spindle turns clockwise (M3) at the speed the stock's diameter
       // asks for, and follows the diameter from there.
       const double start = std::min(std::abs(clamp), *vc / (2 * kPi * raw_.radius));
@@ -1035,6 +1060,8 @@ bool expandLatheToolpaths(Expander &x, Node &ws, const Node &op, const Node &fea
       x.report(ws, *tp, "its toolpath gives no feed per revolution: a lathe step is fed in mm/rev");
       return false;
     }
+    if (tech && !latheSpeedsInRange(x, ws, *tech))
+      return false;
     if (tech) {
       if (auto vc = tech->number("cutting_speed"); vc && *vc > 0) {
         const double clamp = tech->number("spindle_max").value_or(0);
@@ -1103,6 +1130,8 @@ bool expandLatheToolpaths(Expander &x, Node &ws, const Node &op, const Node &fea
     x.report(ws, op, "its operation gives no spindle speed nor cutting speed");
     return false;
   }
+  if (!withinMachine(x, ws, feature, moves))
+    return false;
   x.attach(ws, std::move(moves));
   return true;
 }
@@ -1132,7 +1161,7 @@ bool expandTurning(Expander &x, Node &ws, const Node &op, const std::string &set
     it->second = withMirror(raw.stock->region());
   Node moves = makeMoves(ws, tool->symbol, 0, coolant(op), setup);
   TurningStep step(x, ws, op, *feature, *tool, it->second, *raw.stock, *shape.shape, moves);
-  if (!step.run())
+  if (!step.run() || !withinMachine(x, ws, *feature, moves))
     return false;
   x.attach(ws, std::move(moves));
   return true;

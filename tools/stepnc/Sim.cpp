@@ -7,10 +7,12 @@
 // the native format has no spindle speeds) and the axes' travel: each
 // position where the program origin is on the machine (--work-offset), else
 // only that the program's extent fits the travel. Machines whose chain the
-// player cannot move a 3-axis program on (lathes, generic chains) are
-// refused with the reason.
+// player cannot move a 3-axis program on (generic chains) are refused with
+// the reason. On a lathe the turning steps are timed instead
+// (ir/motion/LatheTime.h: constant surface speed, spindle acceleration).
 #include "driver/LoadModule.h"
 #include "driver/Pipeline.h"
+#include "ir/motion/LatheTime.h"
 #include "ir/motion/MotionIR.h"
 #include "ir/geom/MoveWalk.h"
 #include "runtime/Machine.h"
@@ -71,6 +73,65 @@ std::string label(const ir::Node &e) {
   return s;
 }
 
+/// A lathe: the program's turning steps timed with their spindle
+/// (ir/motion/LatheTime.h), not played at the interpolator's cycle.
+int runLatheSim(const SimCommandOptions &opts, const runtime::Machine &machine, const std::string &machineName,
+                std::unique_ptr<SourceFile> &source, DiagnosticEngine &diags) {
+  if (source->text().starts_with("STEPNC-MOTION")) {
+    printToolError("sim: native motion is planned for a mill: a lathe times IR text or STEP-NC");
+    return kExitUsage;
+  }
+  if (!opts.samples.empty() || !opts.workOffset.empty() || opts.period || opts.tolerance) {
+    printToolError("sim: on a lathe only the program is timed: --samples, --work-offset, --period and --tolerance "
+                   "are for the player of milling programs");
+    return kExitUsage;
+  }
+  driver::SchemaSelection schemas(opts.schema);
+  if (const int rc = loadSchemas(schemas, diags); rc != kExitOk)
+    return rc;
+  std::string usageError;
+  std::unique_ptr<ir::Module> module =
+      driver::loadModule(source, schemas, diags, usageError, nullptr, lowering::LowerOptions{opts.units.conventions()});
+  if (!module) {
+    if (usageError.empty())
+      return kExitDiagnostics;
+    printToolError(usageError);
+    return kExitUsage;
+  }
+  bool hasMoves = false;
+  for (const ir::Node *e : ir::programOrder(*module))
+    hasMoves |= e->child(ir::Kind::Moves) != nullptr;
+  if (!hasMoves) {
+    driver::ToolpathPipelineOptions toolpath;
+    toolpath.machine = machineName;
+    toolpath.allowOutOfRange = opts.allowOutOfRange;
+    driver::PipelineRun run;
+    run.log = &std::cerr;
+    if (const int rc = driver::runPipeline(*module, driver::toolpathPipeline(toolpath), run, diags, usageError);
+        rc != kExitOk) {
+      if (rc == kExitUsage)
+        printToolError(usageError);
+      return rc;
+    }
+  }
+  for (const ir::Node *e : ir::programOrder(*module))
+    if (e->child(ir::Kind::Moves) && !ir::isTurningStep(*e)) {
+      diags.error(e->origin.loc, e->kindName() + " " + e->symbol + " mills or drills: the lathe \"" + machine.name +
+                                     "\" times turning steps only")
+          .entity(e->origin.entityId);
+      printStatus("cannot simulate " + opts.input);
+      return kExitDiagnostics;
+    }
+  if (diags.hasErrors()) {
+    printStatus("cannot simulate " + opts.input);
+    return kExitDiagnostics;
+  }
+  const ir::LatheTimeReport report = ir::timeLatheProgram(*module, machine);
+  if (const int rc = writeText(opts.output, ir::formatLatheReport(report, machine)); rc != kExitOk)
+    return rc;
+  return report.violations.empty() ? kExitOk : kExitDiagnostics;
+}
+
 int runSim(const SimCommandOptions &opts) {
   // First, so that with --diagnostics=json every message of the command is
   // in the one array on stderr.
@@ -90,6 +151,8 @@ int runSim(const SimCommandOptions &opts) {
   const auto machine = runtime::loadMachine(machineName, machineFile, diags);
   if (!machine)
     return kExitUsage;
+  if (machine->kinematics.chain == runtime::Chain::Lathe)
+    return runLatheSim(opts, *machine, machineName, source, diags);
   if (const std::string why = machine->whyNotThreeAxis(); !why.empty()) {
     printToolError("sim: " + why);
     return kExitUsage;
@@ -227,7 +290,8 @@ void registerSim(CLI::App &app, std::function<void(int)> setResult) {
   cmd->add_option("input", opts->input, "Native motion file, IR text or STEP-NC file")->required();
   cmd->add_option("--machine", opts->machine,
                   "Machine: a TOML file (docs/machine-model.md) or a shipped machine (hsc-3axis, the\n"
-                  "default, conventional-3axis or table-table-5axis; lathe-2axis is refused)");
+                  "default, conventional-3axis, table-table-5axis, or lathe-2axis: a lathe times the\n"
+                  "program's turning steps with constant surface speed)");
   cmd->add_option("--tolerance", opts->tolerance, "Path tolerance for blending and the deviation check, mm");
   cmd->add_option("--period", opts->period, "Sampling period, s (default: the machine's cycle time)");
   cmd->add_option("--work-offset", opts->workOffset,
