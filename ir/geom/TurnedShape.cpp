@@ -1,8 +1,10 @@
 #include "ir/geom/TurnedShape.h"
 
+#include "ir/geom/Curves.h"
 #include "support/Format.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -103,6 +105,7 @@ public:
     case Kind::RevolvedFlat: return revolvedFlat(*p) ? ok() : fail();
     case Kind::Groove: return groove(*p) ? ok() : fail();
     case Kind::Thread: return thread(*p) ? ok() : fail();
+    case Kind::GeneralRevolution: return generalRevolution() ? ok() : fail();
     default:
       error_ = named(f_) + " has no turned shape in stepnc yet (docs/turning.md lists the features turned)";
       return fail();
@@ -277,6 +280,115 @@ private:
     s_.contour = path;  // from the low z wall's top round to the high one's
     s_.grooveSpan = {lo, hi};
     s_.grooveFloor = floor;
+    return true;
+  }
+
+  bool generalRevolution() {
+    // Its general profile's curve, in the profile's placement within the
+    // feature's: the points' x is the distance from the axis less the
+    // feature's `radius`, z along it; y must be 0 (the half plane), arcs
+    // turn about y (docs/turning.md).
+    const Vec3 side = f_.vec("material_side").value_or(Vec3(-1, 0, 0));
+    if (!(side.x() < -1 + 1e-9 && std::abs(side.z()) < 1e-9)) {
+      error_ = named(f_) + ": its material side " + formatTuple({side.x(), side.y(), side.z()}, 6) +
+               " is not towards the axis: only outer revolved profiles are turned yet";
+      return false;
+    }
+    const Node *profile = f_.child(Kind::GeneralProfile);
+    if (!profile || profile->children.empty()) {
+      error_ = named(f_) + " needs a general profile with its curve";
+      return false;
+    }
+    if (profile->flag("closed").value_or(false)) {
+      error_ = named(f_) + ": its profile is closed: a revolved profile is an open curve from one end of the "
+                           "surface to the other";
+      return false;
+    }
+    const CurveResult cr = curvePieces(profile->children.front(), ArcPlanes::Principal);
+    if (!cr.error.empty()) {
+      error_ = named(f_) + ": " + cr.error;
+      return false;
+    }
+    auto frameOf = [](const Node &n) {
+      const Vec3 at = n.vec("at").value_or(Vec3::Zero()), axis = n.vec("axis").value_or(Vec3::UnitZ());
+      const Vec3 ref = n.vec("ref").value_or(Vec3::UnitX());
+      return std::array<Vec3, 4>{at, ref, axis.cross(ref), axis};
+    };
+    auto place = [](const std::array<Vec3, 4> &f, const Vec3 &p) { return Vec3(f[0] + p.x() * f[1] + p.y() * f[2] + p.z() * f[3]); };
+    auto turn = [](const std::array<Vec3, 4> &f, const Vec3 &v) { return Vec3(v.x() * f[1] + v.y() * f[2] + v.z() * f[3]); };
+    const std::array<Vec3, 4> feature = frameOf(f_);
+    const std::optional<std::array<Vec3, 4>> local =
+        profile->has("at") ? std::optional(frameOf(*profile)) : std::nullopt;
+    const double radius = f_.number("radius").value_or(0);
+    auto toHalfPlane = [&](const Vec3 &p, bool &off) {
+      Vec3 w = place(feature, local ? place(*local, p) : p);
+      off = off || std::abs(w.y()) > 1e-6;
+      return Vec2(w.z(), w.x() + radius);
+    };
+    std::vector<Seg> chain;
+    bool off = false;
+    for (const CurvePiece &c : cr.pieces) {
+      const Vec2 a = toHalfPlane(c.from, off), b = toHalfPlane(c.to, off);
+      if (!c.arc) {
+        if ((b - a).norm() > geom::kEps)
+          chain.push_back(Seg::line(a, b));
+        continue;
+      }
+      // The arc's axis in the workpiece: along y for a turned profile; seen
+      // from +y, counter-clockwise in (z, x) is counter-clockwise in (z, r).
+      const Vec3 normal = turn(feature, local ? turn(*local, c.plane.normalVector()) : c.plane.normalVector());
+      if (std::abs(std::abs(normal.y()) - 1) > 1e-9 || c.turns > 0) {
+        error_ = named(f_) + ": its profile has an arc about an axis other than the half plane's normal (y)";
+        return false;
+      }
+      const bool ccw = normal.y() > 0 ? c.ccw : !c.ccw;
+      chain.push_back(Seg::arc(a, b, toHalfPlane(c.center, off), ccw));
+    }
+    if (off || chain.empty()) {
+      error_ = named(f_) + ": its profile " + (off ? "leaves the half plane of the axis (y is not 0)" : "is empty");
+      return false;
+    }
+    // From the free end towards the chuck.
+    if (chain.front().a.x() < chain.back().b.x()) {
+      std::reverse(chain.begin(), chain.end());
+      for (Seg &sg : chain)
+        sg = sg.reversed();
+    }
+    for (const Seg &sg : chain) {
+      if (sg.box().lo.y() < -1e-9) {
+        error_ = named(f_) + ": its profile crosses the axis (a radius below 0)";
+        return false;
+      }
+      // From the free end towards the chuck without turning back: an
+      // undercut is no outer surface a turning tool reaches from the end.
+      const geom::Box b = sg.box();
+      if (b.hi.x() > sg.a.x() + 1e-9 || b.lo.x() < sg.b.x() - 1e-9) {
+        error_ = named(f_) + ": its profile turns back towards the free end near (z " + formatFixed(sg.a.x(), 4) +
+                 ", r " + formatFixed(sg.a.y(), 4) + ") mm (an undercut): not turned yet";
+        return false;
+      }
+    }
+    const Vec2 first = chain.front().a, last = chain.back().b;
+    Loop l;
+    l.segs.push_back(Seg::line(Vec2(reachZ_, first.y()), first));
+    for (const Seg &sg : chain)
+      l.segs.push_back(sg);
+    l.segs.push_back(Seg::line(last, Vec2(last.x(), reachR_)));
+    l.segs.push_back(Seg::line(Vec2(last.x(), reachR_), Vec2(reachZ_, reachR_)));
+    l.segs.push_back(Seg::line(Vec2(reachZ_, reachR_), Vec2(reachZ_, first.y())));
+    s_.contour = l.segs;
+    s_.contour.pop_back();
+    s_.contour.pop_back();
+    // The loop runs clockwise (along the surface towards the chuck, back
+    // along the reach): reversed, counter-clockwise as regions are.
+    if (l.area() >= 0) {
+      error_ = named(f_) + ": its profile does not bound material towards the axis (it turns back on itself)";
+      return false;
+    }
+    Loop ccw;
+    for (auto it = l.segs.rbegin(); it != l.segs.rend(); ++it)
+      ccw.segs.push_back(it->reversed());
+    s_.removal = Region{{ccw}};
     return true;
   }
 

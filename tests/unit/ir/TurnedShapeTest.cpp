@@ -152,3 +152,33 @@ TEST_CASE("what is not turned is said", "[turned]") {
     CHECK(r.error.find("no turned surface") != std::string::npos);
   }
 }
+
+TEST_CASE("a general revolved profile: steps from the free end", "[turned]") {
+  auto p = parsed("    general_revolution %g \"G\" at=(0.0000,0.0000,0.0000)mm " + kZ +
+                      " radius=0.0000mm material_side=(-1.000000,0.000000,0.000000)\n"
+                      "      general_profile closed=false\n"
+                      "        polyline\n"
+                      "          point at=(15.0000,0.0000,100.0000)mm\n"
+                      "          point at=(15.0000,0.0000,50.0000)mm\n"
+                      "          point at=(18.0000,0.0000,50.0000)mm\n"
+                      "          point at=(18.0000,0.0000,20.0000)mm\n",
+                  "%g");
+  ir::TurnedShapeResult r = ir::turnedShape(*p.feature, p.stock);
+  REQUIRE(r.shape);
+  // z 50..100 between r 15 and 20, z 20..50 between 18 and 20.
+  CHECK(areaInStock(*r.shape, p.stock) == Approx(50 * 5 + 30 * 2).epsilon(1e-12));
+  // The same profile written from the chuck end reads the same.
+  auto q = parsed("    general_revolution %g \"G\" at=(0.0000,0.0000,0.0000)mm " + kZ +
+                      " radius=0.0000mm\n"
+                      "      general_profile closed=false\n"
+                      "        polyline\n"
+                      "          point at=(18.0000,0.0000,20.0000)mm\n"
+                      "          point at=(18.0000,0.0000,50.0000)mm\n"
+                      "          point at=(15.0000,0.0000,50.0000)mm\n"
+                      "          point at=(15.0000,0.0000,100.0000)mm\n",
+                  "%g");
+  ir::TurnedShapeResult back = ir::turnedShape(*q.feature, q.stock);
+  REQUIRE(back.shape);
+  CHECK(areaInStock(*back.shape, q.stock) == Approx(310).epsilon(1e-12));
+  CHECK(back.shape->contour[1].a.x() == Approx(100));
+}
