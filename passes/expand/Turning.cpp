@@ -486,12 +486,28 @@ private:
     double uTop = -1e300, uFloor = 1e300;
     for (const Vec2 &p : corners(mb))
       uTop = std::max(uTop, u(p));
-    for (const Vec2 &p : corners(cb))
+    // The deepest level: the lowest the nose may go within the material's
+    // extent across the passes (round the stock's outer corner it may go
+    // lower, cutting nothing).
+    geom::Box extent = cb;
+    if (std::abs(d.x()) > 0.5) {
+      extent.lo.x() = std::max(cb.lo.x(), mb.lo.x());
+      extent.hi.x() = std::min(cb.hi.x(), mb.hi.x());
+    } else {
+      extent.lo.y() = std::max(cb.lo.y(), mb.lo.y());
+      extent.hi.y() = std::min(cb.hi.y(), mb.hi.y());
+    }
+    const Region within = geom::intersect(centres, box(extent.lo, extent.hi));
+    for (const Vec2 &p : corners(within.empty() ? cb : within.box()))
       uFloor = std::min(uFloor, u(p));
     std::vector<double> levels;
     double level = uTop + tool_.rc;
     for (size_t k = 0; level > uFloor + 1e-6; ++k) {
       level -= cuts[std::min(k, cuts.size() - 1)];
+      // Contouring ends with a pass along the allowance, which takes the
+      // last depth (less than a depth of cut) along the floor too.
+      if (!facing && level <= uFloor + 1e-6)
+        break;
       levels.push_back(std::max(level, uFloor + 1e-6));
       if (static_cast<int>(levels.size()) > kMaxLevels) {
         x_.report(ws_, "its depth of cut makes more than " + std::to_string(kMaxLevels) + " passes");
