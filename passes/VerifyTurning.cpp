@@ -19,6 +19,7 @@
 
 #include "geom/Boolean.h"
 #include "ir/Program.h"
+#include "ir/geom/FeatureShape.h"
 #include "ir/geom/MoveWalk.h"
 #include "ir/geom/TurnedShape.h"
 #include "support/Format.h"
@@ -131,6 +132,16 @@ struct Insert {
 
 Insert insertOf(const Node &tool) {
   Insert in;
+  const std::string type = tool.text("type").value_or("");
+  if (type != "turning_tool" && type != "grooving_tool" && type != "threading_tool") {
+    // A drill (any axial tool) on the spindle axis, its tip the programmed
+    // point: its point cone, then its body as long as its flutes.
+    const double r = tool.number("diameter").value_or(0) / 2;
+    const double point = ir::pointLength(tool);
+    const double body = tool.number("cutting_edge_length").value_or(std::max(3 * 2 * r, point + 1));
+    in.skeleton = {Vec2(0, 0), Vec2(point, -r), Vec2(body, -r), Vec2(body, r), Vec2(point, r)};
+    return in;
+  }
   in.rc = tool.number("corner_radius").value_or(0);
   const double edge =
       tool.number("cutting_edge_length").value_or(tool.number("max_cutting_depth").value_or(kDefaultEdge));
@@ -167,7 +178,7 @@ public:
 
   bool run() {
     for (const Node *e : ir::programOrder(module_))
-      if (ir::isTurningStep(*e))
+      if (ir::isTurningStep(*e) || ir::drillsOnTurningAxis(*e))
         if (const Node *moves = e->child(ir::Kind::Moves))
           step(*e, *moves);
     return ok_;
@@ -195,10 +206,23 @@ private:
     w.raw = *raw.stock;
     w.stock = raw.stock->region();
     std::vector<Region> removals;
-    for (const Node &f : wp.children)
+    for (const Node &f : wp.children) {
       if (f.category() == ir::Category::Feature && f.is(ir::Trait::Turning))
         if (ir::TurnedShapeResult s = ir::turnedShape(f, w.raw); s.shape)
           removals.push_back(s.shape->removal);
+      // A hole on the axis (drilled on the lathe): its cylinder, from its
+      // top down its depth.
+      if (f.kind == ir::Kind::RoundHole) {
+        const ir::Vec3 at = f.vec("at").value_or(ir::Vec3::Zero()), axis = f.vec("axis").value_or(ir::Vec3::UnitZ());
+        const double r = f.number("diameter").value_or(0) / 2, depth = f.number("depth").value_or(0);
+        if (std::abs(at.x()) < 1e-6 && std::abs(at.y()) < 1e-6 && std::abs(std::abs(axis.z()) - 1) < 1e-9 && r > 0 &&
+            depth > 0) {
+          const double z0 = at.z(), z1 = at.z() - axis.z() * depth;
+          removals.push_back(Region{{geom::polygon({Vec2(std::min(z0, z1), 0), Vec2(std::max(z0, z1), 0),
+                                                    Vec2(std::max(z0, z1), r), Vec2(std::min(z0, z1), r)})}});
+        }
+      }
+    }
     w.part = geom::subtract(w.stock, geom::uniteAll(removals));
     w.chuck = Region{{geom::polygon({Vec2(w.raw.z0 - 1e4, -1e4), Vec2(w.raw.z0, -1e4), Vec2(w.raw.z0, 1e4),
                                      Vec2(w.raw.z0 - 1e4, 1e4)})}};
@@ -216,12 +240,15 @@ private:
     if (!w)
       return;
     const ir::TurnedShapeResult shape = ir::turnedShape(*feature, w->raw);
-    const bool pathsOnly = feature->kind == ir::Kind::ToolpathFeature;
+    // A drill on the axis: its hole is in the part's reading; its moves are
+    // checked as any lathe tool's.
+    const bool drilling = ir::drillsOnTurningAxis(ws);
+    const bool pathsOnly = feature->kind == ir::Kind::ToolpathFeature || drilling;
     if (!shape.shape && !pathsOnly) {
       error(ws, shape.error);
       return;
     }
-    if (pathsOnly)
+    if (pathsOnly && !drilling)
       diags_.warning(ws.origin.loc, "workingstep " + ws.symbol + ": " + feature->symbol +
                                         " gives only its toolpaths: its moves are checked against the stock only")
           .entity(ws.origin.entityId);
@@ -265,7 +292,7 @@ private:
         continue;
       }
       pending.push_back(swept);
-      if (!gouged && !pathsOnly) {
+      if (!gouged && (!pathsOnly || drilling)) {
         const Region cut = geom::intersect(folded(swept), guard);
         if (thick(cut, t)) {
           gouged = true;

@@ -2,6 +2,7 @@
 
 #include "backends/common/ToolTable.h"
 #include "ir/Program.h"
+#include "ir/geom/TurnedShape.h"
 #include "support/Format.h"
 
 #include <cmath>
@@ -66,12 +67,16 @@ std::optional<std::string> LatheEmitter::run(const ir::Module &module) {
   // The tools, numbered in order of first use (or by the table).
   for (const ir::Node *e : ir::programOrder(module))
     if (const ir::Node *moves = e->child(ir::Kind::Moves))
-      if (const ir::Node *tool = ir::findTool(module, moves->text("tool").value_or("")); tool && ir::isTurningStep(*e))
+      if (const ir::Node *tool = ir::findTool(module, moves->text("tool").value_or(""));
+          tool && (ir::isTurningStep(*e) || ir::drillsOnTurningAxis(*e)))
         if (!numbers_.count(tool->symbol)) {
           const int n = toolNumber(*tool);
+          const bool axial = !ir::isTurningStep(*e);
           out_.block(comment(word("T", std::to_string(n)) + " " + tool->label + ", " +
-                             tool->text("type").value_or("") + ", corner radius " +
-                             formatFixed(tool->number("corner_radius").value_or(0), 3) + " mm" +
+                             tool->text("type").value_or("") +
+                             (axial ? ", diameter " + formatFixed(tool->number("diameter").value_or(0), 3)
+                                    : ", corner radius " + formatFixed(tool->number("corner_radius").value_or(0), 3)) +
+                             " mm" +
                              (tool->has("cutting_width")
                                   ? ", width " + formatFixed(*tool->number("cutting_width"), 3) + " mm"
                                   : std::string()) +
@@ -88,6 +93,13 @@ std::optional<std::string> LatheEmitter::run(const ir::Module &module) {
     case ir::Kind::ProgramStop: out_.block(stop(false)); break;
     case ir::Kind::OptionalStop: out_.block(stop(true)); break;
     case ir::Kind::Workingstep:
+      if (ir::drillsOnTurningAxis(*e)) {
+        // A drill on the spindle axis: Z first from where the last step
+        // left the tool (outside the bar), then onto the axis.
+        if (const ir::Node *moves = e->child(ir::Kind::Moves))
+          step(module, *e, *moves, true);
+        break;
+      }
       if (!ir::isTurningStep(*e)) {
         diags_.error(e->origin.loc, "workingstep " + e->symbol + " mills or drills, in a lathe program: " + d_.name +
                                         " does not write turning and milling in one program yet (docs/turning.md)")
@@ -116,7 +128,7 @@ std::optional<std::string> LatheEmitter::run(const ir::Module &module) {
   return out_.text();
 }
 
-void LatheEmitter::step(const ir::Module &module, const ir::Node &ws, const ir::Node &moves) {
+void LatheEmitter::step(const ir::Module &module, const ir::Node &ws, const ir::Node &moves, bool onAxis) {
   out_.block(comment(ws.label.empty() ? ws.symbol : ws.label));
   const ir::Node *tool = ir::findTool(module, moves.text("tool").value_or(""));
   if (!tool)
@@ -146,8 +158,19 @@ void LatheEmitter::step(const ir::Module &module, const ir::Node &ws, const ir::
     out_.block(coolant(cool));
     coolant_ = cool;
   }
-  for (const ir::Move &m : ir::walkMoves(moves, std::nullopt, ir::PathKind::Programmed, ir::OutOfPlaneArcs::Exact))
+  bool first = true;
+  for (const ir::Move &m : ir::walkMoves(moves, std::nullopt, ir::PathKind::Programmed, ir::OutOfPlaneArcs::Exact)) {
+    if (first && onAxis && m.kind == ir::MoveKind::Rapid) {
+      // Along Z alone first: the tool comes from outside the bar's radius.
+      if (modal_.change("G", "0"))
+        out_.block("G0 " + word("Z", num(m.to.z())));
+      else
+        out_.block(word("Z", num(m.to.z())));
+      modal_.change("Z", num(m.to.z()));
+    }
+    first = false;
     move(m);
+  }
 }
 
 void LatheEmitter::move(const ir::Move &m) {

@@ -68,7 +68,8 @@ protected:
   BlockWriter out_;
 
 private:
-  void step(const ir::Module &module, const ir::Node &ws, const ir::Node &moves);
+  /// `onAxis`: a drill on the spindle axis (ir::drillsOnTurningAxis).
+  void step(const ir::Module &module, const ir::Node &ws, const ir::Node &moves, bool onAxis = false);
   void move(const ir::Move &m);
   /// A coordinate as the controller reads it back (X halved in diameter mode).
   double readX(double radius) const;

@@ -1,6 +1,7 @@
 #include "ir/geom/TurnedShape.h"
 
 #include "ir/geom/Curves.h"
+#include "ir/geom/MoveWalk.h"
 #include "support/Format.h"
 
 #include <algorithm>
@@ -440,6 +441,20 @@ private:
 };
 
 } // namespace
+
+bool drillsOnTurningAxis(const Node &exec) {
+  const Node *op = operationOf(exec);
+  const Node *moves = exec.child(Kind::Moves);
+  if (exec.kind != Kind::Workingstep || !op || !op->is(Trait::HoleMaking) || !moves)
+    return false;
+  bool any = false;
+  for (const Move &m : walkMoves(*moves)) {
+    if (std::abs(m.to.x()) > kOnAxis || std::abs(m.to.y()) > kOnAxis)
+      return false;
+    any = true;
+  }
+  return any;
+}
 
 TurnedShapeResult turnedShape(const Node &feature, const TurnStock &stock, double margin) {
   return Builder(feature, stock, margin).build();

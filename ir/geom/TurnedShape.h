@@ -79,6 +79,12 @@ struct TurnedShapeResult {
   std::string error;  ///< why the feature has no turned shape (not supported, missing data)
 };
 
+/// Whether `exec` is a hole-making workingstep whose moves all lie on the
+/// turning axis (x = y = 0): a drill held on the spindle axis of a lathe
+/// (centre drilling, drilling), which a lathe program writes among its
+/// turning steps.
+bool drillsOnTurningAxis(const ir::Node &exec);
+
 /// The turned shape of `feature` on a workpiece cut from `stock`: the
 /// window the removal reaches out to comes from the stock (its radius and
 /// free end, plus `margin`).
