@@ -180,8 +180,11 @@ void LatheEmitter::move(const ir::Move &m) {
   }
   std::string text;
   auto axis = [&](const std::string &name, const std::string &value) {
-    if (modal_.change(name, value))
-      text += (text.empty() ? "" : " ") + word(name, value);
+    if (!modal_.change(name, value))
+      return;
+    if (!text.empty())
+      text += ' ';
+    text += word(name, value);
   };
   const std::string x = xWord(m.to.x()).substr(1), z = num(m.to.z());
   if (m.kind == ir::MoveKind::Rapid) {
@@ -251,8 +254,11 @@ void LatheEmitter::move(const ir::Move &m) {
     axis("Z", z);
   }
   const std::string fw = formatNumber(f, {byRev ? 4 : d_.feedDecimals, false, true});
-  if (modal_.change("F", fw))
-    text += (text.empty() ? "" : " ") + word("F", fw);
+  if (modal_.change("F", fw)) {
+    if (!text.empty())
+      text += ' ';
+    text += word("F", fw);
+  }
   if (!text.empty() && text != "G1")
     out_.block(text);
 }
