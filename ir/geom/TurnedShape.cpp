@@ -233,16 +233,23 @@ private:
     return true;
   }
 
+  /// Whether the feature's material side (absent: -x) points towards the
+  /// axis, as an outer feature's does; else why not, for `what` ("grooves").
+  bool materialTowardsAxis(const char *what) {
+    const Vec3 side = f_.vec("material_side").value_or(Vec3(-1, 0, 0));
+    if (side.x() < -1 + 1e-9 && std::abs(side.z()) < 1e-9)
+      return true;
+    error_ = named(f_) + ": its material side " + formatTuple({side.x(), side.y(), side.z()}, 6) +
+             " is not towards the axis: only outer " + what + " are turned yet";
+    return false;
+  }
+
   bool groove(const Placed &p) {
     // An outer groove: its floor at `radius`, its square-U profile's width
     // centred on the placement along the axis, open outwards.
     const double floor = f_.number("radius").value_or(0);
-    const Vec3 side = f_.vec("material_side").value_or(Vec3(-1, 0, 0));
-    if (!(side.x() < -1 + 1e-9 && std::abs(side.z()) < 1e-9)) {
-      error_ = named(f_) + ": its material side " + formatTuple({side.x(), side.y(), side.z()}, 6) +
-               " is not towards the axis: only outer grooves are turned yet";
+    if (!materialTowardsAxis("grooves"))
       return false;
-    }
     const Node *u = f_.child(Kind::SquareUProfile);
     if (!u) {
       error_ = named(f_) + ": only grooves with a square_u_profile are turned yet";
@@ -289,12 +296,8 @@ private:
     // feature's: the points' x is the distance from the axis less the
     // feature's `radius`, z along it; y must be 0 (the half plane), arcs
     // turn about y (docs/turning.md).
-    const Vec3 side = f_.vec("material_side").value_or(Vec3(-1, 0, 0));
-    if (!(side.x() < -1 + 1e-9 && std::abs(side.z()) < 1e-9)) {
-      error_ = named(f_) + ": its material side " + formatTuple({side.x(), side.y(), side.z()}, 6) +
-               " is not towards the axis: only outer revolved profiles are turned yet";
+    if (!materialTowardsAxis("revolved profiles"))
       return false;
-    }
     const Node *profile = f_.child(Kind::GeneralProfile);
     if (!profile || profile->children.empty()) {
       error_ = named(f_) + " needs a general profile with its curve";

@@ -61,6 +61,7 @@ public:
   LatheWriter(Node &moves, const LatheTool &t) : moves_(moves), tool_(t) {}
 
   const Vec2 &position() const { return pos_; }
+  bool positioned() const { return positioned_; }
 
   void rapid(const Vec2 &c, const char *role) {
     if (positioned_ && (c - pos_).norm() <= geom::kEps)
@@ -99,8 +100,11 @@ public:
     pos_ = s.b;
   }
 
-  /// The tool is at `c` after a move written by hand.
-  void moved(const Vec2 &c) { pos_ = c; }
+  /// A pass synchronised with the spindle (G33): the feed per revolution
+  /// is the thread's lead.
+  void thread(const Vec2 &c, double lead) {
+    feed(c, lead, "thread");
+  }
 
   void dwell(double seconds) {
     if (seconds <= 0)
@@ -249,7 +253,6 @@ private:
     }
     const std::optional<double> vc = tech->number("cutting_speed");
     const std::optional<double> n = tech->number("spindle");
-    Node &moves = moves_;
     if (!latheSpeedsInRange(x_, ws_, *tech))
       return false;
     if (vc && *vc > 0) {
@@ -264,50 +267,43 @@ private:
       // The spindle turns clockwise (M3) at the speed the stock's diameter
       // asks for, and follows the diameter from there.
       const double start = std::min(std::abs(clamp), *vc / (2 * kPi * raw_.radius));
-      moves.set("spindle", Value::spindle(-start));
+      moves_.set("spindle", Value::spindle(-start));
       Node state(ir::Kind::State);
       state.set("surface_speed", Value::feed(*vc));
       state.set("spindle_max", Value::spindle(std::abs(clamp)));
-      moves.children.insert(moves.children.begin(), std::move(state));
+      moves_.children.insert(moves_.children.begin(), std::move(state));
     } else if (n && *n != 0) {
-      moves.set("spindle", Value::spindle(*n));
+      moves_.set("spindle", Value::spindle(*n));
     } else {
       x_.report(ws_, tech ? *tech : op_, "its operation gives no spindle speed nor cutting speed");
       return false;
     }
-    moves.set("x_mode", Value::word("diameter"));
+    moves_.set("x_mode", Value::word("diameter"));
     return true;
   }
 
   // --- safe travel ----------------------------------------------------------------
 
-  /// Whether the insert's corner circles, moved from `a` to `b`, stay clear of the stock.
-  bool clear(const Vec2 &a, const Vec2 &b) const {
+  /// Whether the insert's corner centres, moved from `a` to `b`, keep out
+  /// of `grownRegion` (a region grown by the corner radius).
+  bool keepsOut(const Region &grownRegion, const Vec2 &a, const Vec2 &b) const {
     for (double dz : tool_.corners) {
       const Vec2 off(dz, 0);
-      for (const Seg &s : geom::clip(obstacle_, a + off, b + off))
+      if (grownRegion.contains(a + off) || grownRegion.contains(b + off))
+        return false;
+      for (const Seg &s : geom::clip(grownRegion, a + off, b + off))
         if ((s.b - s.a).norm() > 1e-6)
           return false;
-      if (obstacle_.contains(a + off) || obstacle_.contains(b + off))
-        return false;
     }
     return true;
   }
 
+  /// Whether the insert's corner circles, moved from `a` to `b`, stay clear of the stock.
+  bool clear(const Vec2 &a, const Vec2 &b) const { return keepsOut(obstacle_, a, b); }
+
   /// Whether the corner circles moved from `a` to `b` keep out of what the
   /// step must leave (the part, other features' material, the chuck).
-  bool spares(const Vec2 &a, const Vec2 &b) const {
-    const Region guard = grown(keepRegion(), std::max(tool_.rc, 1e-3) - 1e-4);
-    for (double dz : tool_.corners) {
-      const Vec2 off(dz, 0);
-      if (guard.contains(a + off) || guard.contains(b + off))
-        return false;
-      for (const Seg &s : geom::clip(guard, a + off, b + off))
-        if ((s.b - s.a).norm() > 1e-6)
-          return false;
-    }
-    return true;
-  }
+  bool spares(const Vec2 &a, const Vec2 &b) const { return keepsOut(guard_, a, b); }
 
   /// Leaves the surface from `at`: out along `first` by the clearance when
   /// that spares the part, else along `second`; false (after an error) when neither does.
@@ -327,7 +323,13 @@ private:
     return false;
   }
 
-  void refreshObstacle() { obstacle_ = grown(geom::unite(stock_, chuck_), std::max(tool_.rc, 1e-3) - 1e-4); }
+  /// The stock and what the step must leave, grown by the corner radius,
+  /// after the stock changed.
+  void refreshObstacle() {
+    const double r = std::max(tool_.rc, 1e-3) - 1e-4;
+    obstacle_ = grown(geom::unite(stock_, chuck_), r);
+    guard_ = grown(keepRegion(), r);
+  }
 
   /// What the step must leave: the stock outside the feature's removal, and the chuck.
   Region keepRegion() const { return geom::unite(geom::subtract(stock_, removal_), chuck_); }
@@ -1002,11 +1004,7 @@ private:
         return false;
       }
       w_.rapid(start, "approach");
-      Node &m = moves_.add(Node(ir::Kind::Linear));
-      m.set("to", Value::point(space(end + tool_.tip)));
-      m.set("feed_per_rev", Value::feedPerRev(pitch));
-      m.set("role", Value::word("thread"));
-      w_.moved(end);
+      w_.thread(end, pitch);
       if (!clear(end, outAtEnd)) {
         x_.report(ws_, feature_,
                   shape_.symbol + " ends in material at z " + formatFixed(t.lo, 4) +
@@ -1033,7 +1031,7 @@ private:
   LatheTool tool_;
   Node &moves_;
   LatheWriter w_;
-  Region obstacle_;
+  Region obstacle_, guard_;
   /// The feature's removal, mirrored across the axis; the chuck (all below
   /// the raw piece's chuck-side end), which no tool may enter.
   Region removal_, chuck_;
@@ -1061,7 +1059,8 @@ bool expandLatheToolpaths(Expander &x, Node &ws, const Node &op, const Node &fea
   Node moves = makeMoves(ws, tool.symbol, 0, coolant(op), setup);
   moves.set("x_mode", Value::word("diameter"));
   std::optional<std::pair<double, double>> css;  // surface speed, clamp in force
-  std::optional<Vec3> pos;
+  const LatheTool asGiven;
+  LatheWriter w(moves, asGiven);
   bool spindleSet = false;
   for (const Node *tp : op.childrenOf(ir::Kind::Toolpath)) {
     const Node *tech = tp->child(ir::Kind::Technology);
@@ -1116,30 +1115,16 @@ bool expandLatheToolpaths(Expander &x, Node &ws, const Node &op, const Node &fea
                                  " mm): a lathe's moves lie in the plane of the turning axis");
         return false;
       }
-      if (!pos || (*pos - from).norm() > 1e-6) {
-        Node &m = moves.add(Node(ir::Kind::Rapid));
-        m.set("to", Value::point(from));
-        m.set("role", Value::word("position"));
-      }
-      if (rapid) {
-        Node &m = moves.add(Node(ir::Kind::Rapid));
-        m.set("to", Value::point(to));
-        m.set("role", Value::word("position"));
-      } else if (c.arc) {
-        Node &m = moves.add(Node(ir::Kind::Arc));
-        m.set("to", Value::point(to));
-        m.set("center", Value::point(c.center + at));
-        m.set("dir", Value::word(c.ccw ? "ccw" : "cw"));
-        m.set("feed_per_rev", Value::feedPerRev(perRev));
-        m.set("role", Value::word("cut"));
-        m.set("normal", Value::direction(Vec3::UnitY()));
-      } else {
-        Node &m = moves.add(Node(ir::Kind::Linear));
-        m.set("to", Value::point(to));
-        m.set("feed_per_rev", Value::feedPerRev(perRev));
-        m.set("role", Value::word("cut"));
-      }
-      pos = to;
+      // Points as the file gives them: the writer's tool has no offset.
+      const Vec2 a = halfPlane(from), b = halfPlane(to);
+      if (!w.positioned() || (w.position() - a).norm() > 1e-6)
+        w.rapid(a, "position");
+      if (rapid)
+        w.rapid(b, "position");
+      else if (c.arc)
+        w.seg(Seg::arc(a, b, halfPlane(c.center + at), c.ccw), perRev, "cut");
+      else
+        w.feed(b, perRev, "cut");
     }
   }
   if (!spindleSet) {
