@@ -14,7 +14,8 @@
 //
 // Moves are read as written: their points are the chuck-side corner's
 // imaginary tip (docs/turning.md), the corner's centre a corner radius
-// further out in z and r.
+// further out in z and r; inside a bore (an inner turned shape) further out
+// in z and in towards the axis in r, the insert's edges reaching in too.
 #include "passes/VerifyTurning.h"
 
 #include "geom/Boolean.h"
@@ -130,7 +131,10 @@ struct Insert {
   }
 };
 
-Insert insertOf(const Node &tool) {
+/// The insert of `tool`; `inner`: working an inner surface (a boring bar),
+/// its edges reaching in towards the axis from the corner and its imaginary
+/// tip on the corner's side away from it.
+Insert insertOf(const Node &tool, bool inner) {
   Insert in;
   const std::string type = tool.text("type").value_or("");
   if (type != "turning_tool" && type != "grooving_tool" && type != "threading_tool") {
@@ -160,6 +164,11 @@ Insert insertOf(const Node &tool) {
     const double side = tool.number("side_edge_angle").value_or(0) * kDegree;
     const double end = tool.number("end_edge_angle").value_or(0) * kDegree;
     in.skeleton = {Vec2(0, 0), Vec2(-std::sin(side), std::cos(side)) * edge, Vec2(std::cos(end), std::sin(end)) * edge};
+  }
+  if (inner) {
+    for (Vec2 &p : in.skeleton)
+      p.y() = -p.y();
+    in.tipToCentre.y() = -in.tipToCentre.y();
   }
   return in;
 }
@@ -207,21 +216,10 @@ private:
     w.stock = raw.stock->region();
     std::vector<Region> removals;
     for (const Node &f : wp.children) {
-      if (f.category() == ir::Category::Feature && f.is(ir::Trait::Turning))
+      // Turned features, and holes on the axis (drilled or bored on the lathe).
+      if (f.category() == ir::Category::Feature && (f.is(ir::Trait::Turning) || f.kind == ir::Kind::RoundHole))
         if (ir::TurnedShapeResult s = ir::turnedShape(f, w.raw); s.shape)
           removals.push_back(s.shape->removal);
-      // A hole on the axis (drilled on the lathe): its cylinder, from its
-      // top down its depth.
-      if (f.kind == ir::Kind::RoundHole) {
-        const ir::Vec3 at = f.vec("at").value_or(ir::Vec3::Zero()), axis = f.vec("axis").value_or(ir::Vec3::UnitZ());
-        const double r = f.number("diameter").value_or(0) / 2, depth = f.number("depth").value_or(0);
-        if (std::abs(at.x()) < 1e-6 && std::abs(at.y()) < 1e-6 && std::abs(std::abs(axis.z()) - 1) < 1e-9 && r > 0 &&
-            depth > 0) {
-          const double z0 = at.z(), z1 = at.z() - axis.z() * depth;
-          removals.push_back(Region{{geom::polygon({Vec2(std::min(z0, z1), 0), Vec2(std::max(z0, z1), 0),
-                                                    Vec2(std::max(z0, z1), r), Vec2(std::min(z0, z1), r)})}});
-        }
-      }
     }
     w.part = geom::subtract(w.stock, geom::uniteAll(removals));
     w.chuck = Region{{geom::polygon({Vec2(w.raw.z0 - 1e4, -1e4), Vec2(w.raw.z0, -1e4), Vec2(w.raw.z0, 1e4),
@@ -254,7 +252,7 @@ private:
           .entity(ws.origin.entityId);
     const double t = tolerance_.value_or(wp->number("global_tolerance").value_or(0.01));
     const double allowance = op->number("allowance").value_or(0);
-    const Insert insert = insertOf(*tool);
+    const Insert insert = insertOf(*tool, shape.shape && shape.shape->inner);
     const Vec2 tipToCentre = insert.tipToCentre;
     // What the step may not cut: the part grown by its allowance, and the chuck.
     const Region guard = geom::unite(allowance > 0 ? geom::growExact(w->part, allowance) : w->part, w->chuck);

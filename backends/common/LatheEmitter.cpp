@@ -62,6 +62,7 @@ std::optional<std::string> LatheEmitter::run(const ir::Module &module) {
   out_.block(comment("moves stepnc plans program each turning or grooving insert's imaginary tip (its chuck-side "
                      "corner), a threading insert's point, touched off on X and Z, with the nose radius in the path "
                      "(G40); toolpaths the file gives are written as given"));
+  out_.block(comment("the imaginary tip is on the axis' side of the corner, away from it for a tool marked inside"));
   out_.block(comment(o_.toolTable ? "tool numbers from the tool table" : "no tool table: tools numbered in order "
                                                                          "of first use"));
   // The tools, numbered in order of first use (or by the table).
@@ -82,7 +83,9 @@ std::optional<std::string> LatheEmitter::run(const ir::Module &module) {
                                   : std::string()) +
                              (tool->has("thread_pitch")
                                   ? ", pitch " + formatFixed(*tool->number("thread_pitch"), 3) + " mm"
-                                  : std::string())));
+                                  : std::string()) +
+                             (moves->text("tip") == "inside" ? ", inside: its tip on the side away from the axis"
+                                                             : std::string())));
         }
   if (!ok_)
     return std::nullopt;

@@ -194,6 +194,8 @@ std::optional<std::string> Lowerer::tool(const Instance &t) {
   n.set("type", Value::word(std::string(type)));
   if (body.isA("turning_machine_tool_body")) {
     turningToolBody(body, n);
+    if (t.isA("turning_machine_tool"))
+      copyReal(n, "min_cutting_diameter", t, "minimum_cutting_diameter", Value::length);
   } else if (body) {
     if (Instance dim = body.ref("dimension")) {
       copyReal(n, "diameter", dim, "diameter", Value::length);

@@ -107,6 +107,7 @@ public:
     case Kind::Groove: return groove(*p) ? ok() : fail();
     case Kind::Thread: return thread(*p) ? ok() : fail();
     case Kind::GeneralRevolution: return generalRevolution() ? ok() : fail();
+    case Kind::RoundHole: return roundHole(*p) ? ok() : fail();
     default:
       error_ = named(f_) + " has no turned shape in stepnc yet (docs/turning.md lists the features turned)";
       return fail();
@@ -131,18 +132,31 @@ private:
     s_.removal = Region{{ccwPolygon(pts)}};
   }
 
-  bool outerDiameter(const Placed &p) {
-    const double d = f_.number("diameter").value_or(0), length = f_.number("length").value_or(0);
+  /// The radii at the two ends of the feature's `diameter` over `length`:
+  /// tapering to its `finalAttr` diameter, or by its taper angle (the radius
+  /// falls by length x tan(angle)); nullopt, after an error, when one is not
+  /// positive. `over` words the length in it ("", "a depth of ").
+  std::optional<std::pair<double, double>> taperedRadii(const char *finalAttr, double length, const char *over) {
+    const double d = f_.number("diameter").value_or(0);
     double r0 = d / 2, r1 = r0;
-    if (auto reduced = f_.number("reduced_diameter"))
+    if (auto reduced = f_.number(finalAttr))
       r1 = *reduced / 2;
     else if (auto taper = f_.number("taper_angle"))
       r1 = r0 - length * std::tan(*taper * kDegree);
     if (r0 <= 0 || length <= 0 || r1 <= 0) {
-      error_ = named(f_) + ": its diameter " + formatFixed(d, 4) + " mm over " + formatFixed(length, 4) +
+      error_ = named(f_) + ": its diameter " + formatFixed(d, 4) + " mm over " + over + formatFixed(length, 4) +
                " mm tapers to " + formatFixed(2 * r1, 4) + " mm: no turned surface";
-      return false;
+      return std::nullopt;
     }
+    return std::pair{r0, r1};
+  }
+
+  bool outerDiameter(const Placed &p) {
+    const double length = f_.number("length").value_or(0);
+    const auto radii = taperedRadii("reduced_diameter", length, "");
+    if (!radii)
+      return false;
+    const auto [r0, r1] = *radii;
     // From the placement along its axis; the end nearer the free end (the
     // higher z) is open: what lies beyond it is another feature's.
     Vec2 a(p.at.x(), r0), b(p.at.x() + p.sign * length, r1);
@@ -233,22 +247,27 @@ private:
     return true;
   }
 
-  /// Whether the feature's material side (absent: -x) points towards the
-  /// axis, as an outer feature's does; else why not, for `what` ("grooves").
-  bool materialTowardsAxis(const char *what) {
+  /// Which side of its surface the feature's material lies on: towards the
+  /// axis (absent, -x: an outer surface) or away from it (+x: an inner
+  /// one); nullopt, after an error naming `what` ("revolved profiles"), when
+  /// it is neither.
+  std::optional<bool> innerSide(const char *what) {
     const Vec3 side = f_.vec("material_side").value_or(Vec3(-1, 0, 0));
-    if (side.x() < -1 + 1e-9 && std::abs(side.z()) < 1e-9)
-      return true;
+    if (std::abs(std::abs(side.x()) - 1) < 1e-9 && std::abs(side.z()) < 1e-9)
+      return side.x() > 0;
     error_ = named(f_) + ": its material side " + formatTuple({side.x(), side.y(), side.z()}, 6) +
-             " is not towards the axis: only outer " + what + " are turned yet";
-    return false;
+             " is neither towards the axis nor away from it: " + what + " with their material along the axis are "
+             "not turned yet";
+    return std::nullopt;
   }
 
   bool groove(const Placed &p) {
-    // An outer groove: its floor at `radius`, its square-U profile's width
-    // centred on the placement along the axis, open outwards.
+    // A groove: its floor at `radius`, its square-U profile's width centred
+    // on the placement along the axis, open outwards (an outer groove) or
+    // in towards the axis (an inner one, in a bore).
     const double floor = f_.number("radius").value_or(0);
-    if (!materialTowardsAxis("grooves"))
+    const std::optional<bool> inner = innerSide("grooves");
+    if (!inner)
       return false;
     const Node *u = f_.child(Kind::SquareUProfile);
     if (!u) {
@@ -269,25 +288,35 @@ private:
       return false;
     }
     const double lo = p.at.x() - w / 2, hi = p.at.x() + w / 2;
-    // Walls from the reach down to the floor, round the corners (r1 at the
-    // low z wall, r2 at the high), along the floor.
-    Loop l;
-    const Vec2 topLo(lo, reachR_), topHi(hi, reachR_);
+    // Walls from the open side (the reach, or the axis) to the floor,
+    // round the corners (r1 at the low z wall, r2 at the high), along the
+    // floor; `in` points from the floor towards the open side.
+    const double in = *inner ? -1 : 1, open = *inner ? 0.0 : reachR_;
+    const Vec2 topLo(lo, open), topHi(hi, open);
     std::vector<Seg> path;
-    path.push_back(Seg::line(topLo, Vec2(lo, floor + r1)));
+    path.push_back(Seg::line(topLo, Vec2(lo, floor + in * r1)));
     if (r1 > 0)
-      path.push_back(Seg::arc(Vec2(lo, floor + r1), Vec2(lo + r1, floor), Vec2(lo + r1, floor + r1), true));
+      path.push_back(Seg::arc(Vec2(lo, floor + in * r1), Vec2(lo + r1, floor), Vec2(lo + r1, floor + in * r1), !*inner));
     path.push_back(Seg::line(Vec2(lo + r1, floor), Vec2(hi - r2, floor)));
     if (r2 > 0)
-      path.push_back(Seg::arc(Vec2(hi - r2, floor), Vec2(hi, floor + r2), Vec2(hi - r2, floor + r2), true));
-    path.push_back(Seg::line(Vec2(hi, floor + r2), topHi));
+      path.push_back(Seg::arc(Vec2(hi - r2, floor), Vec2(hi, floor + in * r2), Vec2(hi - r2, floor + in * r2), !*inner));
+    path.push_back(Seg::line(Vec2(hi, floor + in * r2), topHi));
     std::erase_if(path, [](const Seg &s) { return (s.b - s.a).norm() <= geom::kEps && !s.isArc(); });
+    Loop l;
     l.segs = path;
     l.segs.push_back(Seg::line(topHi, topLo));
+    if (*inner) {
+      // Walked clockwise round the material inside: reversed.
+      Loop ccw;
+      for (auto it = l.segs.rbegin(); it != l.segs.rend(); ++it)
+        ccw.segs.push_back(it->reversed());
+      l = ccw;
+    }
     s_.removal = Region{{l}};
-    s_.contour = path;  // from the low z wall's top round to the high one's
+    s_.contour = path;  // from the low z wall's open end round to the high one's
     s_.grooveSpan = {lo, hi};
     s_.grooveFloor = floor;
+    s_.inner = *inner;
     return true;
   }
 
@@ -296,7 +325,8 @@ private:
     // feature's: the points' x is the distance from the axis less the
     // feature's `radius`, z along it; y must be 0 (the half plane), arcs
     // turn about y (docs/turning.md).
-    if (!materialTowardsAxis("revolved profiles"))
+    const std::optional<bool> inner = innerSide("revolved profiles");
+    if (!inner)
       return false;
     const Node *profile = f_.child(Kind::GeneralProfile);
     if (!profile || profile->children.empty()) {
@@ -358,13 +388,24 @@ private:
       for (Seg &sg : chain)
         sg = sg.reversed();
     }
+    return surface(std::move(chain), *inner);
+  }
+
+  /// The removal and contour of a surface of revolution given by `chain`,
+  /// its section from the free end towards the chuck without turning back.
+  /// An outer surface continues at its first radius past the free end and,
+  /// at its chuck-side end, out to the reach (a shoulder); its removal lies
+  /// outwards of it. An inner one (a bore) continues at its first radius
+  /// past the free end and, at its deep end, in to the axis (its bottom);
+  /// its removal lies between it and the axis.
+  bool surface(std::vector<Seg> chain, bool inner) {
     for (const Seg &sg : chain) {
       if (sg.box().lo.y() < -1e-9) {
         error_ = named(f_) + ": its profile crosses the axis (a radius below 0)";
         return false;
       }
       // From the free end towards the chuck without turning back: an
-      // undercut is no outer surface a turning tool reaches from the end.
+      // undercut is no surface a turning tool reaches from the end.
       const geom::Box b = sg.box();
       if (b.hi.x() > sg.a.x() + 1e-9 || b.lo.x() < sg.b.x() - 1e-9) {
         error_ = named(f_) + ": its profile turns back towards the free end near (z " + formatFixed(sg.a.x(), 4) +
@@ -373,21 +414,28 @@ private:
       }
     }
     const Vec2 first = chain.front().a, last = chain.back().b;
+    const double end = inner ? 0.0 : reachR_;  // where the surface's chuck-side end runs to
     Loop l;
     l.segs.push_back(Seg::line(Vec2(reachZ_, first.y()), first));
     for (const Seg &sg : chain)
       l.segs.push_back(sg);
-    l.segs.push_back(Seg::line(last, Vec2(last.x(), reachR_)));
-    l.segs.push_back(Seg::line(Vec2(last.x(), reachR_), Vec2(reachZ_, reachR_)));
-    l.segs.push_back(Seg::line(Vec2(reachZ_, reachR_), Vec2(reachZ_, first.y())));
+    if (std::abs(last.y() - end) > geom::kEps)
+      l.segs.push_back(Seg::line(last, Vec2(last.x(), end)));
     s_.contour = l.segs;
-    s_.contour.pop_back();
-    s_.contour.pop_back();
-    // The loop runs clockwise (along the surface towards the chuck, back
-    // along the reach): reversed, counter-clockwise as regions are.
-    if (l.area() >= 0) {
-      error_ = named(f_) + ": its profile does not bound material towards the axis (it turns back on itself)";
+    l.segs.push_back(Seg::line(Vec2(last.x(), end), Vec2(reachZ_, end)));
+    l.segs.push_back(Seg::line(Vec2(reachZ_, end), Vec2(reachZ_, first.y())));
+    s_.inner = inner;
+    // The loop runs along the surface towards the chuck and back along the
+    // reach: clockwise round an outer removal (reversed, counter-clockwise
+    // as regions are), counter-clockwise round an inner one.
+    if (inner ? l.area() <= 0 : l.area() >= 0) {
+      error_ = named(f_) + ": its profile does not bound material " + (inner ? "away from" : "towards") +
+               " the axis (it turns back on itself)";
       return false;
+    }
+    if (inner) {
+      s_.removal = Region{{l}};
+      return true;
     }
     Loop ccw;
     for (auto it = l.segs.rbegin(); it != l.segs.rend(); ++it)
@@ -396,14 +444,63 @@ private:
     return true;
   }
 
-  bool thread(const Placed &p) {
-    // ISO 68-1's basic profile of a 60 degree thread: the pitch diameter is
-    // d - 0.649519 P; an outer thread's root (minor) diameter is
-    // d - 1.226869 P, the depth 0.613435 P (ISO 965-1's d3).
-    if (f_.flag("inner").value_or(false)) {
-      error_ = named(f_) + " is an inner thread: only outer threads are turned yet";
+  /// A round hole on the axis, turned as an inner diameter (a bore): from
+  /// its placement down its depth along -axis at its diameter (tapering to
+  /// its final diameter, or by its taper angle), with its bottom: through
+  /// (on to the chuck side), flat, or conical (the point at its depth).
+  bool roundHole(const Placed &p) {
+    const double depth = f_.number("depth").value_or(0);
+    if (p.sign < 0) {
+      error_ = named(f_) + " points towards the chuck (its axis along -z): a hole on the axis is bored from the "
+                           "free end (+z)";
       return false;
     }
+    const auto radii = taperedRadii("final_diameter", depth, "a depth of ");
+    if (!radii)
+      return false;
+    const auto [r0, r1] = *radii;
+    const double top = p.at.x(), bottom = top - depth;
+    const std::string kind = f_.text("bottom").value_or("flat");
+    std::vector<Seg> chain;
+    if (kind == "through") {
+      // Through the bar: the wall runs on to the chuck side at its last radius.
+      chain = {Seg::line(Vec2(top, r0), Vec2(bottom, r1))};
+      if (bottom > lowZ_)
+        chain.push_back(Seg::line(Vec2(bottom, r1), Vec2(lowZ_, r1)));
+    } else if (kind == "flat") {
+      chain = {Seg::line(Vec2(top, r0), Vec2(bottom, r1))};
+    } else if (kind == "conical") {
+      const double tip = f_.number("tip_angle").value_or(118);
+      if (tip <= 0 || tip >= 180) {
+        error_ = named(f_) + ": its conical bottom's tip angle " + formatTrimmed(tip, 4) + " deg makes no cone";
+        return false;
+      }
+      // The cone's length L from its point up to the wall, where the
+      // (tapering) wall's radius is r1 + (r0 - r1) L / depth.
+      const double slope = std::tan(tip * kDegree / 2) - (r0 - r1) / depth;
+      const double coneLength = slope > 0 ? r1 / slope : depth;
+      if (coneLength >= depth) {
+        error_ = named(f_) + ": its conical bottom is longer than the hole is deep";
+        return false;
+      }
+      const double shoulder = bottom + coneLength;
+      const double rs = r0 + (r1 - r0) * (top - shoulder) / depth;
+      chain = {Seg::line(Vec2(top, r0), Vec2(shoulder, rs)), Seg::line(Vec2(shoulder, rs), Vec2(bottom, 0))};
+    } else {
+      error_ = named(f_) + ": a hole with a " + kind +
+               " bottom is not turned yet (through, flat and conical bottoms are)";
+      return false;
+    }
+    return surface(std::move(chain), true);
+  }
+
+  bool thread(const Placed &p) {
+    // ISO 68-1's basic profile of a 60 degree thread: the pitch diameter is
+    // d - 0.649519 P. An outer thread's root (minor) diameter is
+    // d - 1.226869 P, the depth 0.613435 P (ISO 965-1's d3); an inner
+    // thread's crest (minor) diameter D1 = D - 1.082532 P, cut out to its
+    // major diameter D, the depth 0.541266 P.
+    const bool inner = f_.flag("inner").value_or(false);
     const double major = f_.number("major_diameter").value_or(0), length = f_.number("length").value_or(0);
     const std::optional<double> pitchD = f_.number("pitch_diameter"), minor = f_.number("minor_diameter");
     if (major <= 0 || length <= 0) {
@@ -419,21 +516,30 @@ private:
         return false;
       }
     }
-    double root = minor ? *minor / 2 : (t.pitch > 0 ? (major - 1.226869 * t.pitch) / 2 : 0);
-    if (root <= 0 || root >= major / 2) {
+    const double minorRadius =
+        minor ? *minor / 2 : (t.pitch > 0 ? (major - (inner ? 1.082532 : 1.226869) * t.pitch) / 2 : 0);
+    if (minorRadius <= 0 || minorRadius >= major / 2) {
       error_ = named(f_) + " needs a minor diameter below its major one, or its pitch diameter (to derive the pitch "
                            "and root of its 60 degree profile)";
       return false;
     }
     t.lo = std::min(p.at.x(), p.at.x() + p.sign * length);
     t.hi = std::max(p.at.x(), p.at.x() + p.sign * length);
-    t.majorRadius = major / 2;
-    t.rootRadius = root;
+    t.crestRadius = inner ? minorRadius : major / 2;
+    t.rootRadius = inner ? major / 2 : minorRadius;
     t.starts = static_cast<int>(f_.count("starts").value_or(1));
     t.leftHand = f_.text("hand") == "left";
-    s_.removal = Region{{ccwPolygon({{t.lo, root}, {t.hi, root}, {t.hi, reachR_}, {t.lo, reachR_}})}};
-    s_.contour = {Seg::line(Vec2(t.hi, root), Vec2(t.lo, root))};
+    if (t.starts < 1) {
+      error_ = named(f_) + " has " + std::to_string(t.starts) + " starts";
+      return false;
+    }
+    // What the thread removes: its band from the root out (an outer
+    // thread) or in to the axis (an inner one, the hole it is cut in).
+    const double from = inner ? 0.0 : t.rootRadius, to = inner ? t.rootRadius : reachR_;
+    s_.removal = Region{{ccwPolygon({{t.lo, from}, {t.hi, from}, {t.hi, to}, {t.lo, to}})}};
+    s_.contour = {Seg::line(Vec2(t.hi, t.rootRadius), Vec2(t.lo, t.rootRadius))};
     s_.thread = t;
+    s_.inner = inner;
     return true;
   }
 

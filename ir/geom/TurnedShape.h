@@ -55,11 +55,13 @@ struct TurnedShape {
   /// strategies plunge between the walls).
   std::optional<std::pair<double, double>> grooveSpan;
   double grooveFloor = 0;
-  /// An outer thread: its extent along the axis (lo < hi), its major and
-  /// root (minor) radii, its pitch and starts (docs/turning.md).
+  /// A thread: its extent along the axis (lo < hi), its crest radius
+  /// (where the tool starts: an outer thread's major, an inner one's minor)
+  /// and its root radius (where the tool cuts to: an outer thread's minor,
+  /// an inner one's major), its pitch and starts (docs/turning.md).
   struct ThreadSpan {
     double lo = 0, hi = 0;
-    double majorRadius = 0, rootRadius = 0;
+    double crestRadius = 0, rootRadius = 0;
     double pitch = 0;
     int starts = 1;
     bool leftHand = false;
@@ -68,6 +70,10 @@ struct TurnedShape {
   /// A face whose material is on the free end's side: it looks towards the
   /// chuck, and only parting off (cutting in) makes it.
   bool towardsChuck = false;
+  /// An inner surface (a bore): it looks towards the axis, its material is
+  /// outwards of it, and tools work it from inside, entering from the free
+  /// end; the removal reaches in to the axis.
+  bool inner = false;
   /// Where the feature is placed (its placement's origin in the half plane)
   /// and which way its axis runs along z (+1 or -1).
   HalfPlanePoint at = HalfPlanePoint::Zero();

@@ -1,5 +1,7 @@
 #include "ir/motion/LatheTime.h"
 
+#include "ir/geom/TurnedShape.h"
+
 #include "ir/Program.h"
 #include "ir/geom/MoveWalk.h"
 #include "support/Format.h"
@@ -41,7 +43,7 @@ public:
 
   LatheTimeReport run() {
     for (const Node *e : programOrder(module_))
-      if (isTurningStep(*e))
+      if (isTurningStep(*e) || drillsOnTurningAxis(*e))
         if (const Node *moves = e->child(Kind::Moves))
           step(*e, *moves);
     travel("x", x_, xLo_, xHi_);
@@ -206,7 +208,7 @@ LatheTimeReport timeLatheProgram(const Module &module, const runtime::Machine &m
 }
 
 std::string formatLatheReport(const LatheTimeReport &r, const runtime::Machine &machine) {
-  std::string out = "lathe program on \"" + machine.name + "\": " + std::to_string(r.steps.size()) + " turning steps\n";
+  std::string out = "lathe program on \"" + machine.name + "\": " + std::to_string(r.steps.size()) + " lathe steps\n";
   out += "cycle time " + formatFixed(r.total, 3) + " s: cutting " + formatFixed(r.cutting, 3) + " s, rapids " +
          formatFixed(r.rapid, 3) + " s, dwells " + formatFixed(r.dwell, 3) + " s, waiting for the spindle " +
          formatFixed(r.spindleWait, 3) + " s (tool changes not counted)\n";

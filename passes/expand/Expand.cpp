@@ -12,6 +12,8 @@
 // strategy it does not know. Warnings never change the moves.
 #include "passes/expand/Expand.h"
 
+#include "ir/geom/TurnedShape.h"
+
 #include "ir/Plausible.h"
 #include "ir/Verifier.h"
 #include "support/Format.h"
@@ -207,8 +209,11 @@ public:
     // program of its own, which a target with control flow writes as such.
     leftOut_.clear();
     ir::forEachMachiningStep(module, [&](Node &e, const std::string &setup) {
-      if (!e.child(ir::Kind::Moves))
+      if (!e.child(ir::Kind::Moves)) {
         executable(e, setup);
+        if (ir::drillsOnTurningAxis(e))
+          noteAxialDrilling(x_, e);
+      }
     });
     if (!leftOut_.empty())
       leaveOut(module.root);

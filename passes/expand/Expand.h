@@ -221,6 +221,10 @@ bool expandTrochoidal(Expander &x, const Step &step);
 /// Turning.cpp: the lathe moves of a turning workingstep, from its turned
 /// feature and the stock the steps before left; false after a diagnostic.
 bool expandTurning(Expander &x, Node &ws, const Node &op, const std::string &setup);
+/// Turning.cpp: after a hole-making step drilled on the turning axis
+/// (ir::drillsOnTurningAxis), its workpiece's lathe stock loses what the
+/// drill's point and body swept, so that a boring step after it finds the hole.
+void noteAxialDrilling(Expander &x, const Node &ws);
 /// Expand.cpp: true when every point and length of the expanded moves is
 /// one a machine tool can go to, else an error at the workingstep naming the
 /// first coordinate beyond (a feature whose dimensions run past it).

@@ -8,8 +8,9 @@
 // apart. Paths are made for the centre of the (chuck-side) corner circle and
 // written for the point a lathe programs, the corner's imaginary tip (the
 // point touched off on X and Z): the centre moved by the corner radius
-// towards -z and towards the axis. The program thus stays G40: nose-radius
-// compensation is computed here (docs/turning.md).
+// towards -z and towards the axis (inside a bore, away from it). The
+// program thus stays G40: nose-radius compensation is computed here
+// (docs/turning.md).
 //
 // Every rapid is checked against the stock as it stands when the rapid is
 // made (the insert's corner circles clear of it); where the straight way is
@@ -19,10 +20,13 @@
 #include "geom/Boolean.h"
 #include "ir/geom/Curves.h"
 #include "ir/Plausible.h"
+#include "ir/geom/FeatureShape.h"
+#include "ir/geom/MoveWalk.h"
 #include "ir/geom/TurnedShape.h"
 #include "support/Format.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace stepnc::passes::expand {
@@ -52,6 +56,9 @@ struct LatheTool {
   std::vector<double> corners{0.0};
   /// The programmed point relative to the chuck-side corner's centre.
   Vec2 tip = Vec2::Zero();
+  /// How far the insert reaches towards the chuck beyond its corner circle
+  /// (a threading insert's flank, as deep as it cuts).
+  double flank = 0;
 };
 
 /// Writes the moves of one lathe step: points are corner centres in the
@@ -189,6 +196,8 @@ public:
                          : "its threading tool " + toolNode_.symbol + " only cuts threads");
       return false;
     }
+    if (shape_.inner && !holeToBore())
+      return false;
     bool ok = false;
     switch (op_.kind) {
     case ir::Kind::ContouringRough: ok = rough(false); break;
@@ -229,9 +238,14 @@ private:
       }
       tool_.corners = {0.0, (tool_.width - 2 * tool_.rc) / 2, tool_.width - 2 * tool_.rc};
     } else if (type == "threading_tool") {
-      // Programmed at the point of its V, the tip circle's lowest point.
+      // Programmed at the point of its V, the tip circle's point nearest
+      // the axis (inside a bore: farthest from it).
       tool_.threading = true;
-      tool_.tip = Vec2(0, -tool_.rc);
+      tool_.tip = Vec2(0, shape_.inner ? tool_.rc : -tool_.rc);
+      // Its V's flank, as deep as the tool cuts (5 mm when it does not say,
+      // as verify-toolpaths reads it).
+      const double half = toolNode_.number("thread_angle").value_or(60) * kPi / 360;
+      tool_.flank = std::tan(half) * toolNode_.number("max_cutting_depth").value_or(5.0);
       return true;
     } else if (type != "turning_tool") {
       x_.report(ws_, toolNode_,
@@ -240,7 +254,8 @@ private:
                     "threading tools");
       return false;
     }
-    tool_.tip = Vec2(-tool_.rc, -tool_.rc);
+    // Inside a bore the corner's imaginary tip is on its side away from the axis.
+    tool_.tip = Vec2(-tool_.rc, shape_.inner ? tool_.rc : -tool_.rc);
     return true;
   }
 
@@ -279,6 +294,31 @@ private:
       return false;
     }
     moves_.set("x_mode", Value::word("diameter"));
+    if (shape_.inner)
+      moves_.set("tip", Value::word("inside"));
+    return true;
+  }
+
+  /// Whether an inner surface has the hole a boring bar works from: the
+  /// material to remove must stand off the axis (a hole drilled or bored
+  /// before), at least as wide as the bar's minimum cutting diameter.
+  bool holeToBore() {
+    const Region material = nearSide(geom::intersect(stock_, removal_));
+    if (material.empty() || material.area() < 1e-9)
+      return true;  // nothing to cut: said by the strategy
+    const double hole = 2 * material.box().lo.y();
+    if (hole < 1e-3) {
+      x_.report(ws_, feature_,
+                "the material inside " + shape_.symbol + " reaches the spindle axis: a tool working inside needs a "
+                                         "hole to work from (drill or bore it on the axis first)");
+      return false;
+    }
+    if (auto least = toolNode_.number("min_cutting_diameter"); least && hole < *least - 1e-9) {
+      x_.report(ws_, toolNode_,
+                "its tool " + toolNode_.symbol + " enters holes of " + formatFixed(*least, 4) +
+                    " mm and more; the hole inside " + shape_.symbol + " is " + formatFixed(hole, 4) + " mm");
+      return false;
+    }
     return true;
   }
 
@@ -342,14 +382,20 @@ private:
       w_.rapid(to, "position");
       return true;
     }
+    // Out above the stock, across and in; else (inside a bore) out along
+    // the axis past the stock's free end, across and back in.
     const double above = maxR(stock_) + tool_.rc + kLatheClearance;
-    const Vec2 up(from.x(), std::max(above, from.y())), over(to.x(), std::max(above, from.y()));
-    if (clear(from, up) && clear(up, over) && clear(over, to)) {
-      w_.rapid(up, "retract");
-      w_.rapid(over, "position");
-      w_.rapid(to, "approach");
-      return true;
-    }
+    const double front = std::max(stock_.box().hi.x() + tool_.rc + tool_.flank + kLatheClearance, from.x());
+    const std::array<std::pair<Vec2, Vec2>, 2> ways{
+        std::pair{Vec2(from.x(), std::max(above, from.y())), Vec2(to.x(), std::max(above, from.y()))},
+        std::pair{Vec2(front, from.y()), Vec2(front, to.y())}};
+    for (const auto &[out, over] : ways)
+      if (clear(from, out) && clear(out, over) && clear(over, to)) {
+        w_.rapid(out, "retract");
+        w_.rapid(over, "position");
+        w_.rapid(to, "approach");
+        return true;
+      }
     x_.report(ws_, "no way at rapid from (z " + formatFixed(from.x(), 4) + ", r " + formatFixed(from.y(), 4) +
                        ") to (z " + formatFixed(to.x(), 4) + ", r " + formatFixed(to.y(), 4) +
                        ") mm clear of the stock (insert corner centres)");
@@ -385,6 +431,18 @@ private:
           for (Region &r : geom::sweptDiscParts(t, tool_.rc))
             parts.push_back(std::move(r));
       }
+    // A grooving insert is the hull of its corners: its edge between them
+    // sweeps what lies between their paths (a plunge's whole width).
+    if (const double span = tool_.corners.back(); span > geom::kEps)
+      for (const Seg &s : path) {
+        const Vec2 w(span, 0);
+        for (const Vec2 &at : {s.a, s.b})
+          for (Region &r : geom::sweptDiscParts(Seg::line(at, at + w), std::max(tool_.rc, 1e-6)))
+            parts.push_back(std::move(r));
+        if (!s.isArc())
+          if (Loop l = geom::polygon({s.a, s.a + w, s.b + w, s.b}); std::abs(l.area()) > 1e-12)
+            parts.push_back(Region{{l.area() > 0 ? l : geom::polygon({s.b, s.b + w, s.a + w, s.a})}});
+      }
     if (away)
       for (const Seg &s : path) {
         const Vec2 far = *away * 2 * (raw_.radius + raw_.z1 - raw_.z0 + 10);
@@ -392,7 +450,9 @@ private:
         if (std::abs(l.area()) > 1e-12) {
           if (l.area() < 0)
             l = geom::polygon({s.a + far, s.b + far, s.b, s.a});
-          parts.push_back(Region{{l}});
+          // Towards the axis (inside a bore) it stops there: what lies past
+          // it is the other side's, which the mirror image gives.
+          parts.push_back(away->y() < 0 ? nearSide(Region{{l}}) : Region{{l}});
         }
       }
     if (!parts.empty())
@@ -444,8 +504,12 @@ private:
       return false;
     }
     const double a = op_.number("allowance").value_or(0);
-    Vec2 d = strategyDir("feed_dir").value_or(facing ? Vec2(0, -1) : Vec2(-1, 0));
-    Vec2 s = strategyDir("stepover_dir").value_or(facing ? Vec2(-1, 0) : Vec2(0, -1));
+    // By default along the axis towards the chuck stepping in towards the
+    // axis (facing: across it towards the axis, stepping towards the chuck);
+    // inside a bore outwards instead.
+    const double in = shape_.inner ? 1 : -1;
+    Vec2 d = strategyDir("feed_dir").value_or(facing ? Vec2(0, in) : Vec2(-1, 0));
+    Vec2 s = strategyDir("stepover_dir").value_or(facing ? Vec2(-1, 0) : Vec2(0, in));
     const bool along = std::abs(std::abs(d.x()) - 1) < 1e-9 && std::abs(s.y()) > 1 - 1e-9;
     const bool across = std::abs(std::abs(d.y()) - 1) < 1e-9 && std::abs(s.x()) > 1 - 1e-9;
     if (!along && !across) {
@@ -477,7 +541,9 @@ private:
     const Region centres = nearSide(geom::subtract(grown(material, tool_.rc), forbidden));
     const Vec2 out = -s;  // from the part towards the stock's outside
     auto u = [&](const Vec2 &p) { return p.dot(out); };
-    const geom::Box cb = centres.box(), mb = material.box();
+    // The material on the near side of the axis (its mirror image past it
+    // would put the first level off by the bore's diameter inside a bore).
+    const geom::Box cb = centres.box(), mb = nearSide(material).box();
     if (centres.empty()) {
       x_.warning(ws_, shape_.symbol + ": the allowance leaves nothing to rough");
       return true;
@@ -786,23 +852,32 @@ private:
 
   double movesSpindle() const { return moves_.number("spindle").value_or(0); }
 
-  /// The radius above which the band [z, z + width] of the stock is clear.
+  /// From the part towards where the tool comes from, across the axis: +1
+  /// outside, -1 inside a bore.
+  double outwards() const { return shape_.inner ? -1 : 1; }
+
+  /// The radius beyond which (outwards, or in towards the axis inside a
+  /// bore) the band [z, z + width] of the stock is clear.
   double topOver(double zLeftEdge) const {
-    const Region band = geom::intersect(stock_, box(Vec2(zLeftEdge, -1), Vec2(zLeftEdge + tool_.width, 1e5)));
+    const Region band = nearSide(geom::intersect(stock_, box(Vec2(zLeftEdge, -1), Vec2(zLeftEdge + tool_.width, 1e5))));
+    if (shape_.inner)
+      return band.empty() ? 0 : band.box().lo.y();
     return maxR(band);
   }
 
   /// One plunge of the grooving insert with its chuck-side edge at `zEdge`
-  /// down to `bottom` (the insert's lowest point), and straight back out.
+  /// to `bottom` (the insert's point farthest in), and straight back out.
   bool plunge(double zEdge, double bottom, const char *role) {
+    const double out = outwards();
     const double zc = zEdge + tool_.rc;
-    const double top = std::max(topOver(zEdge), bottom) + tool_.rc + kLatheClearance;
-    const Vec2 entry(zc, top), end(zc, bottom + tool_.rc);
+    const double topR = topOver(zEdge);
+    const double top = (out > 0 ? std::max(topR, bottom) : std::min(topR, bottom)) + out * (tool_.rc + kLatheClearance);
+    const Vec2 entry(zc, top), end(zc, bottom + out * tool_.rc);
     if (!cut(entry, {Seg::line(entry, end)}, role))
       return false;
     dwell();
     w_.rapid(entry, "retract");
-    removeSwept({Seg::line(entry, end)}, Vec2(0, 1));
+    removeSwept({Seg::line(entry, end)}, Vec2(0, out));
     return true;
   }
 
@@ -824,7 +899,7 @@ private:
     const int n = static_cast<int>(std::ceil((last - first) / step - 1e-9)) + 1;
     for (int k = 0; k < n; ++k) {
       const double z = n == 1 ? first : first + (last - first) * k / (n - 1);
-      if (!plunge(z, shape_.grooveFloor + a, "cut"))
+      if (!plunge(z, shape_.grooveFloor + outwards() * a, "cut"))
         return false;
     }
     return true;
@@ -834,7 +909,7 @@ private:
     if (!needsGroove())
       return false;
     const auto [lo, hi] = *shape_.grooveSpan;
-    const double floor = shape_.grooveFloor;
+    const double floor = shape_.grooveFloor, out = outwards();
     if (hi - lo < tool_.width - 1e-9) {
       x_.report(ws_, toolNode_,
                 "its grooving tool " + toolNode_.symbol + " is wider than " + shape_.symbol + " (" +
@@ -844,19 +919,24 @@ private:
     // Down the free-end wall with the far corner, along the floor, up the
     // chuck-side wall: the chuck-side corner's centre is the reference.
     const double far = tool_.width - 2 * tool_.rc;
-    const double zHiWall = hi - tool_.rc - far, zLoWall = lo + tool_.rc, rFloor = floor + tool_.rc;
-    const double top = std::max(topOver(lo), floor) + tool_.rc + kLatheClearance;
+    const double zHiWall = hi - tool_.rc - far, zLoWall = lo + tool_.rc, rFloor = floor + out * tool_.rc;
+    const double topR = topOver(lo);
+    const double top = (out > 0 ? std::max(topR, floor) : std::min(topR, floor)) + out * (tool_.rc + kLatheClearance);
     std::vector<Seg> path{Seg::line(Vec2(zHiWall, top), Vec2(zHiWall, rFloor)),
                           Seg::line(Vec2(zHiWall, rFloor), Vec2(zLoWall, rFloor)),
                           Seg::line(Vec2(zLoWall, rFloor), Vec2(zLoWall, top))};
     std::erase_if(path, [](const Seg &s) { return (s.b - s.a).norm() < 1e-9; });
     if (!cut(path.front().a, path))
       return false;
-    removeSwept(path, Vec2(0, 1));
+    removeSwept(path, Vec2(0, out));
     return true;
   }
 
   bool cutIn() {
+    if (shape_.inner) {
+      x_.report(ws_, op_, "cutting in on the inner surface of " + shape_.symbol + " is not supported");
+      return false;
+    }
     if (!tool_.grooving) {
       x_.report(ws_, toolNode_, "cutting in needs a grooving (parting) tool; " + toolNode_.symbol + " is a turning tool");
       return false;
@@ -942,12 +1022,8 @@ private:
       return false;
     }
     const ir::TurnedShape::ThreadSpan &t = *shape_.thread;
-    if (t.starts != 1 || t.leftHand) {
-      x_.report(ws_, feature_,
-                shape_.symbol + (t.leftHand ? " is a left-hand thread" : " has several starts") +
-                    ": stepnc cuts single-start right-hand threads yet");
-      return false;
-    }
+    if (t.leftHand)
+      reverseForLeftHand();
     // The tool's pitch is exact; the one a thread's diameters give is as
     // exact as their decimals (1 % agreement asked).
     const double toolPitch = toolNode_.number("thread_pitch").value_or(0);
@@ -963,10 +1039,13 @@ private:
                     shape_.symbol + " has " + formatFixed(t.pitch, 4) + " mm (from its diameters)");
       return false;
     }
-    if (perRev_ > 0 && std::abs(perRev_ - pitch) > 1e-6)
+    // A thread of several starts advances by its lead (starts x pitch) a
+    // revolution; each start is cut from a run-in a pitch further out.
+    const double lead = pitch * t.starts;
+    if (perRev_ > 0 && std::abs(perRev_ - lead) > 1e-6)
       x_.assumed(ws_, *op_.child(ir::Kind::Technology),
                  "its feed per revolution " + formatFixed(perRev_, 4) + " mm is not the thread's lead " +
-                     formatFixed(pitch, 4) + " mm: the passes follow the lead");
+                     formatFixed(lead, 4) + " mm: the passes follow the lead");
     for (const Node &c : moves_.children)
       if (c.kind == ir::Kind::State && c.has("surface_speed")) {
         const Node *tech = op_.child(ir::Kind::Technology);
@@ -974,7 +1053,7 @@ private:
                   "threading follows the spindle: it needs a constant spindle speed, not a constant cutting speed");
         return false;
       }
-    const double depth = t.majorRadius - t.rootRadius;
+    const double depth = std::abs(t.rootRadius - t.crestRadius);
     const double allowance = op_.number("allowance").value_or(0);
     if (allowance < 0 || allowance >= depth) {
       x_.report(ws_, op_, "its allowance " + formatFixed(allowance, 4) + " mm is not within the thread's depth " +
@@ -991,33 +1070,53 @@ private:
       if (!x_.result.ok)
         return false;
     }
-    const double runIn = t.hi + 2 * pitch, clearR = t.majorRadius + kLatheClearance + tool_.rc;
-    const Vec2 outAtStart(runIn, clearR);
-    for (double d : passes) {
-      const double r = t.majorRadius - d + tool_.rc;  // the tip circle's centre
-      const Vec2 start(runIn, r), end(t.lo, r), outAtEnd(t.lo, clearR);
-      if (!travel(outAtStart))
-        return false;
-      if (!clear(outAtStart, start)) {
-        x_.report(ws_, feature_,
-                  "no room to run in before " + shape_.symbol + ": the stock reaches past its free-end end");
-        return false;
+    // Out of the thread is away from the axis for an outer thread, towards
+    // it inside a bore; the tip circle's centre is a corner radius back
+    // from the V's point.
+    const double out = shape_.inner ? -1 : 1;
+    const double runIn = t.hi + 2 * lead, clearR = t.crestRadius + out * (kLatheClearance + tool_.rc);
+    for (double d : passes)
+      for (int k = 0; k < t.starts; ++k) {
+        const double r = t.crestRadius - out * (d - tool_.rc);
+        const double z = runIn + k * pitch;
+        const Vec2 outAtStart(z, clearR), start(z, r), end(t.lo, r), outAtEnd(t.lo, clearR);
+        if (!travel(outAtStart))
+          return false;
+        if (!clear(outAtStart, start)) {
+          x_.report(ws_, feature_,
+                    "no room to run in before " + shape_.symbol + ": the stock reaches past its free-end end");
+          return false;
+        }
+        w_.rapid(start, "approach");
+        w_.thread(end, lead);
+        if (!clear(end, outAtEnd)) {
+          x_.report(ws_, feature_,
+                    shape_.symbol + " ends in material at z " + formatFixed(t.lo, 4) +
+                        " mm: the tool cannot leave the thread there (give it a groove to run out into)");
+          return false;
+        }
+        w_.rapid(outAtEnd, "retract");
       }
-      w_.rapid(start, "approach");
-      w_.thread(end, pitch);
-      if (!clear(end, outAtEnd)) {
-        x_.report(ws_, feature_,
-                  shape_.symbol + " ends in material at z " + formatFixed(t.lo, 4) +
-                      " mm: the tool cannot leave the thread there (give it a groove to run out into)");
-        return false;
-      }
-      w_.rapid(outAtEnd, "retract");
-    }
     // The thread's band is cut when the step ends (passes do not clear it
     // for one another's way out).
-    const double deepest = t.majorRadius - passes.back() + tool_.rc;
-    removeSwept({Seg::line(Vec2(runIn, deepest), Vec2(t.lo, deepest))}, Vec2(0, 1));
+    const double deepest = t.crestRadius - out * (passes.back() - tool_.rc);
+    removeSwept({Seg::line(Vec2(runIn + (t.starts - 1) * pitch, deepest), Vec2(t.lo, deepest))}, Vec2(0, out));
     return true;
+  }
+
+  /// A left-hand thread is cut as a right-hand one is, towards the chuck,
+  /// with the spindle turning the other way (counter-clockwise, M4) and the
+  /// insert mounted for it; a step whose spindle turns clockwise is turned
+  /// round, and that is said.
+  void reverseForLeftHand() {
+    const double n = movesSpindle();
+    if (n < 0) {
+      moves_.set("spindle", Value::spindle(-n));
+      x_.assumed(ws_, op_,
+                 shape_.symbol + " is a left-hand thread: cut towards the chuck with the spindle reversed "
+                                 "(counter-clockwise, M4) and its insert " + toolNode_.symbol +
+                     " mounted upside down for it");
+    }
   }
 
   Expander &x_;
@@ -1137,7 +1236,41 @@ bool expandLatheToolpaths(Expander &x, Node &ws, const Node &op, const Node &fea
   return true;
 }
 
+/// The lathe stock of `workpiece` as the steps so far left it (at first its raw piece).
+Region &latheStock(Expander &x, const Node &workpiece, const ir::TurnStock &raw) {
+  auto [it, fresh] = x.turnedStock.try_emplace(workpiece.symbol, Region());
+  if (fresh)
+    it->second = withMirror(raw.region());
+  return it->second;
+}
+
 } // namespace
+
+void noteAxialDrilling(Expander &x, const Node &ws) {
+  const Node *feature = ir::findFeature(*x.module, ws.text("feature").value_or(""));
+  const Node *moves = ws.child(ir::Kind::Moves);
+  const Node *tool = moves ? ir::findTool(*x.module, moves->text("tool").value_or("")) : nullptr;
+  const Node *workpiece = feature ? ir::workpieceOf(*x.module, *feature) : nullptr;
+  const ir::StockResult raw = ir::turnStock(workpiece);
+  if (!tool || !raw.stock)
+    return;  // not a lathe's workpiece: nothing to follow
+  // The drill's point and body from its deepest point out past the bar's end.
+  double tip = 1e300;
+  for (const ir::Move &m : ir::walkMoves(*moves))
+    if (m.kind != ir::MoveKind::Rapid && m.kind != ir::MoveKind::Dwell)
+      tip = std::min(tip, m.to.z());
+  const double r = tool->number("diameter").value_or(0) / 2;
+  if (tip > raw.stock->z1 || r <= 0)
+    return;
+  const double point = std::min(ir::pointLength(*tool), raw.stock->z1 + 10 - tip);
+  const double out = raw.stock->z1 + 10;
+  const std::vector<Vec2> outline =
+      point > geom::kEps
+          ? std::vector<Vec2>{Vec2(tip, 0), Vec2(tip + point, -r), Vec2(out, -r), Vec2(out, r), Vec2(tip + point, r)}
+          : std::vector<Vec2>{Vec2(tip, -r), Vec2(out, -r), Vec2(out, r), Vec2(tip, r)};
+  Region &stock = latheStock(x, *workpiece, *raw.stock);
+  stock = geom::subtract(stock, Region{{geom::polygon(outline)}});
+}
 
 bool expandTurning(Expander &x, Node &ws, const Node &op, const std::string &setup) {
   const Node *feature = ir::findFeature(*x.module, ws.text("feature").value_or(""));
@@ -1157,11 +1290,9 @@ bool expandTurning(Expander &x, Node &ws, const Node &op, const std::string &set
     x.report(ws, *feature, shape.error);
     return false;
   }
-  auto [it, fresh] = x.turnedStock.try_emplace(workpiece->symbol, Region());
-  if (fresh)
-    it->second = withMirror(raw.stock->region());
   Node moves = makeMoves(ws, tool->symbol, 0, coolant(op), setup);
-  TurningStep step(x, ws, op, *feature, *tool, it->second, *raw.stock, *shape.shape, moves);
+  TurningStep step(x, ws, op, *feature, *tool, latheStock(x, *workpiece, *raw.stock), *raw.stock, *shape.shape,
+                   moves);
   if (!step.run() || !withinMachine(x, ws, *feature, moves))
     return false;
   x.attach(ws, std::move(moves));

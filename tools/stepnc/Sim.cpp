@@ -15,6 +15,7 @@
 #include "ir/motion/LatheTime.h"
 #include "ir/motion/MotionIR.h"
 #include "ir/geom/MoveWalk.h"
+#include "ir/geom/TurnedShape.h"
 #include "runtime/Machine.h"
 #include "runtime/NativeFormat.h"
 #include "runtime/Player.h"
@@ -115,9 +116,9 @@ int runLatheSim(const SimCommandOptions &opts, const runtime::Machine &machine, 
     }
   }
   for (const ir::Node *e : ir::programOrder(*module))
-    if (e->child(ir::Kind::Moves) && !ir::isTurningStep(*e)) {
-      diags.error(e->origin.loc, e->kindName() + " " + e->symbol + " mills or drills: the lathe \"" + machine.name +
-                                     "\" times turning steps only")
+    if (e->child(ir::Kind::Moves) && !ir::isTurningStep(*e) && !ir::drillsOnTurningAxis(*e)) {
+      diags.error(e->origin.loc, e->kindName() + " " + e->symbol + " mills or drills off the spindle axis: the lathe \"" +
+                                     machine.name + "\" times turning steps and holes drilled on its axis only")
           .entity(e->origin.entityId);
       printStatus("cannot simulate " + opts.input);
       return kExitDiagnostics;

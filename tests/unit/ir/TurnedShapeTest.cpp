@@ -134,14 +134,14 @@ TEST_CASE("what is not turned is said", "[turned]") {
     CHECK_FALSE(r.shape);
     CHECK(r.error.find("off the turning axis") != std::string::npos);
   }
-  SECTION("an inner groove") {
+  SECTION("a face groove (its material along the axis)") {
     auto p = parsed("    groove %g \"G\" at=(0.0000,0.0000,50.0000)mm " + kZ +
-                        " radius=16.0000mm material_side=(1.000000,0.000000,0.000000)\n"
+                        " radius=16.0000mm material_side=(0.000000,0.000000,-1.000000)\n"
                         "      square_u_profile width=4.0000mm\n",
                     "%g");
     ir::TurnedShapeResult r = ir::turnedShape(*p.feature, p.stock);
     CHECK_FALSE(r.shape);
-    CHECK(r.error.find("only outer grooves") != std::string::npos);
+    CHECK(r.error.find("grooves with their material along the axis are not turned yet") != std::string::npos);
   }
   SECTION("a taper to nothing") {
     auto p = parsed("    outer_diameter %od \"OD\" at=(0.0000,0.0000,10.0000)mm " + kZ +
@@ -181,4 +181,106 @@ TEST_CASE("a general revolved profile: steps from the free end", "[turned]") {
   REQUIRE(back.shape);
   CHECK(areaInStock(*back.shape, q.stock) == Approx(310).epsilon(1e-12));
   CHECK(back.shape->contour[1].a.x() == Approx(100));
+}
+
+TEST_CASE("a bore: an inner revolved profile", "[turned]") {
+  // 30 mm across for 20 mm from the free end, then 24 mm to 50 mm deep, a
+  // flat bottom: the removal reaches in to the axis.
+  auto p = parsed("    general_revolution %b \"B\" at=(0.0000,0.0000,0.0000)mm " + kZ +
+                      " radius=0.0000mm material_side=(1.000000,0.000000,0.000000)\n"
+                      "      general_profile closed=false\n"
+                      "        polyline\n"
+                      "          point at=(15.0000,0.0000,100.0000)mm\n"
+                      "          point at=(15.0000,0.0000,80.0000)mm\n"
+                      "          point at=(12.0000,0.0000,80.0000)mm\n"
+                      "          point at=(12.0000,0.0000,50.0000)mm\n",
+                  "%b");
+  ir::TurnedShapeResult r = ir::turnedShape(*p.feature, p.stock);
+  REQUIRE(r.shape);
+  CHECK(r.shape->inner);
+  CHECK(areaInStock(*r.shape, p.stock) == Approx(20 * 15 + 30 * 12).epsilon(1e-12));
+  // The surface from past the free end, into the bore, across its bottom to the axis.
+  REQUIRE(r.shape->contour.size() == 5);
+  CHECK(r.shape->contour.front().a.x() == Approx(110));
+  CHECK(r.shape->contour.back().b.x() == Approx(50));
+  CHECK(r.shape->contour.back().b.y() == Approx(0));
+  // The part keeps what lies outside it.
+  CHECK_FALSE(r.shape->removal.contains(geom::Vec2(90, 16)));
+  CHECK(r.shape->removal.contains(geom::Vec2(90, 14)));
+}
+
+TEST_CASE("a hole on the axis turned as an inner diameter", "[turned]") {
+  auto hole = [](const std::string &bottom) {
+    return "    round_hole %h \"H\" at=(0.0000,0.0000,100.0000)mm " + kZ +
+           " depth=30.0000mm diameter=20.0000mm " + bottom + "\n";
+  };
+  SECTION("flat") {
+    auto p = parsed(hole("bottom=flat"), "%h");
+    ir::TurnedShapeResult r = ir::turnedShape(*p.feature, p.stock);
+    REQUIRE(r.shape);
+    CHECK(r.shape->inner);
+    CHECK(areaInStock(*r.shape, p.stock) == Approx(30 * 10).epsilon(1e-12));
+  }
+  SECTION("through: on past the chuck side") {
+    auto p = parsed(hole("bottom=through"), "%h");
+    ir::TurnedShapeResult r = ir::turnedShape(*p.feature, p.stock);
+    REQUIRE(r.shape);
+    CHECK(areaInStock(*r.shape, p.stock) == Approx(100 * 10).epsilon(1e-12));
+  }
+  SECTION("conical: the point at its depth") {
+    // A 90 degree point: a cone 10 mm long ending at z 70.
+    auto p = parsed(hole("bottom=conical tip_angle=90.0000deg"), "%h");
+    ir::TurnedShapeResult r = ir::turnedShape(*p.feature, p.stock);
+    REQUIRE(r.shape);
+    CHECK(areaInStock(*r.shape, p.stock) == Approx(20 * 10 + 10 * 10 / 2.0).epsilon(1e-12));
+  }
+  SECTION("a tapered hole to its final diameter") {
+    auto p = parsed(hole("bottom=flat final_diameter=16.0000mm"), "%h");
+    ir::TurnedShapeResult r = ir::turnedShape(*p.feature, p.stock);
+    REQUIRE(r.shape);
+    CHECK(areaInStock(*r.shape, p.stock) == Approx(30 * (10 + 8) / 2.0).epsilon(1e-12));
+  }
+  SECTION("a spherical bottom is said") {
+    auto p = parsed(hole("bottom=spherical"), "%h");
+    ir::TurnedShapeResult r = ir::turnedShape(*p.feature, p.stock);
+    CHECK_FALSE(r.shape);
+    CHECK(r.error.find("spherical bottom is not turned yet") != std::string::npos);
+  }
+}
+
+TEST_CASE("an inner groove: open towards the axis", "[turned]") {
+  // Its floor 16 mm from the axis, 4 mm wide, a 0.5 mm round at the chuck
+  // side: the removal from the axis out to the floor.
+  auto p = parsed("    groove %g \"G\" at=(0.0000,0.0000,50.0000)mm " + kZ +
+                      " radius=16.0000mm material_side=(1.000000,0.000000,0.000000)\n"
+                      "      square_u_profile width=4.0000mm first_radius=0.5000mm\n",
+                  "%g");
+  ir::TurnedShapeResult r = ir::turnedShape(*p.feature, p.stock);
+  REQUIRE(r.shape);
+  CHECK(r.shape->inner);
+  CHECK(areaInStock(*r.shape, p.stock) == Approx(4 * 16 - (0.25 - kPi * 0.25 / 4)).epsilon(1e-12));
+  CHECK(r.shape->grooveFloor == 16);
+  CHECK_FALSE(r.shape->removal.contains(geom::Vec2(48.1, 15.9)));  // the round's corner stays
+  CHECK(r.shape->removal.contains(geom::Vec2(51, 15.9)));
+}
+
+TEST_CASE("an inner thread: from its minor diameter out to its major", "[turned]") {
+  // M20x1.5 inside, 20 mm from the end: ISO 965-1's D1 = 20 - 1.082532 x 1.5.
+  auto p = parsed("    thread %t \"T\" at=(0.0000,0.0000,100.0000)mm axis=(0.000000,0.000000,-1.000000) "
+                  "ref=(1.000000,0.000000,0.000000) major_diameter=20.0000mm pitch_diameter=19.0260mm "
+                  "length=20.0000mm starts=2 hand=left inner=true\n",
+                  "%t");
+  ir::TurnedShapeResult r = ir::turnedShape(*p.feature, p.stock);
+  REQUIRE(r.shape);
+  REQUIRE(r.shape->thread);
+  CHECK(r.shape->inner);
+  const ir::TurnedShape::ThreadSpan &t = *r.shape->thread;
+  CHECK(t.pitch == Approx(1.5).epsilon(1e-3));  // as exact as the pitch diameter's decimals
+  CHECK(t.rootRadius == 10);
+  CHECK(t.crestRadius == Approx((20 - 1.082532 * t.pitch) / 2).epsilon(1e-12));
+  CHECK(t.lo == 80);
+  CHECK(t.hi == 100);
+  CHECK(t.starts == 2);
+  CHECK(t.leftHand);
+  CHECK(areaInStock(*r.shape, p.stock) == Approx(20 * 10).epsilon(1e-12));
 }
