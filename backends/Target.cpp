@@ -26,7 +26,8 @@ const char *cycleKindName(CycleKind kind) {
 
 std::string overrideHelp() {
   return "decimals=N (coordinates, 0..6), line-numbers=none|every, number-step=N, "
-         "max-line-length=N (0: none), arcs=ijk|radius, cycles=on|off, splines=on|off";
+         "max-line-length=N (0: none), arcs=ijk|radius, cycles=on|off, splines=on|off, "
+         "nose-compensation=path|controller";
 }
 
 std::string applyOverrides(TargetDescriptor &d, const std::vector<std::string> &overrides) {
@@ -58,6 +59,12 @@ std::string applyOverrides(TargetDescriptor &d, const std::vector<std::string> &
         return "--target-opt splines: " + d.name + " has no spline blocks stepnc writes; smooth runs stay lines";
       if (value == "off")
         d.splines = SplineForm::None;
+    } else if (key == "nose-compensation" && (value == "path" || value == "controller")) {
+      if (value == "controller" && !d.latheCompensation)
+        return "--target-opt nose-compensation: " + d.name +
+               " does not write the controller's nose radius compensation (G41/G42) in lathe programs yet (rs274 "
+               "does)";
+      d.controllerNoseCompensation = value == "controller";
     } else {
       return "--target-opt '" + o + "' is not understood (" + overrideHelp() + ")";
     }

@@ -67,11 +67,18 @@ struct TargetDescriptor {
   int feedDecimals = 0;      ///< mm/min
   int speedDecimals = 0;     ///< rev/min
   double tolerance = 0.01;   ///< contour tolerance for the path mode (mm), --tolerance overrides
+  /// Lathe programs: the target can write a finishing pass as the surface
+  /// with the controller's nose radius compensation (G41/G42) ...
+  bool latheCompensation = false;
+  /// ... and is asked to (--target-opt nose-compensation=controller);
+  /// otherwise the moves carry the nose radius and the program stays G40.
+  bool controllerNoseCompensation = false;
 };
 
 /// Applies `key=value` overrides (--target-opt) to a descriptor: decimals,
 /// line-numbers (none|every), number-step, max-line-length, arcs
-/// (ijk|radius), cycles (on|off), splines (on|off). Returns an error
+/// (ijk|radius), cycles (on|off), splines (on|off), nose-compensation
+/// (path|controller). Returns an error
 /// message, or "" when all applied.
 std::string applyOverrides(TargetDescriptor &d, const std::vector<std::string> &overrides);
 

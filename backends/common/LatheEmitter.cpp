@@ -25,6 +25,14 @@ double LatheEmitter::readX(double radius) const {
 
 std::string LatheEmitter::xWord(double radius) const { return word("X", num(diameterMode() ? 2 * radius : radius)); }
 
+std::string LatheEmitter::orientationNote(const ir::Node &tool, bool inside, bool axial) const {
+  const std::string type = tool.text("type").value_or("");
+  if (axial || (type != "turning_tool" && type != "grooving_tool"))
+    return "";
+  const std::string o = toolOrientation(inside);
+  return o.empty() ? "" : ", " + o;
+}
+
 int LatheEmitter::toolNumber(const ir::Node &tool) {
   if (auto it = numbers_.find(tool.symbol); it != numbers_.end())
     return it->second;
@@ -63,6 +71,9 @@ std::optional<std::string> LatheEmitter::run(const ir::Module &module) {
                      "corner), a threading insert's point, touched off on X and Z, with the nose radius in the path "
                      "(G40); toolpaths the file gives are written as given"));
   out_.block(comment("the imaginary tip is on the axis' side of the corner, away from it for a tool marked inside"));
+  if (d_.controllerNoseCompensation)
+    out_.block(comment("finishing passes are the surface under the controller's nose radius compensation: the tool "
+                       "table holds each insert's radius and orientation as listed"));
   out_.block(comment(o_.toolTable ? "tool numbers from the tool table" : "no tool table: tools numbered in order "
                                                                          "of first use"));
   // The tools, numbered in order of first use (or by the table).
@@ -85,7 +96,8 @@ std::optional<std::string> LatheEmitter::run(const ir::Module &module) {
                                   ? ", pitch " + formatFixed(*tool->number("thread_pitch"), 3) + " mm"
                                   : std::string()) +
                              (moves->text("tip") == "inside" ? ", inside: its tip on the side away from the axis"
-                                                             : std::string())));
+                                                             : std::string()) +
+                             orientationNote(*tool, moves->text("tip") == "inside", axial)));
         }
   if (!ok_)
     return std::nullopt;
@@ -160,6 +172,13 @@ void LatheEmitter::step(const ir::Module &module, const ir::Node &ws, const ir::
   if (cool != coolant_) {
     out_.block(coolant(cool));
     coolant_ = cool;
+  }
+  if (d_.controllerNoseCompensation && moves.has("nose_side") && tool->text("type") == "turning_tool") {
+    std::vector<ir::Move> all;
+    for (const ir::Move &m : ir::walkMoves(moves, std::nullopt, ir::PathKind::Programmed, ir::OutOfPlaneArcs::Exact))
+      all.push_back(m);
+    if (compensated(moves, all, *tool))
+      return;
   }
   bool first = true;
   for (const ir::Move &m : ir::walkMoves(moves, std::nullopt, ir::PathKind::Programmed, ir::OutOfPlaneArcs::Exact)) {
@@ -262,8 +281,161 @@ void LatheEmitter::move(const ir::Move &m) {
       text += ' ';
     text += word("F", fw);
   }
+  if (!prefix_.empty()) {
+    text = prefix_ + (text.empty() ? "" : " " + text);
+    prefix_.clear();
+  }
   if (!text.empty() && text != "G1")
     out_.block(text);
+}
+
+namespace {
+
+/// A piece of a surface in (z, r): a line from a to b, or an arc about o of radius r.
+struct Piece {
+  bool arc = false;
+  geom::Vec2 a, b, o;
+  double r = 0;
+};
+
+/// Where two pieces, the lines extended and the arcs as whole circles, meet
+/// nearest `near`; nullopt when they do not.
+std::optional<geom::Vec2> meetNearest(const Piece &p, const Piece &q, const geom::Vec2 &near) {
+  std::vector<geom::Vec2> pts;
+  auto lineCircle = [&](const Piece &l, const Piece &c) {
+    const geom::Vec2 d = (l.b - l.a).normalized();
+    const geom::Vec2 foot = l.a + d * (c.o - l.a).dot(d);
+    const double h2 = c.r * c.r - (foot - c.o).squaredNorm();
+    if (h2 < 0)
+      return;
+    const double h = std::sqrt(h2);
+    pts.push_back(foot + d * h);
+    pts.push_back(foot - d * h);
+  };
+  if (!p.arc && !q.arc) {
+    const geom::Vec2 d1 = p.b - p.a, d2 = q.b - q.a;
+    const double den = geom::cross(d1, d2);
+    if (std::abs(den) > 1e-12)
+      pts.push_back(p.a + d1 * (geom::cross(q.a - p.a, d2) / den));
+  } else if (!p.arc) {
+    lineCircle(p, q);
+  } else if (!q.arc) {
+    lineCircle(q, p);
+  } else {
+    const geom::Vec2 d = q.o - p.o;
+    const double l = d.norm();
+    if (l > 1e-12 && l <= p.r + q.r && l >= std::abs(p.r - q.r)) {
+      const double x = (l * l + p.r * p.r - q.r * q.r) / (2 * l), h = std::sqrt(std::max(0.0, p.r * p.r - x * x));
+      const geom::Vec2 u = d / l, mid = p.o + u * x, across(-u.y(), u.x());
+      pts.push_back(mid + across * h);
+      pts.push_back(mid - across * h);
+    }
+  }
+  std::optional<geom::Vec2> best;
+  for (const geom::Vec2 &x : pts)
+    if (!best || (x - near).norm() < (*best - near).norm())
+      best = x;
+  return best;
+}
+
+} // namespace
+
+bool LatheEmitter::compensated(const ir::Node &moves, const std::vector<ir::Move> &all, const ir::Node &tool) {
+  // The pass: a line onto the surface (approach), the cuts along it, a line
+  // off it (retract), each at feed.
+  size_t first = all.size(), last = all.size();
+  for (size_t i = 0; i + 1 < all.size(); ++i)
+    if (all[i].kind == ir::MoveKind::Linear && all[i].role == "approach" && all[i + 1].isFeed() &&
+        all[i + 1].role == "cut") {
+      first = i;
+      break;
+    }
+  for (size_t i = first + 1; i < all.size(); ++i)
+    if (all[i].role != "cut") {
+      last = i;
+      break;
+    }
+  if (first >= all.size() || last >= all.size() || all[last].kind != ir::MoveKind::Linear ||
+      all[last].role != "retract")
+    return false;
+  const double rc = tool.number("corner_radius").value_or(0);
+  const bool left = moves.text("nose_side") == "left";
+  const bool inside = moves.text("tip") == "inside";
+  // The nose's centre from the programmed point (docs/turning.md), in (z, r).
+  const geom::Vec2 tipToCentre(rc, inside ? -rc : rc);
+  auto centre = [&](const ir::Vec3 &p) -> geom::Vec2 { return geom::Vec2(p.z(), p.x()) + tipToCentre; };
+  auto space = [](const geom::Vec2 &p) { return ir::Vec3(p.y(), 0, p.x()); };
+  // The surface under each cut: lines moved back by the radius across
+  // their direction, arcs about the same centre a radius farther or
+  // nearer; an arc of the nose's radius about a corner is the corner.
+  std::vector<ir::Move> surface;
+  std::optional<geom::Vec2> at;  // where the surface so far ends
+  std::optional<std::pair<Piece, bool>> previous;  // the last piece, and whether the surface ends with it
+  const double s = left ? 1 : -1;
+  for (size_t i = first + 1; i < last; ++i) {
+    const ir::Move &m = all[i];
+    const geom::Vec2 a = centre(*m.from), b = centre(m.to);
+    geom::Vec2 sa, sb;
+    ir::Move out = m;
+    if (m.kind == ir::MoveKind::Linear) {
+      const geom::Vec2 d = (b - a).normalized(), leftOf(-d.y(), d.x());
+      sa = a - s * rc * leftOf;
+      sb = b - s * rc * leftOf;
+    } else {
+      const geom::Vec2 o = centre(m.center);
+      const double r = (a - o).norm();
+      // The centre is on the arc's left when it turns counter-clockwise.
+      const double rs = (m.ccw == left) ? r + rc : r - rc;
+      if (rs < 1e-6) {
+        if (at && (*at - o).norm() > 1e-6)
+          return false;
+        at = o;
+        if (previous)
+          previous->second = false;
+        continue;
+      }
+      sa = o + (a - o) * (rs / r);
+      sb = o + (b - o) * (rs / r);
+      out.center = space(o);
+    }
+    const Piece here{m.kind == ir::MoveKind::Arc, sa, sb, m.kind == ir::MoveKind::Arc ? centre(m.center) : sa,
+                     m.kind == ir::MoveKind::Arc ? (sa - centre(m.center)).norm() : 0};
+    if (at && (*at - sa).norm() > 1e-6) {
+      // A corner the nose cannot fill (the pass's offsets meet there): the
+      // surface's corner is where the two pieces, extended, meet nearest it.
+      if (!previous || !previous->second)
+        return false;
+      const std::optional<geom::Vec2> corner = meetNearest(previous->first, here, a);
+      if (!corner)
+        return false;
+      surface.back().to = space(*corner);
+      sa = *corner;
+    }
+    out.from = space(sa);
+    out.to = space(sb);
+    surface.push_back(out);
+    at = sb;
+    previous = {here, true};
+  }
+  if (surface.empty())
+    return false;
+  for (size_t i = 0; i < first; ++i)
+    move(all[i]);
+  // Onto the surface's start with the compensation on; along it; off it
+  // with the compensation off, to the programmed point.
+  ir::Move onto = all[first];
+  onto.to = *surface.front().from;
+  modal_.forget("G");
+  prefix_ = compensation(left);
+  move(onto);
+  for (const ir::Move &m : surface)
+    move(m);
+  modal_.forget("G");
+  prefix_ = compensationOff();
+  move(all[last]);
+  for (size_t i = last + 1; i < all.size(); ++i)
+    move(all[i]);
+  return true;
 }
 
 } // namespace stepnc::backends

@@ -3,7 +3,10 @@
 // feeds per revolution, constant surface speed with its spindle limit. A
 // dialect fills in its words through the hooks; what to do was decided by
 // the passes (the moves are the insert's programmed point, nose radius
-// compensated: the program stays G40).
+// compensated: the program stays G40). With nose-compensation=controller a
+// finishing step's pass along the surface is written as the surface itself
+// under the controller's compensation (G41/G42), the same path for a tool
+// whose table radius is the insert's.
 #pragma once
 
 #include "backends/Backend.h"
@@ -14,6 +17,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace stepnc::backends {
 
@@ -56,6 +60,13 @@ protected:
   virtual std::string coolant(const std::string &mode) const;
   virtual void message(const std::string &text) = 0;
   virtual std::string stop(bool optional) const { return optional ? "M1" : "M0"; }
+  /// How the controller's tool table says where a turning or grooving
+  /// insert's imaginary tip is ("" when the dialect does not say).
+  virtual std::string toolOrientation(bool /*inside*/) const { return ""; }
+  /// The words that turn the controller's nose radius compensation on, the
+  /// tool left of the path (else right), and off.
+  virtual std::string compensation(bool /*left*/) const { return ""; }
+  virtual std::string compensationOff() const { return "G40"; }
 
   /// X as written: the diameter (twice the radius) or the radius.
   virtual bool diameterMode() const { return true; }
@@ -71,10 +82,16 @@ private:
   /// `onAxis`: a drill on the spindle axis (ir::drillsOnTurningAxis).
   void step(const ir::Module &module, const ir::Node &ws, const ir::Node &moves, bool onAxis = false);
   void move(const ir::Move &m);
+  /// The moves of a finishing step with its pass along the surface written
+  /// as the surface under the controller's compensation; false (nothing
+  /// written) when the pass is not an offset of a surface by the nose.
+  bool compensated(const ir::Node &moves, const std::vector<ir::Move> &all, const ir::Node &tool);
   /// A coordinate as the controller reads it back (X halved in diameter mode).
   double readX(double radius) const;
   std::string xWord(double radius) const;
   int toolNumber(const ir::Node &tool);
+  /// ", " and the tool table's orientation of a turning or grooving insert, or "".
+  std::string orientationNote(const ir::Node &tool, bool inside, bool axial) const;
 
   ModalState modal_;
   std::map<std::string, int> numbers_;
@@ -85,6 +102,7 @@ private:
   std::optional<bool> perRev_;
   double feed_ = -1;
   bool ok_ = true;
+  std::string prefix_;  ///< words the next move's block starts with (G41/G42, G40)
 };
 
 } // namespace stepnc::backends

@@ -34,6 +34,7 @@ TargetDescriptor rs274Descriptor() {
   d.feedDecimals = 1;
   d.speedDecimals = 0;
   d.tolerance = 0.01;
+  d.latheCompensation = true;  // G41/G42 with the tool table's radius and orientation
   return d;
 }
 
@@ -193,6 +194,13 @@ private:
   std::string feedMode(bool perRevolution) const override { return perRevolution ? "G95" : "G94"; }
   std::string dwell(double seconds) const override { return "G4 " + word("P", formatNumber(seconds, {3, false, true})); }
   void message(const std::string &text) override { out_.block(comment("MSG," + text)); }
+  // LinuxCNC's tool table orientations (Q): the imaginary tip towards -X
+  // and -Z of the nose's centre is 2, towards +X and -Z is 3 (read back
+  // from its interpreter with G42 on a shoulder).
+  std::string toolOrientation(bool inside) const override {
+    return inside ? "tool table orientation Q3" : "tool table orientation Q2";
+  }
+  std::string compensation(bool left) const override { return left ? "G41" : "G42"; }
 };
 
 std::optional<std::string> Rs274Emitter::lathe(const ir::Module &module, const TargetDescriptor &d,

@@ -744,7 +744,9 @@ private:
   }
 
   /// One pass along the surface `a` off it, entered and left along its ends' tangents.
-  bool contourPass(double a, const char *role) {
+  /// `onSurface`: a finishing pass, entered so that a controller's
+  /// compensation can make it from the surface (below).
+  bool contourPass(double a, const char *role, bool onSurface = false) {
     const std::optional<std::vector<Seg>> path = contourPath(a);
     if (!x_.result.ok)
       return false;
@@ -766,7 +768,27 @@ private:
       }
     }
     const Vec2 t0 = path->front().tangent(0), t1 = path->back().tangent(1);
-    const Vec2 entry = path->front().a - t0 * kLatheClearance;
+    // Which side of the pass the nose's centre is on, seen along it from
+    // the surface: the side a controller's compensation would put it.
+    {
+      const Seg &first = path->front();
+      const Vec2 mid = first.at(0.5);
+      Vec2 onContour = shape_.contour.front().a;
+      for (const Seg &sg : shape_.contour)
+        if (const Vec2 q = geom::closestPoint(sg, mid); (q - mid).norm() < (onContour - mid).norm())
+          onContour = q;
+      noseLeft_ = geom::cross(first.tangent(0.5), mid - onContour) > 0;
+    }
+    Vec2 entry = path->front().a - t0 * kLatheClearance;
+    if (onSurface) {
+      // The programmed point starts on the tangent of the surface (the
+      // allowance's) before the pass, a lead longer than the nose's radius
+      // off it: the line a controller compensates on entry (G41/G42) ends
+      // with the nose where the pass starts, as without it.
+      const Vec2 toNose = Vec2(-t0.y(), t0.x()) * (*noseLeft_ ? tool_.rc : -tool_.rc);
+      const Vec2 onPart = path->front().a - toNose;
+      entry = onPart - t0 * std::max(kLatheClearance, 2 * tool_.rc) - tool_.tip;
+    }
     if (!clearOfMaterial(entry)) {
       x_.report(ws_, "the pass along " + shape_.symbol + " starts inside the stock: no way in along its tangent");
       return false;
@@ -807,7 +829,13 @@ private:
       x_.report(ws_, toolNode_, "finishing a contour with the grooving tool " + toolNode_.symbol + " is not supported");
       return false;
     }
-    return contourPass(a, "cut");
+    if (!contourPass(a, "cut", true))
+      return false;
+    // One pass along the surface: a target may write it as the surface
+    // itself with the controller's nose radius compensation on this side.
+    if (noseLeft_)
+      moves_.set("nose_side", Value::word(*noseLeft_ ? "left" : "right"));
+    return true;
   }
 
   // --- grooves and cutting in ------------------------------------------------------
@@ -1137,6 +1165,8 @@ private:
   double perRev_ = 0;
   bool saidShortDwell_ = false;
   Vec2 home_ = Vec2::Zero();
+  /// The side of the last pass along the surface the nose's centre is on.
+  std::optional<bool> noseLeft_;
 };
 
 /// A lathe step's explicit toolpaths (AP238 files from CAM systems), in

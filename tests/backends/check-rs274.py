@@ -237,15 +237,22 @@ def run(cmd, **kw):
 def run_rs274(ngc_path, workdir):
     """Runs LinuxCNC's rs274 on a program: (the canonical moves file, None),
     or (None, why) when rs274 rejects it. The tool table has every T number
-    the program calls, length 0, with the diameter its header gives (0.25 in
-    otherwise), in inches; arcs are checked to 0.001 mm."""
+    the program calls, length 0, with the diameter its header gives (a lathe
+    insert's: twice its corner radius; 0.25 in otherwise), in inches, and the
+    orientation (Q) it gives; arcs are checked to 0.001 mm."""
     canon_path = os.path.join(workdir, "prog.canon")
-    tools, diameters = {}, {}
+    tools, diameters, orientations = {}, {}, {}
     with open(ngc_path) as f:
         for line in f:
             m = re.match(r"\(T(\d+) .*diameter ([0-9.]+) mm", line)
             if m:
                 diameters[int(m.group(1))] = float(m.group(2)) / 25.4
+            m = re.match(r"\(T(\d+) .*corner radius ([0-9.]+) mm", line)
+            if m:
+                diameters[int(m.group(1))] = 2 * float(m.group(2)) / 25.4
+            m = re.match(r"\(T(\d+) .*orientation Q(\d)", line)
+            if m:
+                orientations[int(m.group(1))] = int(m.group(2))
             for t in re.findall(r"\bT(\d+)\b", line.split("(")[0]):
                 tools[int(t)] = None
     for t in tools:
@@ -253,7 +260,8 @@ def run_rs274(ngc_path, workdir):
     table = os.path.join(workdir, "tools.tbl")
     with open(table, "w") as f:
         for t, d in sorted(tools.items()):
-            f.write("T%d P%d Z0 D%.6f ;\n" % (t, t, d))
+            q = " Q%d" % orientations[t] if t in orientations else ""
+            f.write("T%d P%d Z0 D%.6f%s ;\n" % (t, t, d, q))
     ini = os.path.join(workdir, "strict.ini")
     with open(ini, "w") as f:
         f.write("[RS274NGC]\nCENTER_ARC_RADIUS_TOLERANCE_MM = 0.001\n")
@@ -268,7 +276,7 @@ def run_rs274(ngc_path, workdir):
     return canon_path, None
 
 
-def check(stepnc, path, cycles, extra, workdir, program=None):
+def check(stepnc, path, cycles, extra, workdir, program=None, target_opts=()):
     base = os.path.join(workdir, "prog")
     ir_path, ngc_path = base + ".ir", base + ".ngc"
     r = run([stepnc, "compile", path, "--emit=toolpath-ir", "-o", ir_path] + extra)
@@ -277,7 +285,7 @@ def check(stepnc, path, cycles, extra, workdir, program=None):
     if program:
         ngc_path = program
     else:
-        opts = ([] if cycles else ["--no-cycles"]) + extra
+        opts = ([] if cycles else ["--no-cycles"]) + extra + ["--target-opt=" + o for o in target_opts]
         r = run([stepnc, "compile", path, "--target=rs274", "-o", ngc_path] + opts)
         if r.returncode != 0:
             return ["stepnc could not write the rs274 program:\n" + r.stderr]
@@ -301,12 +309,14 @@ def main():
     ap.add_argument("--no-cycles", action="store_true", help="compile with --no-cycles and compare every move")
     ap.add_argument("--program", help="check this program against the (single) input's IR instead of "
                     "compiling one (to show that the check can fail)")
+    ap.add_argument("--target-opt", action="append", default=[], help="a target option for the program only "
+                    "(the IR is the same): nose-compensation=controller")
     ap.add_argument("inputs", nargs="+")
     args, extra = ap.parse_known_args()
     failed = False
     for path in args.inputs:
         with tempfile.TemporaryDirectory() as work:
-            problems = check(args.stepnc, path, not args.no_cycles, extra, work, args.program)
+            problems = check(args.stepnc, path, not args.no_cycles, extra, work, args.program, args.target_opt)
         for p in problems:
             print("FAIL: %s: %s" % (path, p))
         failed = failed or bool(problems)
