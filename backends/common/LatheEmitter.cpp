@@ -177,7 +177,7 @@ void LatheEmitter::step(const ir::Module &module, const ir::Node &ws, const ir::
     std::vector<ir::Move> all;
     for (const ir::Move &m : ir::walkMoves(moves, std::nullopt, ir::PathKind::Programmed, ir::OutOfPlaneArcs::Exact))
       all.push_back(m);
-    if (compensated(moves, all, *tool))
+    if (compensated(ws, moves, all, *tool))
       return;
   }
   bool first = true;
@@ -340,7 +340,8 @@ std::optional<geom::Vec2> meetNearest(const Piece &p, const Piece &q, const geom
 
 } // namespace
 
-bool LatheEmitter::compensated(const ir::Node &moves, const std::vector<ir::Move> &all, const ir::Node &tool) {
+bool LatheEmitter::compensated(const ir::Node &ws, const ir::Node &moves, const std::vector<ir::Move> &all,
+                               const ir::Node &tool) {
   // The pass: a line onto the surface (approach), the cuts along it, a line
   // off it (retract), each at feed.
   size_t first = all.size(), last = all.size();
@@ -419,6 +420,29 @@ bool LatheEmitter::compensated(const ir::Node &moves, const std::vector<ir::Move
   }
   if (surface.empty())
     return false;
+  // A controller enters along the line onto the surface, the nose square to
+  // it at its end: only a line along the surface's first tangent puts the
+  // nose where the pass starts.
+  {
+    const geom::Vec2 from(all[first].from->z(), all[first].from->x());
+    const geom::Vec2 onto(surface.front().from->z(), surface.front().from->x());
+    const ir::Move &m = surface.front();
+    geom::Vec2 t;
+    if (m.kind == ir::MoveKind::Linear) {
+      t = geom::Vec2(m.to.z(), m.to.x()) - onto;
+    } else {
+      const geom::Vec2 radial = onto - geom::Vec2(m.center.z(), m.center.x());
+      t = m.ccw ? geom::Vec2(-radial.y(), radial.x()) : geom::Vec2(radial.y(), -radial.x());
+    }
+    const geom::Vec2 in = onto - from;
+    if (in.norm() <= rc || std::abs(geom::cross(in.normalized(), t.normalized())) > 1e-6 || in.dot(t) <= 0) {
+      diags_.warning(ws.origin.loc, "workingstep " + ws.symbol +
+                                        ": its finishing pass is not entered along the surface: written with the "
+                                        "nose radius in the path (G40), not under the controller's compensation")
+          .entity(ws.origin.entityId);
+      return false;
+    }
+  }
   for (size_t i = 0; i < first; ++i)
     move(all[i]);
   // Onto the surface's start with the compensation on; along it; off it

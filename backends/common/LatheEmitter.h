@@ -85,7 +85,7 @@ private:
   /// The moves of a finishing step with its pass along the surface written
   /// as the surface under the controller's compensation; false (nothing
   /// written) when the pass is not an offset of a surface by the nose.
-  bool compensated(const ir::Node &moves, const std::vector<ir::Move> &all, const ir::Node &tool);
+  bool compensated(const ir::Node &ws, const ir::Node &moves, const std::vector<ir::Move> &all, const ir::Node &tool);
   /// A coordinate as the controller reads it back (X halved in diameter mode).
   double readX(double radius) const;
   std::string xWord(double radius) const;

@@ -108,6 +108,7 @@ public:
     case Kind::Thread: return thread(*p) ? ok() : fail();
     case Kind::GeneralRevolution: return generalRevolution() ? ok() : fail();
     case Kind::RoundHole: return roundHole(*p) ? ok() : fail();
+    case Kind::RevolvedRound: return revolvedRound(*p) ? ok() : fail();
     default:
       error_ = named(f_) + " has no turned shape in stepnc yet (docs/turning.md lists the features turned)";
       return fail();
@@ -441,6 +442,59 @@ private:
     for (auto it = l.segs.rbegin(); it != l.segs.rend(); ++it)
       ccw.segs.push_back(it->reversed());
     s_.removal = Region{{ccw}};
+    return true;
+  }
+
+  /// A round on the part's outer edge: the corner at the placement, `radius`
+  /// from the axis, between the face there (the part behind it, towards the
+  /// chuck) and the diameter (the part inside it, its material side towards
+  /// the axis), rounded by its partial circular profile's radius over a
+  /// quarter turn. Everything outside the round, out to the reach, is the
+  /// round's to remove, as an outer diameter's is (the steps before took
+  /// what belongs to the face and the diameter).
+  bool revolvedRound(const Placed &p) {
+    const double corner = f_.number("radius").value_or(0);
+    const std::optional<bool> inner = innerSide("rounds");
+    if (!inner)
+      return false;
+    if (*inner) {
+      error_ = named(f_) + ": its material lies away from the axis: inner rounds are not turned yet";
+      return false;
+    }
+    const Node *prof = f_.child(Kind::PartialCircularProfile);
+    const double r = prof ? prof->number("radius").value_or(0) : 0;
+    const double sweep = prof ? prof->number("sweep_angle").value_or(90) : 90;
+    if (!prof || r <= 0 || corner <= r) {
+      error_ = named(f_) + " needs a partial circular profile with a radius below its own radius " +
+               formatFixed(corner, 4) + " mm (the edge it rounds)";
+      return false;
+    }
+    if (std::abs(sweep - 90) > 1e-9) {
+      error_ = named(f_) + ": a round over " + formatTrimmed(sweep, 4) +
+               " deg is not turned yet (rounds of a square edge, 90 deg)";
+      return false;
+    }
+    if (p.sign < 0) {
+      error_ = named(f_) + " has its axis towards the chuck: a round on an edge looking towards the chuck is not "
+                           "turned (no tool reaches it from the free end)";
+      return false;
+    }
+    // From the face (the free end's side) round the arc onto the diameter.
+    const double z0 = p.at.x();
+    const Vec2 onFace(z0, corner - r), onDiameter(z0 - r, corner), c(z0 - r, corner - r);
+    Loop l;
+    l.segs = {Seg::arc(onDiameter, onFace, c, false), Seg::line(onFace, Vec2(reachZ_, corner - r)),
+              Seg::line(Vec2(reachZ_, corner - r), Vec2(reachZ_, reachR_)),
+              Seg::line(Vec2(reachZ_, reachR_), Vec2(z0 - r, reachR_)), Seg::line(Vec2(z0 - r, reachR_), onDiameter)};
+    if (l.area() <= 0) {
+      error_ = named(f_) + ": its round bounds no material";
+      return false;
+    }
+    s_.removal = Region{{l}};
+    // The surface: up the face onto the round, round it, on along the
+    // diameter (a radius of each, tangent to the round).
+    s_.contour = {Seg::line(Vec2(z0, corner - 2 * r), onFace), Seg::arc(onFace, onDiameter, c, true),
+                  Seg::line(onDiameter, Vec2(z0 - 2 * r, corner))};
     return true;
   }
 

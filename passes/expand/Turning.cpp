@@ -789,9 +789,16 @@ private:
       const Vec2 onPart = path->front().a - toNose;
       entry = onPart - t0 * std::max(kLatheClearance, 2 * tool_.rc) - tool_.tip;
     }
-    if (!clearOfMaterial(entry)) {
-      x_.report(ws_, "the pass along " + shape_.symbol + " starts inside the stock: no way in along its tangent");
-      return false;
+    if (!clearOfMaterial(entry) || !spares(entry, path->front().a)) {
+      // Where the surface's tangent runs into the part (a round starting at
+      // a face), the nose comes in square to the pass from the tool's side.
+      const Vec2 square = path->front().a + Vec2(-t0.y(), t0.x()) * (*noseLeft_ ? 1.0 : -1.0) * kLatheClearance;
+      if (!clearOfMaterial(square) || !spares(square, path->front().a)) {
+        x_.report(ws_, "the pass along " + shape_.symbol +
+                           " starts inside the stock: no way in along its tangent nor square to it");
+        return false;
+      }
+      entry = square;
     }
     if (!cut(entry, *path, role))
       return false;

@@ -284,3 +284,27 @@ TEST_CASE("an inner thread: from its minor diameter out to its major", "[turned]
   CHECK(t.leftHand);
   CHECK(areaInStock(*r.shape, p.stock) == Approx(20 * 10).epsilon(1e-12));
 }
+
+TEST_CASE("a revolved round: the corner outside a quarter circle", "[turned]") {
+  // The bar's edge at the free end (z 100, r 20) rounded by 2 mm: the corner
+  // material outside the round, 4 - pi, within the bar.
+  auto p = parsed("    revolved_round %r \"R\" at=(0.0000,0.0000,100.0000)mm " + kZ +
+                      " radius=20.0000mm\n"
+                      "      partial_circular_profile radius=2.0000mm sweep_angle=90.0000deg\n",
+                  "%r");
+  ir::TurnedShapeResult r = ir::turnedShape(*p.feature, p.stock);
+  REQUIRE(r.shape);
+  CHECK(areaInStock(*r.shape, p.stock) == Approx(4 - kPi).epsilon(1e-9));
+  REQUIRE(r.shape->contour.size() == 3);
+  CHECK(r.shape->contour[1].isArc());
+  CHECK_FALSE(r.shape->removal.contains(geom::Vec2(99, 19)));  // inside the round: the part
+  CHECK(r.shape->removal.contains(geom::Vec2(99.9, 19.9)));    // the corner
+  // A round over other than a quarter turn is said.
+  auto q = parsed("    revolved_round %r \"R\" at=(0.0000,0.0000,100.0000)mm " + kZ +
+                      " radius=20.0000mm\n"
+                      "      partial_circular_profile radius=2.0000mm sweep_angle=60.0000deg\n",
+                  "%r");
+  ir::TurnedShapeResult bad = ir::turnedShape(*q.feature, q.stock);
+  CHECK_FALSE(bad.shape);
+  CHECK(bad.error.find("a round over 60 deg is not turned yet") != std::string::npos);
+}
