@@ -39,6 +39,8 @@ constexpr double kLatheClearance = 1.0;
 constexpr double kDefaultLatheDepth = 2.0;
 /// Lift off the surface after a roughing pass when the file gives none (mm).
 constexpr double kDefaultLift = 0.5;
+/// How far a pecking plunge backs off when its strategy gives no retract distance (mm).
+constexpr double kDefaultPeckRetract = 0.5;
 /// Roughing passes shorter than this (mm) are left to the contour pass after them.
 constexpr double kMinRoughPass = 0.1;
 
@@ -908,8 +910,28 @@ private:
     const double topR = topOver(zEdge);
     const double top = (out > 0 ? std::max(topR, bottom) : std::min(topR, bottom)) + out * (tool_.rc + kLatheClearance);
     const Vec2 entry(zc, top), end(zc, bottom + out * tool_.rc);
-    if (!cut(entry, {Seg::line(entry, end)}, role))
+    // Pecking: the strategy's travel_distance at a time into the material,
+    // back its retract_distance at rapid to break the chip, in again at feed.
+    const Node *st = strategy();
+    const double peck = st ? st->number("travel_distance").value_or(0) : 0;
+    const double back = st ? st->number("retract_distance").value_or(kDefaultPeckRetract) : kDefaultPeckRetract;
+    const double firstCut = topR + out * tool_.rc;  // the centre where the insert meets the stock
+    if (peck > 0 && back > 0 && std::abs(end.y() - firstCut) > peck + 1e-9 &&
+        std::abs(end.y() - firstCut) / peck <= kMaxLevels) {
+      if (!cut(entry, {Seg::line(entry, Vec2(zc, firstCut))}, role))
+        return false;
+      for (double at = firstCut;;) {
+        const double next = out > 0 ? std::max(at - peck, end.y()) : std::min(at + peck, end.y());
+        w_.feed(Vec2(zc, next), perRev_, role);
+        if (std::abs(next - end.y()) < 1e-9)
+          break;
+        w_.rapid(Vec2(zc, next + out * back), "retract");
+        w_.rapid(Vec2(zc, next + out * std::min(back, 0.1)), "approach");
+        at = next;
+      }
+    } else if (!cut(entry, {Seg::line(entry, end)}, role)) {
       return false;
+    }
     dwell();
     w_.rapid(entry, "retract");
     removeSwept({Seg::line(entry, end)}, Vec2(0, out));
@@ -1110,11 +1132,12 @@ private:
     // from the V's point.
     const double out = shape_.inner ? -1 : 1;
     const double runIn = t.hi + 2 * lead, clearR = t.crestRadius + out * (kLatheClearance + tool_.rc);
-    for (double d : passes)
+    const std::vector<double> shifts = flankShifts(passes, depth);
+    for (size_t i = 0; i < passes.size(); ++i)
       for (int k = 0; k < t.starts; ++k) {
-        const double r = t.crestRadius - out * (d - tool_.rc);
-        const double z = runIn + k * pitch;
-        const Vec2 outAtStart(z, clearR), start(z, r), end(t.lo, r), outAtEnd(t.lo, clearR);
+        const double r = t.crestRadius - out * (passes[i] - tool_.rc);
+        const double z = runIn + k * pitch + shifts[i];
+        const Vec2 outAtStart(z, clearR), start(z, r), end(t.lo + shifts[i], r), outAtEnd(t.lo + shifts[i], clearR);
         if (!travel(outAtStart))
           return false;
         if (!clear(outAtStart, start)) {
@@ -1126,7 +1149,7 @@ private:
         w_.thread(end, lead);
         if (!clear(end, outAtEnd)) {
           x_.report(ws_, feature_,
-                    shape_.symbol + " ends in material at z " + formatFixed(t.lo, 4) +
+                    shape_.symbol + " ends in material at z " + formatFixed(end.x(), 4) +
                         " mm: the tool cannot leave the thread there (give it a groove to run out into)");
           return false;
         }
@@ -1135,8 +1158,34 @@ private:
     // The thread's band is cut when the step ends (passes do not clear it
     // for one another's way out).
     const double deepest = t.crestRadius - out * (passes.back() - tool_.rc);
-    removeSwept({Seg::line(Vec2(runIn + (t.starts - 1) * pitch, deepest), Vec2(t.lo, deepest))}, Vec2(0, out));
+    removeSwept({Seg::line(Vec2(runIn + (t.starts - 1) * pitch + shifts.back(), deepest),
+                           Vec2(t.lo + shifts.back(), deepest))},
+                Vec2(0, out));
     return true;
+  }
+
+  /// How far along the axis each pass at cumulative depth `passes[i]` is
+  /// moved (docs/turning.md): the strategy's `threading_direction` center
+  /// (or none) feeds in radially; right (left) along the flank, the V's
+  /// point (D - d) tan(half the thread angle less 0.5 deg) towards the free
+  /// end (the chuck) of where it ends, D the full depth, so that the
+  /// insert's other flank skims the thread's; the zigzags alternate sides,
+  /// starting on the one named. Passes at the full depth are centred.
+  std::vector<double> flankShifts(const std::vector<double> &passes, double depth) const {
+    std::vector<double> shifts(passes.size(), 0.0);
+    const Node *st = strategy();
+    const std::string side = st ? st->text("thread_side").value_or("center") : "center";
+    if (side == "center")
+      return shifts;
+    const double half = toolNode_.number("thread_angle").value_or(60) / 2 - 0.5;
+    const double slope = std::tan(std::max(half, 0.0) * kPi / 180);
+    const double first = side.starts_with("right") ? 1 : -1;
+    const bool zigzag = side.ends_with("zigzag");
+    for (size_t i = 0; i < passes.size(); ++i) {
+      const double sign = zigzag && i % 2 == 1 ? -first : first;
+      shifts[i] = sign * std::max(depth - passes[i], 0.0) * slope;
+    }
+    return shifts;
   }
 
   /// A left-hand thread is cut as a right-hand one is, towards the chuck,
