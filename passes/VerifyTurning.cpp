@@ -134,7 +134,7 @@ struct Insert {
 /// The insert of `tool`; `inner`: working an inner surface (a boring bar),
 /// its edges reaching in towards the axis from the corner and its imaginary
 /// tip on the corner's side away from it.
-Insert insertOf(const Node &tool, bool inner) {
+Insert insertOf(const Node &tool, bool inner, bool face) {
   Insert in;
   const std::string type = tool.text("type").value_or("");
   if (type != "turning_tool" && type != "grooving_tool" && type != "threading_tool") {
@@ -159,7 +159,10 @@ Insert insertOf(const Node &tool, bool inner) {
   } else if (tool.text("type") == "grooving_tool") {
     const double w = std::max(tool.number("cutting_width").value_or(2 * in.rc) - 2 * in.rc, 0.0);
     const double depth = tool.number("max_cutting_depth").value_or(kDefaultEdge * 2);
-    in.skeleton = {Vec2(0, 0), Vec2(w, 0), Vec2(w, depth), Vec2(0, depth)};
+    // Its cutting corners along the axis, its body outwards; a face
+    // grooving insert's corners across the axis, its body towards the free end.
+    in.skeleton = face ? std::vector<Vec2>{Vec2(0, 0), Vec2(0, w), Vec2(depth, w), Vec2(depth, 0)}
+                       : std::vector<Vec2>{Vec2(0, 0), Vec2(w, 0), Vec2(w, depth), Vec2(0, depth)};
   } else {
     const double side = tool.number("side_edge_angle").value_or(0) * kDegree;
     const double end = tool.number("end_edge_angle").value_or(0) * kDegree;
@@ -252,7 +255,8 @@ private:
           .entity(ws.origin.entityId);
     const double t = tolerance_.value_or(wp->number("global_tolerance").value_or(0.01));
     const double allowance = op->number("allowance").value_or(0);
-    const Insert insert = insertOf(*tool, shape.shape && shape.shape->inner);
+    const Insert insert =
+        insertOf(*tool, shape.shape && shape.shape->inner, shape.shape && shape.shape->faceGroove);
     const Vec2 tipToCentre = insert.tipToCentre;
     // What the step may not cut: the part grown by its allowance, and the chuck.
     const Region guard = geom::unite(allowance > 0 ? geom::growExact(w->part, allowance) : w->part, w->chuck);

@@ -267,6 +267,9 @@ private:
     // on the placement along the axis, open outwards (an outer groove) or
     // in towards the axis (an inner one, in a bore).
     const double floor = f_.number("radius").value_or(0);
+    if (const Vec3 side = f_.vec("material_side").value_or(Vec3(-1, 0, 0));
+        std::abs(std::abs(side.z()) - 1) < 1e-9)
+      return faceGroove(p, side.z());
     const std::optional<bool> inner = innerSide("grooves");
     if (!inner)
       return false;
@@ -318,6 +321,49 @@ private:
     s_.grooveSpan = {lo, hi};
     s_.grooveFloor = floor;
     s_.inner = *inner;
+    return true;
+  }
+
+  /// A face groove: in a face looking towards the free end (its material
+  /// side -z), its floor at the placement's z, its square-U profile's width
+  /// centred on `radius` across the axis, open towards the free end; square
+  /// corners (corner radii are not turned yet).
+  bool faceGroove(const Placed &p, double side) {
+    if (side > 0) {
+      error_ = named(f_) + ": a face groove in a face looking towards the chuck (its material side +z) is not "
+                           "turned (no tool reaches it from the free end)";
+      return false;
+    }
+    const Node *u = f_.child(Kind::SquareUProfile);
+    if (!u) {
+      error_ = named(f_) + ": only grooves with a square_u_profile are turned yet";
+      return false;
+    }
+    const double mid = f_.number("radius").value_or(0), w = u->number("width").value_or(0);
+    for (const char *a : {"first_radius", "second_radius"})
+      if (u->number(a).value_or(0) > 1e-9) {
+        error_ = named(f_) + ": a face groove with rounded corners is not turned yet (square corners only)";
+        return false;
+      }
+    for (const char *a : {"first_angle", "second_angle"})
+      if (auto angle = u->number(a); angle && std::abs(*angle - 90) > 1e-9) {
+        error_ = named(f_) + ": a groove wall at " + formatTrimmed(*angle, 4) +
+                 " deg is not turned yet (square walls only)";
+        return false;
+      }
+    const double lo = mid - w / 2, hi = mid + w / 2, z0 = p.at.x();
+    if (w <= 0 || lo < 0) {
+      error_ = named(f_) + ": its width " + formatFixed(w, 4) + " mm about a radius of " + formatFixed(mid, 4) +
+               " mm makes no face groove";
+      return false;
+    }
+    s_.removal = Region{{ccwPolygon({{z0, lo}, {reachZ_, lo}, {reachZ_, hi}, {z0, hi}})}};
+    // From the outer wall's open end, down it, across the floor, up the inner wall.
+    s_.contour = {Seg::line(Vec2(reachZ_, hi), Vec2(z0, hi)), Seg::line(Vec2(z0, hi), Vec2(z0, lo)),
+                  Seg::line(Vec2(z0, lo), Vec2(reachZ_, lo))};
+    s_.grooveSpan = {lo, hi};
+    s_.grooveFloor = z0;
+    s_.faceGroove = true;
     return true;
   }
 

@@ -52,9 +52,11 @@ struct TurnedShape {
   /// boundary of `removal`.
   std::vector<geom::Seg> contour;
   /// A groove's extent along the axis and its floor radius (grooving
-  /// strategies plunge between the walls).
+  /// strategies plunge between the walls); a face groove's (faceGroove)
+  /// extent across the axis (radii) and its floor's z.
   std::optional<std::pair<double, double>> grooveSpan;
   double grooveFloor = 0;
+  bool faceGroove = false;
   /// A thread: its extent along the axis (lo < hi), its crest radius
   /// (where the tool starts: an outer thread's major, an inner one's minor)
   /// and its root radius (where the tool cuts to: an outer thread's minor,

@@ -54,8 +54,9 @@ struct LatheTool {
   double rc = 0;     ///< nose (corner) radius
   double width = 0;  ///< a grooving insert's cutting width
   double maxDepth = 0;
-  /// The corner circles' centres relative to the chuck-side one (z only).
-  std::vector<double> corners{0.0};
+  /// The corner circles' centres relative to the reference one (the
+  /// chuck-side corner; a face grooving insert's corner nearest the axis).
+  std::vector<Vec2> corners{Vec2::Zero()};
   /// The programmed point relative to the chuck-side corner's centre.
   Vec2 tip = Vec2::Zero();
   /// How far the insert reaches towards the chuck beyond its corner circle
@@ -238,7 +239,9 @@ private:
                   "its grooving tool " + toolNode_.symbol + " needs a cutting width (at least twice its corner radius)");
         return false;
       }
-      tool_.corners = {0.0, (tool_.width - 2 * tool_.rc) / 2, tool_.width - 2 * tool_.rc};
+      // Its corners along the axis, or across it for a face groove.
+      const Vec2 across = shape_.faceGroove ? Vec2(0, 1) : Vec2(1, 0);
+      tool_.corners = {Vec2::Zero(), across * ((tool_.width - 2 * tool_.rc) / 2), across * (tool_.width - 2 * tool_.rc)};
     } else if (type == "threading_tool") {
       // Programmed at the point of its V, the tip circle's point nearest
       // the axis (inside a bore: farthest from it).
@@ -329,8 +332,7 @@ private:
   /// Whether the insert's corner centres, moved from `a` to `b`, keep out
   /// of `grownRegion` (a region grown by the corner radius).
   bool keepsOut(const Region &grownRegion, const Vec2 &a, const Vec2 &b) const {
-    for (double dz : tool_.corners) {
-      const Vec2 off(dz, 0);
+    for (const Vec2 &off : tool_.corners) {
       if (grownRegion.contains(a + off) || grownRegion.contains(b + off))
         return false;
       for (const Seg &s : geom::clip(grownRegion, a + off, b + off))
@@ -423,21 +425,20 @@ private:
   /// outwards of it (`away`, up to the reach) that the insert's edge cuts.
   void removeSwept(const std::vector<Seg> &path, const std::optional<Vec2> &away) {
     std::vector<Region> parts;
-    for (double dz : tool_.corners)
+    for (const Vec2 &off : tool_.corners)
       for (const Seg &s : path) {
         Seg t = s;
-        t.a += Vec2(dz, 0);
-        t.b += Vec2(dz, 0);
-        t.c += Vec2(dz, 0);
+        t.a += off;
+        t.b += off;
+        t.c += off;
         if (tool_.rc > geom::kEps)
           for (Region &r : geom::sweptDiscParts(t, tool_.rc))
             parts.push_back(std::move(r));
       }
     // A grooving insert is the hull of its corners: its edge between them
     // sweeps what lies between their paths (a plunge's whole width).
-    if (const double span = tool_.corners.back(); span > geom::kEps)
+    if (const Vec2 w = tool_.corners.back(); w.norm() > geom::kEps)
       for (const Seg &s : path) {
-        const Vec2 w(span, 0);
         for (const Vec2 &at : {s.a, s.b})
           for (Region &r : geom::sweptDiscParts(Seg::line(at, at + w), std::max(tool_.rc, 1e-6)))
             parts.push_back(std::move(r));
@@ -938,10 +939,26 @@ private:
     return true;
   }
 
-  bool grooveRough() {
-    if (!needsGroove())
+  /// One plunge of a face grooving insert along -z, its edge nearest the
+  /// axis at `rEdge`, to `bottom` (the insert's front), and straight back out.
+  bool facePlunge(double rEdge, double bottom, const char *role) {
+    const double rc = rEdge + tool_.rc;
+    const Region band = geom::intersect(stock_, box(Vec2(-1e5, rEdge), Vec2(1e5, rEdge + tool_.width)));
+    const double topZ = band.empty() ? bottom : std::max(band.box().hi.x(), bottom);
+    const Vec2 entry(topZ + tool_.rc + kLatheClearance, rc), end(bottom + tool_.rc, rc);
+    if (!cut(entry, {Seg::line(entry, end)}, role))
       return false;
-    const double a = op_.number("allowance").value_or(0);
+    dwell();
+    w_.rapid(entry, "retract");
+    removeSwept({Seg::line(entry, end)}, Vec2(1, 0));
+    return true;
+  }
+
+  /// Where the plunges across a groove put the insert's reference edge:
+  /// `a` inside the walls, the first and last against them, overlapping by
+  /// a fifth of the insert's width; nullopt after an error (the insert wider
+  /// than the groove less its allowances).
+  std::optional<std::vector<double>> plungeEdges(double a) {
     const auto [lo, hi] = *shape_.grooveSpan;
     const double first = lo + a, last = hi - a - tool_.width;
     if (last < first - 1e-9) {
@@ -949,16 +966,45 @@ private:
                 "its grooving tool " + toolNode_.symbol + " (" + formatFixed(tool_.width, 4) +
                     " mm wide) is wider than " + shape_.symbol + " less its allowances (" +
                     formatFixed(hi - lo - 2 * a, 4) + " mm)");
-      return false;
+      return std::nullopt;
     }
-    // Plunges overlapping by a fifth of the width, the first and last at the walls.
     const double step = 0.8 * tool_.width;
     const int n = static_cast<int>(std::ceil((last - first) / step - 1e-9)) + 1;
-    for (int k = 0; k < n; ++k) {
-      const double z = n == 1 ? first : first + (last - first) * k / (n - 1);
-      if (!plunge(z, shape_.grooveFloor + outwards() * a, "cut"))
+    std::vector<double> edges;
+    for (int k = 0; k < n; ++k)
+      edges.push_back(n == 1 ? first : first + (last - first) * k / (n - 1));
+    return edges;
+  }
+
+  bool grooveRough() {
+    if (!needsGroove())
+      return false;
+    const double a = op_.number("allowance").value_or(0);
+    const std::optional<std::vector<double>> edges = plungeEdges(a);
+    if (!edges)
+      return false;
+    for (double e : *edges)
+      if (!(shape_.faceGroove ? facePlunge(e, shape_.grooveFloor + a, "cut")
+                              : plunge(e, shape_.grooveFloor + outwards() * a, "cut")))
         return false;
-    }
+    return true;
+  }
+
+  /// A face groove's finish: down its outer wall with the far corner,
+  /// across its floor, up its inner wall.
+  bool faceGrooveFinish() {
+    const auto [lo, hi] = *shape_.grooveSpan;
+    const double far = tool_.width - 2 * tool_.rc;
+    const double rOuter = hi - tool_.rc - far, rInner = lo + tool_.rc, zFloor = shape_.grooveFloor + tool_.rc;
+    const Region band = geom::intersect(stock_, box(Vec2(-1e5, lo), Vec2(1e5, hi)));
+    const double top = (band.empty() ? shape_.grooveFloor : band.box().hi.x()) + tool_.rc + kLatheClearance;
+    std::vector<Seg> path{Seg::line(Vec2(top, rOuter), Vec2(zFloor, rOuter)),
+                          Seg::line(Vec2(zFloor, rOuter), Vec2(zFloor, rInner)),
+                          Seg::line(Vec2(zFloor, rInner), Vec2(top, rInner))};
+    std::erase_if(path, [](const Seg &sg) { return (sg.b - sg.a).norm() < 1e-9; });
+    if (!cut(path.front().a, path))
+      return false;
+    removeSwept(path, Vec2(1, 0));
     return true;
   }
 
@@ -973,6 +1019,8 @@ private:
                     formatFixed(hi - lo, 4) + " mm)");
       return false;
     }
+    if (shape_.faceGroove)
+      return faceGrooveFinish();
     // Down the free-end wall with the far corner, along the floor, up the
     // chuck-side wall: the chuck-side corner's centre is the reference.
     const double far = tool_.width - 2 * tool_.rc;

@@ -134,14 +134,14 @@ TEST_CASE("what is not turned is said", "[turned]") {
     CHECK_FALSE(r.shape);
     CHECK(r.error.find("off the turning axis") != std::string::npos);
   }
-  SECTION("a face groove (its material along the axis)") {
+  SECTION("a face groove in a face looking towards the chuck") {
     auto p = parsed("    groove %g \"G\" at=(0.0000,0.0000,50.0000)mm " + kZ +
-                        " radius=16.0000mm material_side=(0.000000,0.000000,-1.000000)\n"
+                        " radius=16.0000mm material_side=(0.000000,0.000000,1.000000)\n"
                         "      square_u_profile width=4.0000mm\n",
                     "%g");
     ir::TurnedShapeResult r = ir::turnedShape(*p.feature, p.stock);
     CHECK_FALSE(r.shape);
-    CHECK(r.error.find("grooves with their material along the axis are not turned yet") != std::string::npos);
+    CHECK(r.error.find("looking towards the chuck") != std::string::npos);
   }
   SECTION("a taper to nothing") {
     auto p = parsed("    outer_diameter %od \"OD\" at=(0.0000,0.0000,10.0000)mm " + kZ +
@@ -307,4 +307,20 @@ TEST_CASE("a revolved round: the corner outside a quarter circle", "[turned]") {
   ir::TurnedShapeResult bad = ir::turnedShape(*q.feature, q.stock);
   CHECK_FALSE(bad.shape);
   CHECK(bad.error.find("a round over 60 deg is not turned yet") != std::string::npos);
+}
+
+TEST_CASE("a face groove: in the end face, open towards the free end", "[turned]") {
+  // Its floor at z 95, 4 mm wide about a radius of 10 mm: 5 x 4 of the bar.
+  auto p = parsed("    groove %g \"G\" at=(0.0000,0.0000,95.0000)mm " + kZ +
+                      " radius=10.0000mm material_side=(0.000000,0.000000,-1.000000)\n"
+                      "      square_u_profile width=4.0000mm\n",
+                  "%g");
+  ir::TurnedShapeResult r = ir::turnedShape(*p.feature, p.stock);
+  REQUIRE(r.shape);
+  CHECK(r.shape->faceGroove);
+  CHECK(areaInStock(*r.shape, p.stock) == Approx(5 * 4).epsilon(1e-12));
+  REQUIRE(r.shape->grooveSpan);
+  CHECK(r.shape->grooveSpan->first == 8);
+  CHECK(r.shape->grooveSpan->second == 12);
+  CHECK(r.shape->grooveFloor == 95);
 }
