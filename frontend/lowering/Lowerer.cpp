@@ -318,14 +318,19 @@ std::optional<std::string> Lowerer::setup(const Instance &s) {
 // --- executables -------------------------------------------------------------
 
 std::optional<Node> Lowerer::workingstep(const Instance &ws) {
+  return workingstep(ws, ws.ref("its_feature"), "its_feature", ws.string("its_id").value_or(""));
+}
+
+std::optional<Node> Lowerer::workingstep(const Instance &ws, const Instance &featureInstance, std::string_view attribute,
+                                         const std::string &name) {
   Node node(ir::Kind::Workingstep);
   stamp(node, ws);
-  node.symbol = symbolFor('@', ws.string("its_id"), "ws");
-  const std::optional<std::string> f = feature(ws.ref("its_feature"));
+  node.symbol = symbolFor('@', name, "ws");
+  const std::optional<std::string> f = feature(featureInstance);
   if (f)
     node.set("feature", Value::ref(*f));
   else
-    missing(ws, "its_feature");
+    missing(ws, attribute);
   const Node *featureNode = f ? ir::findFeature(*module_, *f) : nullptr;
   // A turned feature's axis is the turning axis, either way: a lathe turns
   // the part about it, no re-clamping (docs/turning.md).
@@ -335,7 +340,7 @@ std::optional<Node> Lowerer::workingstep(const Instance &ws) {
     if (auto h = planeHeight(ws, "its_secplane", "security plane"))
       node.set("secplane", Value::length(*h));
   if (Instance op = ws.ref("its_operation")) {
-    use_ = {op, ws.ref("its_feature")};
+    use_ = {op, featureInstance};
     std::optional<Node> lowered = operation(op);
     use_ = {};
     if (lowered)
@@ -378,6 +383,33 @@ bool Lowerer::executable(const Instance &exe, Node &parent) {
       reclampBefore(*ws, parent);
       parent.add(std::move(*ws));
     }
+    return true;
+  }
+  if (exe.isA("turning_workingstep")) {
+    // One turning operation over several features (ISO 14649-12): a
+    // workingstep each, in the order listed, the same operation (their
+    // surfaces are not joined into one pass yet: said).
+    const std::vector<Instance> features = exe.refs("its_features");
+    if (features.empty()) {
+      missing(exe, "its_features");
+      return true;
+    }
+    const std::string id = exe.string("its_id").value_or("");
+    std::string names;
+    for (size_t i = 0; i < features.size(); ++i) {
+      const std::string name = features.size() == 1 ? id : id + " " + std::to_string(i + 1);
+      if (auto ws = workingstep(exe, features[i], "its_features", name)) {
+        if (features.size() > 1)
+          ws->label = id + ": " + features[i].string("its_id").value_or(hashId(features[i].id()));
+        names += (names.empty() ? "" : ", ") + ws->symbol;
+        reclampBefore(*ws, parent);
+        parent.add(std::move(*ws));
+      }
+    }
+    if (features.size() > 1)
+      assumed(exe, "its_features",
+              "lists " + std::to_string(features.size()) + " features: machined one after the other with its "
+              "operation, a workingstep each (" + names + "); stepnc does not join their surfaces into one pass yet");
     return true;
   }
   if (exe.isA("workplan")) {

@@ -239,6 +239,10 @@ private:
   std::optional<std::string> setup(const Instance &setup);
   bool executable(const Instance &exe, Node &parent);
   std::optional<Node> workingstep(const Instance &ws);
+  /// A workingstep of `ws` machining `featureInstance` (its `attribute`),
+  /// its symbol from `name`.
+  std::optional<Node> workingstep(const Instance &ws, const Instance &featureInstance, std::string_view attribute,
+                                  const std::string &name);
   std::optional<Node> workplan(const Instance &wp);
   Node *findResource(const std::string &symbol);
   /// The copies placeOnFace makes, each once per face (LowerClampings.cpp).
