@@ -442,6 +442,32 @@ std::optional<std::string> Lowerer::feature(const Instance &f) {
     if (Instance form = f.ref("form"))
       if (auto text = form.string("descriptive_string"))
         n.set("form", Value::string(*text));
+  } else if (f.isA("knurl")) {
+    // Its pattern by its subtype, the surface it is pressed into by its base
+    // feature, its extent by its partial profile (docs/turning.md).
+    n.kind = ir::Kind::Knurl;
+    commonPlacement();
+    if (auto base = feature(f.ref("base_feature")))
+      n.set("base", Value::ref(*base));
+    else
+      missing(f, "base_feature");
+    if (Instance partial = f.ref("partial_profile"))
+      if (auto l = toleranced(partial, "effective_length"))
+        n.set("length", Value::length(*l));
+    length("tooth_depth", "tooth_depth");
+    length("diametral_pitch", "diametral_pitch");
+    length("root_fillet", "root_fillet");
+    length("major_diameter", "major_diameter");
+    length("nominal_diameter", "nominal_diameter");
+    if (auto teeth = f.integer("number_of_teeth"))
+      n.set("teeth", Value::integer(*teeth));
+    const char *pattern = f.isA("straight_knurl")  ? "straight"
+                          : f.isA("diagonal_knurl") ? "diagonal"
+                          : f.isA("diamond_knurl")  ? "diamond"
+                                                    : "tool";
+    n.set("pattern", Value::word(pattern));
+    copyAngle(n, "helix_angle", f, f.isA("diamond_knurl") ? "helix1_angle" : "helix_angle");
+    copyAngle(n, "helix2_angle", f, "helix2_angle");
   } else if (f.isA("thread")) {
     unsupported(f, "thread (a catalogue thread gives its size by a reference to a standard; stepnc turns defined "
                    "threads, whose diameters the file gives)");

@@ -482,6 +482,9 @@ constexpr std::pair<std::string_view, std::string_view> kAngles[] = {
     {"turning_threading_tool", "threading_angle"},
     {"unidirectional_diagonal", "path_return_angle"},
     {"contour_turning", "path_return_angle"},
+    {"diagonal_knurl", "helix_angle"},
+    {"diamond_knurl", "helix1_angle"},
+    {"diamond_knurl", "helix2_angle"},
 };
 
 } // namespace

@@ -1,0 +1,4 @@
+# Adds a diamond knurl on the 40 mm diameter to lathe-shaft.stp
+# (knurl.test): the feature, a knurling step, a knurling tool.
+s/^#2=WORKPLAN('main workplan',(#10,#11,#130,#131,#132,#12,#13,#14,#15,#16,#17,#18,#19),/#2=WORKPLAN('main workplan',(#10,#11,#130,#131,#132,#12,#13,#14,#15,#300,#16,#17,#18,#19),/
+/^#107=/a #300=MACHINING_WORKINGSTEP('knurl the grip',#6,#301,#302,$);\n#301=DIAMOND_KNURL('grip',#3,(#302),#303,#20,#304,#305,#306,$,$,#80,$,30.,30.);\n#302=KNURLING($,$,'knurl',$,$,#307,#62,#64,$,$,$);\n#303=AXIS2_PLACEMENT_3D('grip',#308,#107,#92);\n#304=PARTIAL_AREA_DEFINITION(20.,#303,$);\n#305=TOLERANCED_LENGTH_MEASURE(0.4,#77);\n#306=TOLERANCED_LENGTH_MEASURE(1.2,#77);\n#307=TURNING_MACHINE_TOOL('T6 knurl 1.2',#309,(#310),110.,$,$);\n#308=CARTESIAN_POINT('grip',(0.,0.,50.));\n#309=KNURLING_TOOL(#58,.NEUTRAL.,$,$,$,$,$,.DIAMOND.,10.,30.,1.2);\n#310=CUTTING_COMPONENT(110.,$,$,$,$);
