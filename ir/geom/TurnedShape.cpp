@@ -46,6 +46,22 @@ std::optional<Placed> placedOnAxis(const Node &n, std::string &error) {
   return Placed{Vec2(at.z(), 0), axis.z() > 0 ? 1.0 : -1.0};
 }
 
+/// Whether a loop's segments meet only where consecutive ones join: a
+/// profile that runs back along itself or crosses itself bounds no region.
+bool simple(const Loop &l) {
+  const size_t n = l.segs.size();
+  for (size_t i = 0; i < n; ++i)
+    for (size_t j = i + 1; j < n; ++j) {
+      const bool next = j == i + 1, wrap = i == 0 && j == n - 1;
+      for (const Vec2 &x : geom::intersect(l.segs[i], l.segs[j])) {
+        const bool atJoint = (next && (x - l.segs[j].a).norm() < 1e-7) || (wrap && (x - l.segs[i].a).norm() < 1e-7);
+        if (!atJoint)
+          return false;
+      }
+    }
+  return true;
+}
+
 /// A loop through the points in order, counter-clockwise whichever way they are given.
 Loop ccwPolygon(const std::vector<Vec2> &pts) {
   Loop l = geom::polygon(pts);
@@ -475,7 +491,7 @@ private:
     // The loop runs along the surface towards the chuck and back along the
     // reach: clockwise round an outer removal (reversed, counter-clockwise
     // as regions are), counter-clockwise round an inner one.
-    if (inner ? l.area() <= 0 : l.area() >= 0) {
+    if ((inner ? l.area() <= 0 : l.area() >= 0) || !simple(l)) {
       error_ = named(f_) + ": its profile does not bound material " + (inner ? "away from" : "towards") +
                " the axis (it turns back on itself)";
       return false;

@@ -714,13 +714,17 @@ private:
         continue;
       }
       const Vec2 from = chain[k].a, to = chain[k].b;
-      chain.erase(chain.begin() + static_cast<long>(k));
-      if (k < chain.size() && !chain[k].isArc())
-        chain[k].a = from;
-      else if (k > 0 && !chain[k - 1].isArc())
-        chain[k - 1].b = to;
-      else if (k < chain.size())
-        chain.insert(chain.begin() + static_cast<long>(k), Seg::line(from, chain[k].a));
+      if ((k + 1 < chain.size() && !chain[k + 1].isArc()) || (k > 0 && !chain[k - 1].isArc())) {
+        chain.erase(chain.begin() + static_cast<long>(k));
+        if (k < chain.size() && !chain[k].isArc())
+          chain[k].a = from;
+        else
+          chain[k - 1].b = to;
+      } else {
+        // Between two arcs (or alone at an end): kept, as a line.
+        chain[k] = Seg::line(from, to);
+        ++k;
+      }
     }
     // Trimmed to the pieces that touch material.
     const Region material = geom::intersect(stock_, removal_);
