@@ -296,12 +296,8 @@ private:
     }
     const double w = u->number("width").value_or(0);
     const double r1 = u->number("first_radius").value_or(0), r2 = u->number("second_radius").value_or(0);
-    for (const char *a : {"first_angle", "second_angle"})
-      if (auto angle = u->number(a); angle && std::abs(*angle - 90) > 1e-9) {
-        error_ = named(f_) + ": a groove wall at " + formatTrimmed(*angle, 4) +
-                 " deg is not turned yet (square walls only)";
-        return false;
-      }
+    if (!squareWalls(*u))
+      return false;
     if (floor <= 0 || w <= 0 || r1 < 0 || r2 < 0 || r1 + r2 > w + 1e-9) {
       error_ = named(f_) + ": its floor radius " + formatFixed(floor, 4) + " mm and width " + formatFixed(w, 4) +
                " mm (corner radii " + formatFixed(r1, 4) + " and " + formatFixed(r2, 4) + " mm) make no groove";
@@ -340,6 +336,18 @@ private:
     return true;
   }
 
+  /// Whether a square-U profile's walls stand at 90 degrees (the only ones
+  /// turned); else an error naming the first that does not.
+  bool squareWalls(const Node &u) {
+    for (const char *a : {"first_angle", "second_angle"})
+      if (auto angle = u.number(a); angle && std::abs(*angle - 90) > 1e-9) {
+        error_ = named(f_) + ": a groove wall at " + formatTrimmed(*angle, 4) +
+                 " deg is not turned yet (square walls only)";
+        return false;
+      }
+    return true;
+  }
+
   /// A face groove: in a face looking towards the free end (its material
   /// side -z), its floor at the placement's z, its square-U profile's width
   /// centred on `radius` across the axis, open towards the free end; square
@@ -361,12 +369,8 @@ private:
         error_ = named(f_) + ": a face groove with rounded corners is not turned yet (square corners only)";
         return false;
       }
-    for (const char *a : {"first_angle", "second_angle"})
-      if (auto angle = u->number(a); angle && std::abs(*angle - 90) > 1e-9) {
-        error_ = named(f_) + ": a groove wall at " + formatTrimmed(*angle, 4) +
-                 " deg is not turned yet (square walls only)";
-        return false;
-      }
+    if (!squareWalls(*u))
+      return false;
     const double lo = mid - w / 2, hi = mid + w / 2, z0 = p.at.x();
     if (w <= 0 || lo < 0) {
       error_ = named(f_) + ": its width " + formatFixed(w, 4) + " mm about a radius of " + formatFixed(mid, 4) +

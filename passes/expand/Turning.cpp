@@ -1002,13 +1002,20 @@ private:
     const double rOuter = hi - tool_.rc - far, rInner = lo + tool_.rc, zFloor = shape_.grooveFloor + tool_.rc;
     const Region band = geom::intersect(stock_, box(Vec2(-1e5, lo), Vec2(1e5, hi)));
     const double top = (band.empty() ? shape_.grooveFloor : band.box().hi.x()) + tool_.rc + kLatheClearance;
-    std::vector<Seg> path{Seg::line(Vec2(top, rOuter), Vec2(zFloor, rOuter)),
-                          Seg::line(Vec2(zFloor, rOuter), Vec2(zFloor, rInner)),
-                          Seg::line(Vec2(zFloor, rInner), Vec2(top, rInner))};
-    std::erase_if(path, [](const Seg &sg) { return (sg.b - sg.a).norm() < 1e-9; });
+    return cutU({Vec2(top, rOuter), Vec2(zFloor, rOuter), Vec2(zFloor, rInner), Vec2(top, rInner)}, Vec2(1, 0));
+  }
+
+  /// A groove's finishing path through `corners` (down one wall, along the
+  /// floor, up the other; empty pieces dropped), entered at its first; the
+  /// stock then loses what it swept and all beyond it along `away`.
+  bool cutU(const std::vector<Vec2> &corners, const Vec2 &away) {
+    std::vector<Seg> path;
+    for (size_t i = 0; i + 1 < corners.size(); ++i)
+      if ((corners[i + 1] - corners[i]).norm() >= 1e-9)
+        path.push_back(Seg::line(corners[i], corners[i + 1]));
     if (!cut(path.front().a, path))
       return false;
-    removeSwept(path, Vec2(1, 0));
+    removeSwept(path, away);
     return true;
   }
 
@@ -1031,14 +1038,8 @@ private:
     const double zHiWall = hi - tool_.rc - far, zLoWall = lo + tool_.rc, rFloor = floor + out * tool_.rc;
     const double topR = topOver(lo);
     const double top = (out > 0 ? std::max(topR, floor) : std::min(topR, floor)) + out * (tool_.rc + kLatheClearance);
-    std::vector<Seg> path{Seg::line(Vec2(zHiWall, top), Vec2(zHiWall, rFloor)),
-                          Seg::line(Vec2(zHiWall, rFloor), Vec2(zLoWall, rFloor)),
-                          Seg::line(Vec2(zLoWall, rFloor), Vec2(zLoWall, top))};
-    std::erase_if(path, [](const Seg &s) { return (s.b - s.a).norm() < 1e-9; });
-    if (!cut(path.front().a, path))
-      return false;
-    removeSwept(path, Vec2(0, out));
-    return true;
+    return cutU({Vec2(zHiWall, top), Vec2(zHiWall, rFloor), Vec2(zLoWall, rFloor), Vec2(zLoWall, top)},
+                Vec2(0, out));
   }
 
   bool cutIn() {
