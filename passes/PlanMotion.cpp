@@ -1,5 +1,6 @@
 // plan-motion: plans the whole program's moves on a machine (runtime/Planner)
 // and writes the trajectory into the IR as `motion` nodes (ir/motion/MotionIR).
+#include "ir/motion/LathePlan.h"
 #include "ir/motion/MotionIR.h"
 #include "ir/Program.h"
 #include "passes/Pass.h"
@@ -18,14 +19,16 @@ public:
   std::string_view name() const override { return "plan-motion"; }
 
   PassResult run(ir::Module &module, DiagnosticEngine &diags, PassStats &stats) override {
-    if (!ir::requireThreeAxisMilling(module, "plan-motion", diags, ir::ArcPlanes::Principal))
-      return {false, false};
     // Kept for the life of the pass: diagnostics point into it.
     const auto machine = runtime::loadMachine(machinePath_, machineFile_, diags);
     if (!machine)
       return {false, false};
-    // The planner moves x, y and z: a lathe or a generic chain is refused
-    // rather than planned with its axes taken for x, y, z.
+    if (machine->kinematics.chain == runtime::Chain::Lathe)
+      return runLathe(module, *machine, diags, stats);
+    if (!ir::requireThreeAxisMilling(module, "plan-motion", diags, ir::ArcPlanes::Principal))
+      return {false, false};
+    // The planner moves x, y and z: a generic chain is refused rather than
+    // planned with its axes taken for x, y, z.
     if (const std::string why = machine->whyNotThreeAxis(); !why.empty()) {
       diags.error({}, "plan-motion: " + why);
       return {false, false};
@@ -44,6 +47,36 @@ public:
       options.tolerance = *tolerance_;
     const runtime::Trajectory trajectory = runtime::plan(program.path, *machine, options);
     ir::attachMotion(module, program, trajectory);
+    count(program, trajectory, stats);
+    return {true, true};
+  }
+
+private:
+  /// A lathe program: its turning steps and holes drilled on the axis,
+  /// planned in the ZX plane with the spindle (ir/motion/LathePlan.h).
+  PassResult runLathe(ir::Module &module, const runtime::Machine &machine, DiagnosticEngine &diags,
+                      PassStats &stats) {
+    if (!ir::requireThreeAxisMilling(module, "plan-motion", diags, ir::ArcPlanes::Principal, ir::TurningSteps::Skip))
+      return {false, false};
+    if (!ir::hasMachiningSteps(module))
+      return {true, false};
+    runtime::PlanOptions options;
+    if (tolerance_)
+      options.tolerance = *tolerance_;
+    std::optional<ir::LathePlan> plan = ir::planLathe(module, machine, options, diags);
+    if (!plan)
+      return {false, false};
+    if (plan->program.path.moves.empty()) {
+      diags.warning({}, "plan-motion: the program has no moves to plan (run expand-strategies first)");
+      return {true, false};
+    }
+    ir::attachMotion(module, plan->program, plan->trajectory);
+    count(plan->program, plan->trajectory, stats);
+    stats["spindle waits"] = plan->spindleWaits;
+    return {true, true};
+  }
+
+  static void count(const ir::ProgramPath &program, const runtime::Trajectory &trajectory, PassStats &stats) {
     long long blends = 0, dwells = 0, stops = 0;
     for (size_t k = 0; k < trajectory.segments.size(); ++k) {
       blends += trajectory.segments[k].kind == runtime::SegmentKind::Blend;
@@ -56,10 +89,8 @@ public:
     stats["dwells"] = dwells;
     stats["stops"] = stops;
     stats["cycle time (ms)"] = (long long)std::llround(trajectory.duration() * 1000);
-    return {true, true};
   }
 
-private:
   std::string machinePath_;
   std::unique_ptr<SourceFile> machineFile_;
   std::optional<double> tolerance_;

@@ -71,8 +71,8 @@ std::string Machine::whyNotThreeAxis() const {
   }
   case Chain::Lathe:
     return "the machine " + quoted +
-           " is a lathe (x radial, z along the spindle): the planner and the player move a milling tool in x, y "
-           "and z, so stepnc cannot plan or play motion for it yet";
+           " is a lathe (x radial, z along the spindle): a 3-axis milling program cannot run on it (lathe programs "
+           "are planned and played in its ZX plane, docs/turning.md)";
   case Chain::Generic:
     return "the machine " + quoted + " has a generic chain moved by the solver '" + kinematics.solver +
            "': the planner and the player move x, y and z through the xyz and 5-axis chains only";
@@ -355,6 +355,22 @@ void readAxes(TomlReader &r, const toml::table &axes, Machine &m) {
 }
 
 } // namespace
+
+Machine latheFrameMachine(const Machine &lathe) {
+  Machine out = lathe;
+  out.kinematics = KinematicsSpec{};
+  out.axes.clear();
+  const Axis *x = lathe.axis("x"), *z = lathe.axis("z");
+  if (!x || !z)
+    return out;
+  out.axes.push_back(*z);
+  out.axes.push_back(*x);
+  Axis y = *x;
+  y.name = "y";
+  y.travelMin = y.travelMax = 0;
+  out.axes.push_back(y);
+  return out;
+}
 
 std::optional<Machine> readMachine(const SourceFile &file, DiagnosticEngine &diags) {
   TomlReader r(file, diags, "the machine file");

@@ -117,6 +117,12 @@ struct Machine {
   std::string whyNotThreeAxis() const;
 };
 
+/// A lathe as the planner and the player take it: three linear axes in the
+/// order of a lathe trajectory's coordinates (Frame::Zxy, Trajectory.h): its
+/// z, its x (radius), and a y that never moves (given x's limits). The rest
+/// (name, spindle, controller) is the lathe's.
+Machine latheFrameMachine(const Machine &lathe);
+
 /// Reads and checks a machine description. Reports every problem found
 /// (unknown keys, missing or out-of-range values, a chain naming an axis it
 /// does not have, TOML syntax) at its place in the file; returns nullopt when

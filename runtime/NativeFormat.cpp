@@ -24,17 +24,23 @@ namespace stepnc::runtime {
 namespace {
 
 /// Version 2 is version 1 with dwells (the `dwell` segment and the stop
-/// reason `dwell`). A trajectory without them is written as version 1, which
-/// players of version 1 read; version 2 only when it has one.
-constexpr int kVersion = 2;
+/// reason `dwell`); version 3 adds the `axes` line (a lathe's coordinates are
+/// z x y) and each segment's spindle. A trajectory is written in the lowest
+/// version that holds it, so players of an older version go on reading what
+/// they can play: a mill's without dwells as version 1, with them as 2, a
+/// lathe's as 3.
+constexpr int kVersion = 3;
+constexpr int kVersionWithDwells = 2;
 constexpr int kVersionWithoutDwells = 1;
 constexpr std::string_view kMagic = "STEPNC-MOTION";
 
 /// The version a trajectory needs.
 int versionFor(const Trajectory &t) {
+  if (t.frame == Frame::Zxy)
+    return kVersion;
   for (size_t i = 0; i < t.segments.size(); ++i)
     if (t.segments[i].kind == SegmentKind::Dwell || t.info[i].stop == StopReason::Dwell)
-      return kVersion;
+      return kVersionWithDwells;
   return kVersionWithoutDwells;
 }
 
@@ -99,6 +105,9 @@ std::string writeNative(const Trajectory &trajectory, const std::string &source)
   out += "machine " + quoted(t.machine) + '\n';
   out += "cycle_time " + number(t.cycleTime) + '\n';
   out += "tolerance " + number(t.tolerance) + '\n';
+  const bool lathe = t.frame == Frame::Zxy;
+  if (lathe)
+    out += "axes z x y\n";
   out += "start";
   appendPoint(out, t.start);
   out += '\n';
@@ -149,6 +158,11 @@ std::string writeNative(const Trajectory &trajectory, const std::string &source)
     out += " phases " + std::to_string(prof.phases.size());
     for (const Phase &ph : prof.phases)
       appendNumbers(out, {ph.duration, ph.jerk});
+    if (lathe) {
+      out += " spindle";
+      appendNumbers(out, {info.spindle0, info.spindle1});
+      out += info.sync ? " sync index" : " sync none";
+    }
     out += '\n';
   }
   out += "end\n";
@@ -448,9 +462,8 @@ bool Reader::header(Trajectory &t) {
   // The very first line, before any comment or blank, must name the format.
   if (!nextLine(false) || words_[0].offset != 0 || words_[0].text != kMagic) {
     fail(words_.empty() ? 0 : words_[0].offset,
-         "not a stepnc native motion file: the first line must be '" + std::string(kMagic) + " " +
-             std::to_string(kVersionWithoutDwells) + "' or '" + std::string(kMagic) + " " + std::to_string(kVersion) +
-             "'");
+         "not a stepnc native motion file: the first line must be '" + std::string(kMagic) + " N', N the format "
+         "version (" + std::to_string(kVersionWithoutDwells) + " to " + std::to_string(kVersion) + ")");
     return false;
   }
   ++pos_;
@@ -483,6 +496,20 @@ bool Reader::header(Trajectory &t) {
   if (line("tolerance"))
     t.tolerance = nonNegative("the tolerance");
   endOfLine("the tolerance");
+  if (version_ >= kVersion) {
+    // Which machine axes the three coordinates are: a mill's x y z, a lathe's z x y.
+    if (line("axes")) {
+      const Word *a = word("the first axis"), *b = word("the second axis"), *c = word("the third axis");
+      if (a && b && c) {
+        const std::string axes = std::string(a->text) + " " + std::string(b->text) + " " + std::string(c->text);
+        if (axes == "z x y")
+          t.frame = Frame::Zxy;
+        else if (axes != "x y z")
+          fail(a->offset, "the axes are 'x y z' (a mill) or 'z x y' (a lathe), not '" + shown(axes) + "'");
+      }
+    }
+    endOfLine("the axes");
+  }
   if (line("start"))
     t.start = point("the start point");
   endOfLine("the start point");
@@ -518,8 +545,8 @@ void Reader::segment(Trajectory &t, bool first) {
     kind = SegmentKind::Dwell;
   else if (kindWord.text != "line")
     fail(kindWord.offset, "unknown segment kind '" + shown(kindWord.text) + "' (known: line, arc, blend, dwell)");
-  if (kind == SegmentKind::Dwell && version_ < kVersion)
-    fail(kindWord.offset, "a dwell segment needs format version " + std::to_string(kVersion) +
+  if (kind == SegmentKind::Dwell && version_ < kVersionWithDwells)
+    fail(kindWord.offset, "a dwell segment needs format version " + std::to_string(kVersionWithDwells) +
                               "; this file is version " + std::to_string(version_));
   const Vec3 from = at_;
   keyword("to");
@@ -576,8 +603,8 @@ void Reader::segment(Trajectory &t, bool first) {
   info.nextMove = integer("the next move index");
   keyword("stop");
   info.stop = choice(kStopReasons, stopReasonName, "stop reason");
-  if (ok_ && info.stop == StopReason::Dwell && version_ < kVersion)
-    failHere("the stop reason 'dwell' needs format version " + std::to_string(kVersion) + "; this file is version " +
+  if (ok_ && info.stop == StopReason::Dwell && version_ < kVersionWithDwells)
+    failHere("the stop reason 'dwell' needs format version " + std::to_string(kVersionWithDwells) + "; this file is version " +
              std::to_string(version_));
   if (ok_ && kind == SegmentKind::Dwell && info.stop != StopReason::Dwell)
     failHere("a dwell segment stops for its dwell: 'stop dwell', not 'stop " + std::string(stopReasonName(info.stop)) +
@@ -608,7 +635,25 @@ void Reader::segment(Trajectory &t, bool first) {
     prof.phases[k].duration = nonNegative("a phase's duration");
     prof.phases[k].jerk = real("a phase's jerk");
   }
-  endOfLine("the last phase");
+  if (version_ >= kVersion) {
+    // The spindle: its speed at both ends; a thread pass keeps it.
+    keyword("spindle");
+    info.spindle0 = real("the spindle speed at the start");
+    const uint64_t spindleAt = last_;
+    info.spindle1 = real("the spindle speed at the end");
+    keyword("sync");
+    if (const Word *w = word("the synchronisation (index or none)"); w && w->text != "index" && w->text != "none")
+      fail(w->offset, "unknown synchronisation '" + shown(w->text) + "' (known: index, none)");
+    else
+      info.sync = w && w->text == "index";
+    if (ok_ && info.sync && (info.spindle0 == 0 || std::abs(info.spindle1 - info.spindle0) >
+                                                      kRelTolerance * std::abs(info.spindle0)))
+      fail(spindleAt, "a segment synchronised with the spindle (a thread pass) needs it turning at one speed, not " +
+                          number(info.spindle0) + " to " + number(info.spindle1) + " rev/min");
+    endOfLine("the synchronisation");
+  } else {
+    endOfLine("the last phase");
+  }
 
   // The geometry, rebuilt.
   Segment seg;

@@ -52,12 +52,28 @@ struct SegmentInfo {
   uint32_t move = 0;                    ///< index of the programmed move it follows
   uint32_t nextMove = 0;                ///< blends: the move it joins to (else = move)
   StopReason stop = StopReason::None;   ///< why the segment starts at rest
+  /// Lathes (Frame::Zxy): the spindle's speed at the segment's start and at
+  /// its end, rev/min (negative: turning the other way, M4), changing
+  /// linearly with time in between.
+  double spindle0 = 0, spindle1 = 0;
+  /// Lathes: a thread pass, which starts when the spindle passes its index
+  /// and moves with its turning (the spindle keeps its speed throughout).
+  bool sync = false;
 };
+
+/// What the three coordinates of a trajectory's points are. A mill's are its
+/// x, y, z. A lathe's are z, x, y (x the radius, y always 0): the ZX plane's
+/// own coordinates (geom/ArcPlane.h), so that the lathe's arcs, which turn in
+/// that plane, are arcs about the third coordinate as every reader of
+/// segments takes them, counter-clockwise as G3 in G18 (seen from +y).
+enum class Frame : uint8_t { Xyz, Zxy };
 
 struct Trajectory {
   std::string machine;    ///< the machine's name
   double tolerance = 0;   ///< mm, the path tolerance blends kept
   double cycleTime = 0.001;  ///< s, the machine's interpolation period
+  /// Zxy for a lathe, whose segments also carry the spindle (SegmentInfo).
+  Frame frame = Frame::Xyz;
   Vec3 start = Vec3::Zero();
   std::vector<Segment> segments;
   std::vector<Profile> profiles;  ///< one per segment

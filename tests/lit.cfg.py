@@ -58,6 +58,10 @@ else:
 config.substitutions.append(("%check-rs274", "python3 %s --stepnc %s" % (
     os.path.join(config.test_source_root, "backends", "check-rs274.py"),
     os.path.join(config.stepnc_tools_dir, "stepnc"))))
+# A lathe's native motion checked against its toolpath IR, played independently.
+config.substitutions.append(("%check-native-lathe", "python3 %s --stepnc %s" % (
+    os.path.join(config.test_source_root, "backends", "check-native-lathe.py"),
+    os.path.join(config.stepnc_tools_dir, "stepnc"))))
 # Open CASCADE's STEP reader reads the STEP-NC that compile --emit=stepnc writes.
 occt_read_step = os.path.join(config.stepnc_tools_dir, "stepnc-occt-read-step")
 if config.occt_available == "ON" and os.path.exists(occt_read_step):

@@ -1,5 +1,7 @@
 #include "ir/motion/LatheTime.h"
 
+#include "ir/motion/LatheSpindle.h"
+
 #include "ir/geom/TurnedShape.h"
 
 #include "ir/Program.h"
@@ -9,14 +11,12 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numbers>
 #include <optional>
 
 namespace stepnc::ir {
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
 /// Length of the pieces a cut is timed in (mm): the spindle's speed is
 /// taken at each piece's middle.
 constexpr double kPiece = 0.1;
@@ -52,22 +52,6 @@ public:
   }
 
 private:
-  /// The speed the spindle is asked for at radius `radius`, within the
-  /// step's limit and the machine's range; `clamped` when a limit holds it
-  /// below the surface speed.
-  double target(double radius, bool &clamped) const {
-    clamped = false;
-    if (!css_)
-      return constant_;
-    const double wanted = radius > 1e-9 ? css_->first / (2 * kPi * radius) : std::numeric_limits<double>::infinity();
-    const double limit = std::min(css_->second, machine_.spindleMax);
-    if (wanted > limit) {
-      clamped = true;
-      return limit;
-    }
-    return std::max(wanted, machine_.spindleMin);
-  }
-
   /// The spindle's speed after `dt` s going towards `to`.
   double towards(double to, double dt) const {
     if (!machine_.spindleAcceleration)
@@ -80,13 +64,10 @@ private:
     LatheStepTime st;
     st.step = &ws;
     st.minRpm = std::numeric_limits<double>::infinity();
-    css_.reset();
-    for (const Node &c : moves.children)
-      if (c.kind == Kind::State && c.has("surface_speed"))
-        css_ = std::make_pair(*c.number("surface_speed"), c.number("spindle_max").value_or(machine_.spindleMax));
-    constant_ = std::abs(moves.number("spindle").value_or(0));
-    if (!css_ && (constant_ > machine_.spindleMax || (constant_ > 0 && constant_ < machine_.spindleMin)))
-      violation(ws, "spindle " + formatFixed(constant_, 0) + " rev/min is outside the machine's " +
+    ask_ = LatheSpindle::of(moves, machine_);
+    const double constant = std::abs(ask_.constant);
+    if (!ask_.surfaceSpeed && (constant > machine_.spindleMax || (constant > 0 && constant < machine_.spindleMin)))
+      violation(ws, "spindle " + formatFixed(constant, 0) + " rev/min is outside the machine's " +
                         formatFixed(machine_.spindleMin, 0) + ".." + formatFixed(machine_.spindleMax, 0) + " rev/min");
     double sinceCut = 0;  // rapids before this step's first cut: time the spindle has to get to speed
     bool cutting = false;
@@ -116,7 +97,7 @@ private:
       if (!cutting) {
         // The first cut waits for the spindle to reach its speed there.
         bool clamped = false;
-        const double n = thread ? constant_ : target(std::abs(from.x()), clamped);
+        const double n = thread ? constant : ask_.at(from.x(), &clamped);
         const double ramp = machine_.spindleAcceleration ? std::abs(n - spindle_) / *machine_.spindleAcceleration : 0;
         const double wait = std::max(0.0, ramp - sinceCut);
         st.seconds += wait;
@@ -135,7 +116,7 @@ private:
       for (int k = 0; k < pieces; ++k) {
         const Vec3 mid = from + u * (ds * (k + 0.5));
         bool clamped = false;
-        const double want = thread ? constant_ : target(std::abs(mid.x()), clamped);
+        const double want = thread ? constant : ask_.at(mid.x(), &clamped);
         // The time at the speed now, then the speed after that time.
         double n = spindle_ > 0 ? spindle_ : want;
         double feed = (m.feed > 0 ? m.feed : perRev * n);
@@ -149,11 +130,11 @@ private:
         st.seconds += dt;
         r_.cutting += dt;
         r_.cutLength += ds;
-        if (clamped && css_)
+        if (clamped && ask_.surfaceSpeed)
           r_.clampedLength += ds;
         st.minRpm = std::min(st.minRpm, n);
         st.maxRpm = std::max(st.maxRpm, n);
-        if (css_ && !clamped && n < machine_.spindleMin - 1e-9 && !saidSlow_) {
+        if (ask_.surfaceSpeed && !clamped && n < machine_.spindleMin - 1e-9 && !saidSlow_) {
           saidSlow_ = true;
           violation(ws, "its surface speed asks for " + formatFixed(n, 0) + " rev/min, below the machine's " +
                             formatFixed(machine_.spindleMin, 0));
@@ -190,8 +171,7 @@ private:
   const runtime::Machine &machine_;
   runtime::Axis x_, z_;
   LatheTimeReport r_;
-  std::optional<std::pair<double, double>> css_;  ///< surface speed mm/min, spindle limit rev/min
-  double constant_ = 0;  ///< rev/min when not at constant surface speed
+  LatheSpindle ask_;      ///< what the step asks of the spindle
   double spindle_ = 0;   ///< the spindle's speed now, rev/min
   std::optional<Vec3> position_;
   bool saidSlow_ = false;

@@ -112,7 +112,10 @@ void attachMotion(ir::Module &module, const ProgramPath &program, const runtime:
       order.push_back(owner);
       motion.set("machine", ir::Value::string(trajectory.machine));
       motion.set("tolerance", ir::Value::length(trajectory.tolerance));
+      motion.set("cycle_time", ir::Value::real(trajectory.cycleTime));
       motion.set("from", ir::Value::reals(numbers(seg.start)));
+      if (trajectory.frame == runtime::Frame::Zxy)
+        motion.set("frame", ir::Value::word("zxy"));
     }
     times[owner] += prof.duration();
     ir::Node s(ir::Kind::MotionSegment);
@@ -155,6 +158,11 @@ void attachMotion(ir::Module &module, const ProgramPath &program, const runtime:
       phases.push_back(ph.jerk);
     }
     s.set("phases", ir::Value::reals(std::move(phases)));
+    if (trajectory.frame == runtime::Frame::Zxy) {
+      s.set("spindle", ir::Value::reals({info.spindle0, info.spindle1}));
+      if (info.sync)
+        s.set("sync", ir::Value::boolean(true));
+    }
     motion.add(std::move(s));
   }
   for (const ir::Node *owner : order) {
@@ -192,9 +200,14 @@ std::optional<runtime::Trajectory> readMotion(const ir::Module &module, Diagnost
     if (!any) {
       out.machine = motion->text("machine").value_or("");
       out.tolerance = motion->number("tolerance").value_or(0);
+      out.cycleTime = motion->number("cycle_time").value_or(out.cycleTime);
+      if (!(out.cycleTime > 0))
+        fail(*motion, "the machine's cycle time must be more than 0 s, not " + formatExact(out.cycleTime));
       out.start = start;
       at = start;
       any = true;
+      if (motion->text("frame") == "zxy")
+        out.frame = runtime::Frame::Zxy;
     } else if ((start - at).norm() > 1e-9) {
       fail(*motion, "motion starts at " + formatTuple({start.x(), start.y(), start.z()}, 6) +
                         ", not where the previous motion ended, " + formatTuple({at.x(), at.y(), at.z()}, 6));
@@ -206,6 +219,9 @@ std::optional<runtime::Trajectory> readMotion(const ir::Module &module, Diagnost
       if (!to || !limits || !phases)
         continue;
       const Vec3 end((*to)[0], (*to)[1], (*to)[2]);
+      std::optional<std::vector<double>> spindle;
+      if (out.frame == runtime::Frame::Zxy && !(spindle = numbersOf(s, "spindle", 2)))
+        continue;
       const std::string shape = s.text("shape").value_or("");
       Segment seg;
       if (shape == "line") {
@@ -250,6 +266,11 @@ std::optional<runtime::Trajectory> readMotion(const ir::Module &module, Diagnost
       info.limitedBy =
           runtime::speedLimitNamed(s.text("limited_by").value_or("feed")).value_or(runtime::SpeedLimit::Feed);
       info.limits = {(*limits)[0], (*limits)[1], (*limits)[2]};
+      if (spindle) {
+        info.spindle0 = (*spindle)[0];
+        info.spindle1 = (*spindle)[1];
+        info.sync = s.flag("sync").value_or(false);
+      }
       runtime::Profile prof;
       prof.v0 = s.number("v0").value_or(0);
       prof.a0 = s.number("a0").value_or(0);

@@ -322,7 +322,7 @@ void registerCompile(CLI::App &app, std::function<void(int)> setResult) {
   cmd->add_option("--machine", opts->machine,
                   "Machine to plan the motion on, for --target=native and --emit=motion-ir: a TOML\n"
                   "file (docs/machine-model.md) or a shipped machine (hsc-3axis, conventional-3axis,\n"
-                  "table-table-5axis; lathe-2axis is refused: the planner moves x, y, z);\n"
+                  "table-table-5axis, lathe-2axis: a lathe program planned in its ZX plane);\n"
                   "feed adaptation also keeps feeds within its dynamics and spindle");
   cmd->add_flag("--no-adapt-feed", opts->noAdaptFeed,
                 "Keep the programmed feeds: leave out the adapt-feed pass (docs/feed-adaptation.md)");

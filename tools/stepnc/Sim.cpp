@@ -25,9 +25,11 @@
 #include "tools/stepnc/Commands.h"
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
+#include <limits>
 
 namespace stepnc::tool {
 
@@ -74,19 +76,60 @@ std::string label(const ir::Node &e) {
   return s;
 }
 
+/// A lathe's native motion (planned by plan-motion on a lathe, axes z x y):
+/// played on the lathe's z and x axes, which checks every axis's limits, and
+/// the spindle's speeds against the machine's range.
+int playLatheMotion(const SimCommandOptions &opts, const runtime::Machine &machine, const SourceFile &source,
+                    DiagnosticEngine &diags) {
+  std::optional<runtime::Trajectory> trajectory = runtime::readNative(source, diags);
+  if (!trajectory || diags.hasErrors()) {
+    printStatus("cannot simulate " + opts.input);
+    return kExitDiagnostics;
+  }
+  if (trajectory->frame != runtime::Frame::Zxy) {
+    printToolError("sim: " + opts.input + " is motion planned for a mill (axes x y z); the lathe \"" + machine.name +
+                   "\" plays motion planned for a lathe (axes z x y)");
+    return kExitUsage;
+  }
+  if (!trajectory->machine.empty() && trajectory->machine != machine.name)
+    diags.warning({}, "the motion was planned for \"" + trajectory->machine + "\" and is played on \"" +
+                          machine.name + "\"");
+  runtime::SimOptions simOptions;
+  double lowest = std::numeric_limits<double>::infinity(), highest = 0;
+  size_t threads = 0;
+  for (const runtime::SegmentInfo &info : trajectory->info) {
+    if (simOptions.spindleRpm.size() <= info.move)
+      simOptions.spindleRpm.resize(info.move + 1, 0);
+    const double most = std::max(std::abs(info.spindle0), std::abs(info.spindle1));
+    simOptions.spindleRpm[info.move] = std::max(simOptions.spindleRpm[info.move], most);
+    if (info.feed > 0) {
+      lowest = std::min({lowest, std::abs(info.spindle0), std::abs(info.spindle1)});
+      highest = std::max(highest, most);
+    }
+    threads += info.sync;
+  }
+  const runtime::Machine frame = runtime::latheFrameMachine(machine);
+  const runtime::SimReport report = runtime::simulate(*trajectory, frame, simOptions);
+  std::string text = runtime::formatReport(report, *trajectory, frame);
+  if (std::isfinite(lowest))
+    text += "spindle while cutting: " + formatFixed(lowest, 0) + ".." + formatFixed(highest, 0) + " rev/min; " +
+            std::to_string(threads) + " thread pass segments synchronised with it\n";
+  if (const int rc = writeText(opts.output, text); rc != kExitOk)
+    return rc;
+  return report.violationCount == 0 ? kExitOk : kExitDiagnostics;
+}
+
 /// A lathe: the program's turning steps timed with their spindle
 /// (ir/motion/LatheTime.h), not played at the interpolator's cycle.
 int runLatheSim(const SimCommandOptions &opts, const runtime::Machine &machine, const std::string &machineName,
                 std::unique_ptr<SourceFile> &source, DiagnosticEngine &diags) {
-  if (source->text().starts_with("STEPNC-MOTION")) {
-    printToolError("sim: native motion is planned for a mill: a lathe times IR text or STEP-NC");
-    return kExitUsage;
-  }
   if (!opts.samples.empty() || !opts.workOffset.empty() || opts.period || opts.tolerance) {
-    printToolError("sim: on a lathe only the program is timed: --samples, --work-offset, --period and --tolerance "
-                   "are for the player of milling programs");
+    printToolError("sim: on a lathe the program is timed, or its native motion played as planned: --samples, "
+                   "--work-offset, --period and --tolerance are for the player of milling programs");
     return kExitUsage;
   }
+  if (source->text().starts_with("STEPNC-MOTION"))
+    return playLatheMotion(opts, machine, *source, diags);
   driver::SchemaSelection schemas(opts.schema);
   if (const int rc = loadSchemas(schemas, diags); rc != kExitOk)
     return rc;

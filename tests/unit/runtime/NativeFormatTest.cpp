@@ -173,7 +173,11 @@ void requireSame(const Trajectory &a, const Trajectory &b) {
     CHECK(m.move == n.move);
     CHECK(m.nextMove == n.nextMove);
     CHECK(m.stop == n.stop);
+    CHECK(m.spindle0 == n.spindle0);
+    CHECK(m.spindle1 == n.spindle1);
+    CHECK(m.sync == n.sync);
   }
+  CHECK(a.frame == b.frame);
 }
 
 /// One straight segment of 5 mm at up to 2 mm/s with a jerk of 2 mm/s^3:
@@ -245,6 +249,39 @@ TEST_CASE("a dwell reads back value for value and byte for byte, as version 2", 
   // Without a dwell the same writer writes version 1, which version 1
   // players read.
   CHECK(writeNative(sample(), "p").rfind("STEPNC-MOTION 1\n", 0) == 0);
+}
+
+TEST_CASE("a lathe's trajectory is version 3: its axes and each segment's spindle", "[native][lathe]") {
+  // The sample's segments taken as a lathe's (z, x, y), a thread pass among them.
+  Trajectory t = dwelling();
+  t.frame = Frame::Zxy;
+  t.info[0].spindle0 = 1200;
+  t.info[0].spindle1 = 1250.5;
+  t.info[1].spindle0 = 1250.5;
+  t.info[1].spindle1 = 1300;
+  t.info[2].spindle0 = t.info[2].spindle1 = -600;
+  t.info[2].sync = true;
+  const std::string text = writeNative(t, "shaft");
+  INFO(text);
+  CHECK(text.rfind("STEPNC-MOTION 3\n", 0) == 0);
+  CHECK(text.find("\ntolerance 0.01\naxes z x y\nstart ") != std::string::npos);
+  CHECK(text.find(" spindle 1200 1250.5 sync none\n") != std::string::npos);
+  CHECK(text.find(" spindle -600 -600 sync index\nend\n") != std::string::npos);
+  Read r = read(text);
+  REQUIRE(r.errors.empty());
+  REQUIRE(r.trajectory);
+  requireSame(t, *r.trajectory);
+  CHECK(writeNative(*r.trajectory, "shaft") == text);
+  // A thread pass needs one spindle speed; the axes are a mill's or a lathe's.
+  CHECK(error(replaced(text, " spindle -600 -600 sync index", " spindle -600 -610 sync index")).find(
+            "a segment synchronised with the spindle (a thread pass) needs it turning at one speed, not -600 to -610 "
+            "rev/min") != std::string::npos);
+  CHECK(error(replaced(text, "axes z x y", "axes x z y")).find("the axes are 'x y z' (a mill) or 'z x y' (a lathe)") !=
+        std::string::npos);
+  CHECK(error(replaced(text, " sync none\n", " sync maybe\n")).find("unknown synchronisation 'maybe'") !=
+        std::string::npos);
+  CHECK(error(replaced(text, " spindle 1200 1250.5 sync none", "")).find("the line ends where 'spindle' should follow") !=
+        std::string::npos);
 }
 
 TEST_CASE("native dwells are checked", "[native][dwell]") {
@@ -355,10 +392,10 @@ TEST_CASE("the native text of a small trajectory", "[native]") {
 TEST_CASE("native format mistakes are located", "[native]") {
   REQUIRE(read(kSmall).errors.empty());
   // Another version: refused at the version number.
-  CHECK(error(replaced(kSmall, "STEPNC-MOTION 1", "STEPNC-MOTION 3")) ==
-        "1:15: unsupported native format version 3; this stepnc reads versions 1 to 2");
+  CHECK(error(replaced(kSmall, "STEPNC-MOTION 1", "STEPNC-MOTION 4")) ==
+        "1:15: unsupported native format version 4; this stepnc reads versions 1 to 3");
   const std::string notMotion =
-      ": not a stepnc native motion file: the first line must be 'STEPNC-MOTION 1' or 'STEPNC-MOTION 2'";
+      ": not a stepnc native motion file: the first line must be 'STEPNC-MOTION N', N the format version (1 to 3)";
   CHECK(error("G01 X1\n") == "1:1" + notMotion);
   CHECK(error("\n" + kSmall) == "2:1" + notMotion);
   CHECK(error("") == "1:1" + notMotion);
