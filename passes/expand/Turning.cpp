@@ -15,6 +15,7 @@
 // Every rapid is checked against the stock as it stands when the rapid is
 // made (the insert's corner circles clear of it); where the straight way is
 // blocked the tool goes out radially above the stock first.
+#include "ir/Printer.h"
 #include "passes/expand/Expand.h"
 
 #include "geom/Boolean.h"
@@ -167,6 +168,62 @@ bool latheSpeedsInRange(Expander &x, const Node &ws, const Node &tech) {
                   "its maximum spindle speed", "rev/min") &&
          !outside(tech.number("spindle"), 1, ir::kPlausibleMinSpindleRpm, ir::kPlausibleMaxSpindleRpm,
                   "its spindle speed", "rev/min");
+}
+
+/// What the file may ask of a turning operation or its strategy that the
+/// strategies here do not do yet, by IR attribute, with the standard's name
+/// and what is done instead. Each one given is said at its node (an
+/// assumption: --strict refuses it), never dropped without a word.
+struct Unfollowed {
+  const char *attribute;  ///< IR name
+  const char *standard;   ///< ISO 14649-12 name
+  const char *instead;
+};
+constexpr Unfollowed kUnfollowedStrategy[] = {
+    {"overcut", "overcut_length", "passes end at the feature's extent plus stepnc's clearance"},
+    {"back_path_feed", "back_path_feed", "the tool goes back at rapid"},
+    {"lift_feed", "lift_feed", "the tool lifts at rapid"},
+    {"downward_feed", "stepover_feed", "the tool steps over at rapid and enters at the operation's feed"},
+    {"return_angle", "path_return_angle", nullptr},  // said by the operation (noteUnfollowed)
+    {"variable_depth", "variable_depth", "the depths of cut are those listed"},
+    {"variable_downward_feed", "variable_stepover_feed", "the feeds are the operation's"},
+};
+constexpr Unfollowed kUnfollowedOperation[] = {
+    {"overcut", "overcut_length", "passes end at the feature's extent plus stepnc's clearance"},
+    {"return_amount", "return_amount", "the tool withdraws 1 mm plus its corner radius clear of the stock"},
+    {"feed_ratio", "feed_ratio", "the feed is the technology's"},
+    {"start_point", "start_point", "each step starts outside the stock's corner at the free end"},
+};
+
+/// Says each attribute of `op` and its strategy that is not followed.
+void noteUnfollowed(Expander &x, const Node &ws, const Node &op) {
+  const bool threading = op.kind == ir::Kind::ThreadingRough || op.kind == ir::Kind::ThreadingFinish;
+  auto note = [&](const Node &n, const Unfollowed &u, const std::string &which) {
+    if (const ir::Value *v = n.get(u.attribute)) {
+      std::string value;
+      ir::printValue(*v, value);
+      const char *instead = u.instead ? u.instead
+                            : threading ? "a thread pass is left straight out from the axis"
+                                        : "each pass is left on stepnc's own path (45 degrees back when roughing)";
+      x.assumed(ws, n, which + " " + u.standard + " " + value + " is not followed yet: " + instead);
+    }
+  };
+  for (const Unfollowed &u : kUnfollowedOperation)
+    note(op, u, "its operation's");
+  if (const Node *s = op.child(ir::Kind::TurningStrategy)) {
+    for (const Unfollowed &u : kUnfollowedStrategy)
+      note(*s, u, "its strategy's");
+    if (s->flag("multiple_passes") == false)
+      x.assumed(ws, *s,
+                "its strategy's allow_multiple_passes false is not followed yet: the material is cut in as many "
+                "passes as the depths of cut make");
+  }
+  for (ir::Kind k : {ir::Kind::Approach, ir::Kind::Retract})
+    if (const Node *n = op.child(k))
+      x.assumed(ws, *n,
+                std::string("its ") + (k == ir::Kind::Approach ? "approach" : "retract") +
+                    " strategy is not followed yet on a lathe: the tool comes and goes at rapid on a path clear "
+                    "of the stock");
 }
 
 class TurningStep {
@@ -523,6 +580,15 @@ private:
       return false;
     }
     const bool bidirectional = strategy() && strategy()->text("type") == "bidirectional";
+    // The way back between passes: against the feed direction, at rapid.
+    if (const std::optional<Vec2> back = strategyDir("back_path_dir");
+        back && (bidirectional || back->dot(-d) < 1 - 1e-9))
+      x_.assumed(ws_, *strategy(),
+                 "its strategy's back_path_direction " + formatTuple({back->x(), back->y()}, 6) +
+                     " (z, r) is not followed yet: " +
+                     (bidirectional ? std::string("bidirectional passes have no way back")
+                                    : "the tool goes back against its feed direction " +
+                                          formatTuple({-d.x(), -d.y()}, 6) + ", at rapid, clear of the stock"));
     const std::vector<double> cuts = depths();
     if (cuts.empty())
       return false;
@@ -1429,6 +1495,7 @@ bool expandTurning(Expander &x, Node &ws, const Node &op, const std::string &set
     x.report(ws, *feature, shape.error);
     return false;
   }
+  noteUnfollowed(x, ws, op);
   Node moves = makeMoves(ws, tool->symbol, 0, coolant(op), setup);
   TurningStep step(x, ws, op, *feature, *tool, latheStock(x, *workpiece, *raw.stock), *raw.stock, *shape.shape,
                    moves);
