@@ -11,6 +11,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <set>
 
 namespace stepnc::ir {
 
@@ -368,6 +369,7 @@ private:
   bool checkThreads(const LathePlan &plan) {
     const runtime::Trajectory &t = plan.trajectory;
     bool ok = true;
+    std::set<const Node *> refused;
     for (size_t i = 0; i < t.segments.size(); ++i) {
       const runtime::SegmentInfo &info = t.info[i];
       if (!info.sync)
@@ -377,13 +379,17 @@ private:
       const double lead = item.node ? item.node->number("feed_per_rev").value_or(0) : 0;
       const std::string what = ws.kindName() + " " + ws.symbol + ": a thread pass of lead " + formatFixed(lead, 4) +
                                " mm at " + formatFixed(std::abs(info.spindle0), 0) + " rev/min";
+      // Located at the move when the file gave it (explicit toolpaths), else at the step.
+      const SourceLoc at = item.node && item.node->origin.loc.valid() ? item.node->origin.loc : ws.origin.loc;
       if (info.limits.v < info.feed * (1 - 1e-9)) {
-        diags_.error(item.node ? item.node->origin.loc : ws.origin.loc,
+        ok = false;
+        if (!refused.insert(&ws).second)
+          continue;  // once a step
+        diags_.error(at,
                      what + " moves " + formatFixed(info.feed * 60, 1) + " mm/min; the lathe \"" + lathe_.name +
                          "\" reaches " + formatFixed(info.limits.v * 60, 1) + " mm/min on it (" +
-                         std::string(runtime::speedLimitDescription(info.limitedBy)) + "): a lower spindle speed")
+                         std::string(runtime::speedLimitDescription(info.limitedBy)) + "): give the step a lower spindle speed")
             .entity(ws.origin.entityId);
-        ok = false;
         continue;
       }
       const runtime::Profile &p = t.profiles[i];
@@ -391,7 +397,7 @@ private:
       const double reached = p.at(speedUp).s, left = t.segments[i].length - p.at(speedUp + p.phases[3].duration).s;
       if ((reached > 2 * lead + 1e-9 || left > 2 * lead + 1e-9) && !warned_) {
         warned_ = true;
-        diags_.warning(item.node ? item.node->origin.loc : ws.origin.loc,
+        diags_.warning(at,
                        what + " reaches its feed " + formatFixed(reached, 3) + " mm after its start and leaves it " +
                            formatFixed(left, 3) + " mm before its end, beyond two leads (" + formatFixed(2 * lead, 3) +
                            " mm): the turns cut there have a shorter lead")
