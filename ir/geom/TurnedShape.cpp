@@ -332,6 +332,7 @@ private:
     s_.contour = path;  // from the low z wall's open end round to the high one's
     s_.grooveSpan = {lo, hi};
     s_.grooveFloor = floor;
+    s_.grooveRadii = {r1, r2};
     s_.inner = *inner;
     return true;
   }
@@ -350,8 +351,9 @@ private:
 
   /// A face groove: in a face looking towards the free end (its material
   /// side -z), its floor at the placement's z, its square-U profile's width
-  /// centred on `radius` across the axis, open towards the free end; square
-  /// corners (corner radii are not turned yet).
+  /// centred on `radius` across the axis, open towards the free end; its
+  /// corner radii first_radius at the wall nearer the axis, second_radius at
+  /// the outer one.
   bool faceGroove(const Placed &p, double side) {
     if (side > 0) {
       error_ = named(f_) + ": a face groove in a face looking towards the chuck (its material side +z) is not "
@@ -363,26 +365,35 @@ private:
       error_ = named(f_) + ": only grooves with a square_u_profile are turned yet";
       return false;
     }
-    const double mid = f_.number("radius").value_or(0), w = u->number("width").value_or(0);
-    for (const char *a : {"first_radius", "second_radius"})
-      if (u->number(a).value_or(0) > 1e-9) {
-        error_ = named(f_) + ": a face groove with rounded corners is not turned yet (square corners only)";
-        return false;
-      }
     if (!squareWalls(*u))
       return false;
+    const double mid = f_.number("radius").value_or(0), w = u->number("width").value_or(0);
+    const double r1 = u->number("first_radius").value_or(0), r2 = u->number("second_radius").value_or(0);
     const double lo = mid - w / 2, hi = mid + w / 2, z0 = p.at.x();
-    if (w <= 0 || lo < 0) {
+    if (w <= 0 || lo < 0 || r1 < 0 || r2 < 0 || r1 + r2 > w + 1e-9) {
       error_ = named(f_) + ": its width " + formatFixed(w, 4) + " mm about a radius of " + formatFixed(mid, 4) +
-               " mm makes no face groove";
+               " mm (corner radii " + formatFixed(r1, 4) + " and " + formatFixed(r2, 4) + " mm) makes no face groove";
       return false;
     }
-    s_.removal = Region{{ccwPolygon({{z0, lo}, {reachZ_, lo}, {reachZ_, hi}, {z0, hi}})}};
-    // From the outer wall's open end, down it, across the floor, up the inner wall.
-    s_.contour = {Seg::line(Vec2(reachZ_, hi), Vec2(z0, hi)), Seg::line(Vec2(z0, hi), Vec2(z0, lo)),
-                  Seg::line(Vec2(z0, lo), Vec2(reachZ_, lo))};
+    // From the outer wall's open end, down it, round its corner, across the
+    // floor, round the inner corner, up the inner wall.
+    std::vector<Seg> path;
+    path.push_back(Seg::line(Vec2(reachZ_, hi), Vec2(z0 + r2, hi)));
+    if (r2 > 0)
+      path.push_back(Seg::arc(Vec2(z0 + r2, hi), Vec2(z0, hi - r2), Vec2(z0 + r2, hi - r2), true));
+    path.push_back(Seg::line(Vec2(z0, hi - r2), Vec2(z0, lo + r1)));
+    if (r1 > 0)
+      path.push_back(Seg::arc(Vec2(z0, lo + r1), Vec2(z0 + r1, lo), Vec2(z0 + r1, lo + r1), true));
+    path.push_back(Seg::line(Vec2(z0 + r1, lo), Vec2(reachZ_, lo)));
+    std::erase_if(path, [](const Seg &s) { return (s.b - s.a).norm() <= geom::kEps && !s.isArc(); });
+    Loop l;
+    l.segs = path;
+    l.segs.push_back(Seg::line(Vec2(reachZ_, lo), Vec2(reachZ_, hi)));
+    s_.removal = Region{{l}};
+    s_.contour = path;
     s_.grooveSpan = {lo, hi};
     s_.grooveFloor = z0;
+    s_.grooveRadii = {r1, r2};
     s_.faceGroove = true;
     return true;
   }

@@ -56,6 +56,9 @@ struct TurnedShape {
   /// extent across the axis (radii) and its floor's z.
   std::optional<std::pair<double, double>> grooveSpan;
   double grooveFloor = 0;
+  /// A groove's corner radii where its floor meets the wall at the low end
+  /// of its span (first_radius) and at the high end (second_radius).
+  std::pair<double, double> grooveRadii{0, 0};
   bool faceGroove = false;
   /// A thread: its extent along the axis (lo < hi), its crest radius
   /// (where the tool starts: an outer thread's major, an inner one's minor)

@@ -1046,45 +1046,84 @@ private:
     return edges;
   }
 
+  // A groove's own frame: u along its floor (z for a radial groove, r for a
+  // face groove), v from the floor towards its open side. The grooving
+  // insert's reference corner is at the low-u end of its edge, the far one
+  // `width - 2 rc` further along u.
+
+  /// The point (u, v) of the groove's frame in the half plane.
+  Vec2 grooveWorld(double u, double v) const {
+    if (shape_.faceGroove)
+      return Vec2(shape_.grooveFloor + v, u);
+    return Vec2(u, shape_.grooveFloor + outwards() * v);
+  }
+
+  /// Whether the frame's (u, v) turn the other way round than (z, r): an
+  /// arc clockwise in the frame is then counter-clockwise in the half plane.
+  bool grooveFlipped() const { return shape_.faceGroove || shape_.inner; }
+
+  /// How close to the floor (v) a corner centre at `u` may come keeping the
+  /// allowance `a` off the floor and off a rounded corner: an insert corner
+  /// rounder than the groove's stays on the floor's straight part.
+  double grooveDepth(double u, double a) const {
+    const auto [lo, hi] = *shape_.grooveSpan;
+    const auto [rLo, rHi] = shape_.grooveRadii;
+    double v = tool_.rc + a;
+    auto corner = [&](double cu, double rho) {
+      const double reach = rho - tool_.rc - a;
+      if (reach <= 0)
+        return;
+      const double du = std::min(std::abs(u - cu), reach);
+      v = std::max(v, rho - std::sqrt(reach * reach - du * du));
+    };
+    if (u < lo + rLo)
+      corner(lo + rLo, rLo);
+    if (u > hi - rHi)
+      corner(hi - rHi, rHi);
+    return v;
+  }
+
   bool grooveRough() {
     if (!needsGroove())
       return false;
     const double a = op_.number("allowance").value_or(0);
-    const std::optional<std::vector<double>> edges = plungeEdges(a);
+    std::optional<std::vector<double>> edges = plungeEdges(a);
     if (!edges)
       return false;
-    for (double e : *edges)
-      if (!(shape_.faceGroove ? facePlunge(e, shape_.grooveFloor + a, "cut")
-                              : plunge(e, shape_.grooveFloor + outwards() * a, "cut")))
-        return false;
-    return true;
-  }
-
-  /// A face groove's finish: down its outer wall with the far corner,
-  /// across its floor, up its inner wall.
-  bool faceGrooveFinish() {
-    const auto [lo, hi] = *shape_.grooveSpan;
     const double far = tool_.width - 2 * tool_.rc;
-    const double rOuter = hi - tool_.rc - far, rInner = lo + tool_.rc, zFloor = shape_.grooveFloor + tool_.rc;
-    const Region band = geom::intersect(stock_, box(Vec2(-1e5, lo), Vec2(1e5, hi)));
-    const double top = (band.empty() ? shape_.grooveFloor : band.box().hi.x()) + tool_.rc + kLatheClearance;
-    return cutU({Vec2(top, rOuter), Vec2(zFloor, rOuter), Vec2(zFloor, rInner), Vec2(top, rInner)}, Vec2(1, 0));
-  }
-
-  /// A groove's finishing path through `corners` (down one wall, along the
-  /// floor, up the other; empty pieces dropped), entered at its first; the
-  /// stock then loses what it swept and all beyond it along `away`.
-  bool cutU(const std::vector<Vec2> &corners, const Vec2 &away) {
-    std::vector<Seg> path;
-    for (size_t i = 0; i + 1 < corners.size(); ++i)
-      if ((corners[i + 1] - corners[i]).norm() >= 1e-9)
-        path.push_back(Seg::line(corners[i], corners[i + 1]));
-    if (!cut(path.front().a, path))
-      return false;
-    removeSwept(path, away);
+    // Corners rounder than the insert's: the plunges next to the walls stop
+    // above the rounds, so the floor between them gets plunges of its own
+    // (the reference corner where both corners reach the floor's straight
+    // part, a fifth of the insert's width overlapping).
+    const auto [lo, hi] = *shape_.grooveSpan;
+    const auto [rLo, rHi] = shape_.grooveRadii;
+    if (rLo > tool_.rc + a || rHi > tool_.rc + a) {
+      const double first = lo + std::max(rLo, tool_.rc + a), last = hi - std::max(rHi, tool_.rc + a) - far;
+      if (last >= first - 1e-9) {
+        const int n = static_cast<int>(std::ceil((last - first) / (0.8 * tool_.width) - 1e-9)) + 1;
+        for (int k = 0; k < n; ++k)
+          edges->push_back((n == 1 ? first : first + (last - first) * k / (n - 1)) - tool_.rc);
+        std::sort(edges->begin(), edges->end());
+        edges->erase(std::unique(edges->begin(), edges->end(), [](double x, double y) { return y - x < 1e-6; }),
+                     edges->end());
+      }
+    }
+    for (double e : *edges) {
+      // The insert's front from the floor: as deep as both corners may go.
+      const double u = e + tool_.rc;
+      const double front = std::max(grooveDepth(u, a), grooveDepth(u + far, a)) - tool_.rc;
+      if (!(shape_.faceGroove ? facePlunge(e, shape_.grooveFloor + front, "cut")
+                              : plunge(e, shape_.grooveFloor + outwards() * front, "cut")))
+        return false;
+    }
     return true;
   }
 
+  /// A groove's finish: down the wall at the high end of its span with the
+  /// far corner (round the groove's corner there when it is rounder than
+  /// the insert's), along the floor, round the low corner and up the low
+  /// wall with the reference corner; entered at its start, the stock then
+  /// loses what it swept and all beyond it towards the open side.
   bool grooveFinish() {
     if (!needsGroove())
       return false;
@@ -1096,16 +1135,44 @@ private:
                     formatFixed(hi - lo, 4) + " mm)");
       return false;
     }
-    if (shape_.faceGroove)
-      return faceGrooveFinish();
-    // Down the free-end wall with the far corner, along the floor, up the
-    // chuck-side wall: the chuck-side corner's centre is the reference.
-    const double far = tool_.width - 2 * tool_.rc;
-    const double zHiWall = hi - tool_.rc - far, zLoWall = lo + tool_.rc, rFloor = floor + out * tool_.rc;
-    const double topR = topOver(lo);
-    const double top = (out > 0 ? std::max(topR, floor) : std::min(topR, floor)) + out * (tool_.rc + kLatheClearance);
-    return cutU({Vec2(zHiWall, top), Vec2(zHiWall, rFloor), Vec2(zLoWall, rFloor), Vec2(zLoWall, top)},
-                Vec2(0, out));
+    const double rc = tool_.rc, far = tool_.width - 2 * rc;
+    const double rLo = std::max(shape_.grooveRadii.first, rc), rHi = std::max(shape_.grooveRadii.second, rc);
+    if (hi - rHi - far < lo + rLo - 1e-9) {
+      x_.report(ws_, toolNode_,
+                "the floor of " + shape_.symbol + " between its rounded corners (" +
+                    formatFixed(std::max(0.0, hi - lo - rLo - rHi + 2 * rc), 4) + " mm for the corner centres) is " +
+                    "narrower than the edge of its grooving tool " + toolNode_.symbol + " between its corners (" +
+                    formatFixed(far, 4) + " mm): a narrower insert finishes it");
+      return false;
+    }
+    // Where the insert comes in from, clear of the stock, as v.
+    double top = 0;
+    if (shape_.faceGroove) {
+      const Region band = geom::intersect(stock_, box(Vec2(-1e5, lo), Vec2(1e5, hi)));
+      top = (band.empty() ? floor : band.box().hi.x()) + rc + kLatheClearance - floor;
+    } else {
+      const double topR = topOver(lo);
+      top = ((out > 0 ? std::max(topR, floor) : std::min(topR, floor)) + out * (rc + kLatheClearance) - floor) * out;
+    }
+    const bool ccw = grooveFlipped();  // clockwise in the frame
+    auto at = [&](double u, double v) { return grooveWorld(u, v); };
+    std::vector<Seg> path;
+    auto line = [&](const Vec2 &p, const Vec2 &q) {
+      if ((q - p).norm() >= 1e-9)
+        path.push_back(Seg::line(p, q));
+    };
+    const double uHi = hi - rc - far;
+    line(at(uHi, top), at(uHi, rHi));
+    if (rHi > rc + 1e-9)
+      path.push_back(Seg::arc(at(uHi, rHi), at(hi - rHi - far, rc), at(hi - rHi - far, rHi), ccw));
+    line(at(hi - rHi - far, rc), at(lo + rLo, rc));
+    if (rLo > rc + 1e-9)
+      path.push_back(Seg::arc(at(lo + rLo, rc), at(lo + rc, rLo), at(lo + rLo, rLo), ccw));
+    line(at(lo + rc, rLo), at(lo + rc, top));
+    if (!cut(path.front().a, path))
+      return false;
+    removeSwept(path, shape_.faceGroove ? Vec2(1, 0) : Vec2(0, out));
+    return true;
   }
 
   bool cutIn() {
