@@ -92,10 +92,31 @@ bool thick(const Region &r, double t) {
   return wide && !geom::offset(r, -t / 2).empty();
 }
 
+/// Where a region lies, as a programmer finds it: each of its separate
+/// pieces as its extent in z and r (the first three along the axis, then
+/// how many more), not one box over all of them.
 std::string where(const Region &r) {
-  const geom::Box b = r.box();
-  return "z " + formatFixed(b.lo.x(), 3) + ".." + formatFixed(b.hi.x(), 3) + ", r " + formatFixed(std::max(b.lo.y(), 0.0), 3) +
-         ".." + formatFixed(b.hi.y(), 3) + " mm";
+  auto extent = [](const geom::Box &b) {
+    return "z " + formatFixed(b.lo.x(), 3) + ".." + formatFixed(b.hi.x(), 3) + ", r " +
+           formatFixed(std::max(b.lo.y(), 0.0), 3) + ".." + formatFixed(b.hi.y(), 3) + " mm";
+  };
+  std::vector<geom::Box> pieces;
+  for (const geom::Loop &l : r.loops)
+    if (l.area() > 1e-9)  // an outer boundary (holes run the other way)
+      pieces.push_back(Region{{l}}.box());
+  if (pieces.size() <= 1)
+    return extent(r.box());
+  std::sort(pieces.begin(), pieces.end(), [](const geom::Box &a, const geom::Box &b) {
+    return a.lo.x() != b.lo.x() ? a.lo.x() < b.lo.x() : a.lo.y() < b.lo.y();
+  });
+  constexpr size_t kShown = 3;
+  std::string out;
+  for (size_t i = 0; i < pieces.size() && i < kShown; ++i)
+    out += (i == 0 ? "" : i + 1 == std::min(pieces.size(), kShown) && pieces.size() <= kShown ? " and " : "; ") +
+           extent(pieces[i]);
+  if (pieces.size() > kShown)
+    out += " and " + std::to_string(pieces.size() - kShown) + " more places";
+  return out;
 }
 
 struct Insert {
