@@ -158,6 +158,13 @@ struct Insert {
 Insert insertOf(const Node &tool, bool inner, bool face) {
   Insert in;
   const std::string type = tool.text("type").value_or("");
+  if (type == "knurling_tool") {
+    // Its wheels' rim, as wide as its cutting length along the axis,
+    // programmed at its chuck-side end; the wheels outwards from it.
+    const double w = tool.number("cutting_width").value_or(0);
+    in.skeleton = {Vec2(0, 0), Vec2(w, 0), Vec2(w, 2 * kDefaultEdge), Vec2(0, 2 * kDefaultEdge)};
+    return in;
+  }
   if (type != "turning_tool" && type != "grooving_tool" && type != "threading_tool") {
     // A drill (any axial tool) on the spindle axis, its tip the programmed
     // point: its point cone, then its body as long as its flutes.

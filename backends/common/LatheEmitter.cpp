@@ -84,13 +84,21 @@ std::optional<std::string> LatheEmitter::run(const ir::Module &module) {
         if (!numbers_.count(tool->symbol)) {
           const int n = toolNumber(*tool);
           const bool axial = !ir::isTurningStep(*e);
+          const bool knurling = tool->text("type") == "knurling_tool";
           out_.block(comment(word("T", std::to_string(n)) + " " + tool->label + ", " +
                              tool->text("type").value_or("") +
-                             (axial ? ", diameter " + formatFixed(tool->number("diameter").value_or(0), 3)
-                                    : ", corner radius " + formatFixed(tool->number("corner_radius").value_or(0), 3)) +
-                             " mm" +
+                             (axial      ? ", diameter " + formatFixed(tool->number("diameter").value_or(0), 3) + " mm"
+                              : knurling ? std::string()
+                                         : ", corner radius " +
+                                               formatFixed(tool->number("corner_radius").value_or(0), 3) + " mm") +
                              (tool->has("cutting_width")
-                                  ? ", width " + formatFixed(*tool->number("cutting_width"), 3) + " mm"
+                                  ? (knurling ? ", wheels " : ", width ") +
+                                        formatFixed(*tool->number("cutting_width"), 3) + " mm" +
+                                        (knurling ? " wide, programmed at their chuck-side end" : "")
+                                  : std::string()) +
+                             (tool->has("knurl_pitch")
+                                  ? ", " + tool->text("knurl_pattern").value_or("knurl") + " pitch " +
+                                        formatFixed(*tool->number("knurl_pitch"), 3) + " mm"
                                   : std::string()) +
                              (tool->has("thread_pitch")
                                   ? ", pitch " + formatFixed(*tool->number("thread_pitch"), 3) + " mm"

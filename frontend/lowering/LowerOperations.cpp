@@ -139,6 +139,12 @@ void Lowerer::turningToolBody(const Instance &body, Node &n) {
   } else if (body.isA("turning_threading_tool")) {
     copyReal(n, "thread_pitch", body, "threading_pitch", Value::length);
     copyAngle(n, "thread_angle", body, "threading_angle");
+  } else if (body.isA("knurling_tool")) {
+    copyReal(n, "cutting_width", body, "cutting_length", Value::length);
+    copyReal(n, "knurl_pitch", body, "pitch", Value::length);
+    if (auto pattern = body.enumeration("knurl_pattern_type"); pattern && (*pattern == "straight" ||
+                                                                         *pattern == "diagonal" || *pattern == "diamond"))
+      n.set("knurl_pattern", Value::word(*pattern));
   }
 }
 

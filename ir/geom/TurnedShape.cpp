@@ -125,6 +125,7 @@ public:
     case Kind::GeneralRevolution: return generalRevolution() ? ok() : fail();
     case Kind::RoundHole: return roundHole(*p) ? ok() : fail();
     case Kind::RevolvedRound: return revolvedRound(*p) ? ok() : fail();
+    case Kind::Knurl: return knurl(*p) ? ok() : fail();
     default:
       error_ = named(f_) + " has no turned shape in stepnc yet (docs/turning.md lists the features turned)";
       return fail();
@@ -395,6 +396,33 @@ private:
     s_.grooveFloor = z0;
     s_.grooveRadii = {r1, r2};
     s_.faceGroove = true;
+    return true;
+  }
+
+  /// A knurl rolled on an outer diameter: from its placement along its axis
+  /// over its length, at its major diameter (else its nominal one), its
+  /// teeth tooth_depth deep.
+  bool knurl(const Placed &p) {
+    const double d = f_.number("major_diameter").value_or(f_.number("nominal_diameter").value_or(0));
+    const double length = f_.number("length").value_or(0), depth = f_.number("tooth_depth").value_or(0);
+    if (d <= 0) {
+      error_ = named(f_) + " needs the diameter it is rolled on (its major_diameter or nominal_diameter)";
+      return false;
+    }
+    if (length <= 0) {
+      error_ = named(f_) + " needs its length (its partial area's)";
+      return false;
+    }
+    if (depth <= 0 || depth >= d / 2) {
+      error_ = named(f_) + " needs a tooth_depth between 0 and its radius " + formatFixed(d / 2, 4) + " mm, not " +
+               formatFixed(depth, 4) + " mm";
+      return false;
+    }
+    const double r = d / 2, z0 = p.at.x(), z1 = p.at.x() + p.sign * length;
+    const double lo = std::min(z0, z1), hi = std::max(z0, z1);
+    s_.removal = Region{{ccwPolygon({{lo, r - depth}, {hi, r - depth}, {hi, r}, {lo, r}})}};
+    s_.contour = {Seg::line(Vec2(hi, r), Vec2(lo, r))};
+    s_.knurl = TurnedShape::KnurlSpan{lo, hi, r, depth};
     return true;
   }
 

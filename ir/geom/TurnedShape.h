@@ -72,6 +72,13 @@ struct TurnedShape {
     bool leftHand = false;
   };
   std::optional<ThreadSpan> thread;
+  /// A knurl: its extent along the axis (lo < hi), the radius it is rolled
+  /// on and its teeth's depth. Its band, that depth in from the radius over
+  /// the extent, is its `removal`: the wheels press the teeth in there.
+  struct KnurlSpan {
+    double lo = 0, hi = 0, radius = 0, depth = 0;
+  };
+  std::optional<KnurlSpan> knurl;
   /// A face whose material is on the free end's side: it looks towards the
   /// chuck, and only parting off (cutting in) makes it.
   bool towardsChuck = false;

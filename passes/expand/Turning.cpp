@@ -52,6 +52,7 @@ Vec3 space(const Vec2 &p) { return Vec3(p.y(), 0, p.x()); }
 struct LatheTool {
   bool grooving = false;
   bool threading = false;
+  bool knurling = false;
   double rc = 0;     ///< nose (corner) radius
   double width = 0;  ///< a grooving insert's cutting width
   double maxDepth = 0;
@@ -256,6 +257,14 @@ public:
                          : "its threading tool " + toolNode_.symbol + " only cuts threads");
       return false;
     }
+    const bool knurlOp = op_.kind == ir::Kind::Knurling;
+    if (tool_.knurling != knurlOp) {
+      x_.report(ws_, toolNode_,
+                knurlOp ? "knurling needs a knurling tool; " + toolNode_.symbol + " is a " +
+                              toolNode_.text("type").value_or("")
+                        : "its knurling tool " + toolNode_.symbol + " only rolls knurls");
+      return false;
+    }
     if (shape_.inner && !holeToBore())
       return false;
     bool ok = false;
@@ -269,6 +278,7 @@ public:
     case ir::Kind::CuttingIn: ok = cutIn(); break;
     case ir::Kind::ThreadingRough: ok = threading(false); break;
     case ir::Kind::ThreadingFinish: ok = threading(true); break;
+    case ir::Kind::Knurling: ok = knurl(); break;
     default:
       x_.report(ws_, op_,
                 "its operation " + op_.kindName() + " '" + op_.label +
@@ -309,11 +319,21 @@ private:
       const double half = toolNode_.number("thread_angle").value_or(60) * kPi / 360;
       tool_.flank = std::tan(half) * toolNode_.number("max_cutting_depth").value_or(5.0);
       return true;
+    } else if (type == "knurling_tool") {
+      // Its wheels' rim, as wide along the axis as its cutting length,
+      // programmed at its chuck-side end; the rim's ends a micrometre in
+      // from the wheels' edges, which meet the knurl's ends exactly.
+      tool_.knurling = true;
+      tool_.rc = 0;
+      tool_.width = toolNode_.number("cutting_width").value_or(0);
+      const double in = std::min(1e-3, tool_.width / 2);
+      tool_.corners = {Vec2(in, 0), Vec2(tool_.width - in, 0)};
+      return true;
     } else if (type != "turning_tool") {
       x_.report(ws_, toolNode_,
                 "its tool " + toolNode_.symbol + " is a " + type +
                     ": stepnc turns with turning tools, grooves and cuts in with grooving tools, threads with "
-                    "threading tools");
+                    "threading tools, knurls with knurling tools");
       return false;
     }
     // Inside a bore the corner's imaginary tip is on its side away from the axis.
@@ -1172,6 +1192,51 @@ private:
     if (!cut(path.front().a, path))
       return false;
     removeSwept(path, shape_.faceGroove ? Vec2(1, 0) : Vec2(0, out));
+    return true;
+  }
+
+  /// Knurling: the wheels pressed in at the knurl's free-end end to its
+  /// teeth's depth, fed along it towards the chuck at the feed per
+  /// revolution, and lifted straight out at its other end.
+  bool knurl() {
+    if (!shape_.knurl) {
+      x_.report(ws_, feature_, "knurling rolls a knurl; " + shape_.symbol + " is a " + feature_.kindName());
+      return false;
+    }
+    const ir::TurnedShape::KnurlSpan k = *shape_.knurl;
+    const double w = tool_.width;
+    if (w > k.hi - k.lo + 1e-9) {
+      x_.report(ws_, toolNode_,
+                "the wheels of its knurling tool " + toolNode_.symbol + " (" + formatFixed(w, 4) +
+                    " mm wide) are wider than " + shape_.symbol + " (" + formatFixed(k.hi - k.lo, 4) + " mm)");
+      return false;
+    }
+    // The wheels roll their own pitch and pattern.
+    const std::optional<double> toolPitch = toolNode_.number("knurl_pitch"),
+                                pitch = feature_.number("diametral_pitch");
+    if (toolPitch && pitch && std::abs(*toolPitch - *pitch) > 1e-6)
+      x_.assumed(ws_, toolNode_,
+                 "its knurling tool " + toolNode_.symbol + " rolls a pitch of " + formatFixed(*toolPitch, 4) +
+                     " mm, not the " + formatFixed(*pitch, 4) + " mm of " + shape_.symbol +
+                     ": the knurl gets the wheels' pitch");
+    const std::optional<std::string> toolPattern = toolNode_.text("knurl_pattern"),
+                                     pattern = feature_.text("pattern");
+    if (toolPattern && pattern && *pattern != "tool" && *toolPattern != *pattern)
+      x_.assumed(ws_, toolNode_,
+                 "its knurling tool " + toolNode_.symbol + " rolls a " + *toolPattern + " pattern, not the " +
+                     *pattern + " one of " + shape_.symbol + ": the knurl gets the wheels' pattern");
+    // The rim presses into the knurl's band and touches the part along its
+    // bottom: that is the knurl, so the moves in are not held off the part
+    // as a cutting insert's are (cut()).
+    const double rim = k.radius - k.depth, clear = k.radius + kLatheClearance;
+    const Vec2 start(k.hi - w, rim), end(k.lo, rim);
+    if (!travel(Vec2(start.x(), clear)))
+      return false;
+    w_.feed(start, perRev_, "plunge");
+    w_.feed(end, perRev_, "cut");
+    dwell();
+    w_.feed(Vec2(end.x(), clear), perRev_, "retract");
+    removeSwept({Seg::line(Vec2(start.x(), clear), start), Seg::line(start, end)}, Vec2(0, 1));
     return true;
   }
 
