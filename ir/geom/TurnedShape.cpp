@@ -562,10 +562,6 @@ private:
     const std::optional<bool> inner = innerSide("rounds");
     if (!inner)
       return false;
-    if (*inner) {
-      error_ = named(f_) + ": its material lies away from the axis: inner rounds are not turned yet";
-      return false;
-    }
     const Node *prof = f_.child(Kind::PartialCircularProfile);
     const double r = prof ? prof->number("radius").value_or(0) : 0;
     const double sweep = prof ? prof->number("sweep_angle").value_or(90) : 90;
@@ -584,8 +580,29 @@ private:
                            "turned (no tool reaches it from the free end)";
       return false;
     }
-    // From the face (the free end's side) round the arc onto the diameter.
     const double z0 = p.at.x();
+    if (*inner) {
+      // An edge of a bore (its material away from the axis): the face's
+      // edge at the bore's mouth, or a shoulder's inside it. From the face
+      // round the arc into the bore, the round's centre out from the edge.
+      const Vec2 onFace(z0, corner + r), onBore(z0 - r, corner), c(z0 - r, corner + r);
+      Loop l;
+      l.segs = {Seg::arc(onFace, onBore, c, false), Seg::line(onBore, Vec2(z0 - r, 0)),
+                Seg::line(Vec2(z0 - r, 0), Vec2(reachZ_, 0)), Seg::line(Vec2(reachZ_, 0), Vec2(reachZ_, corner + r)),
+                Seg::line(Vec2(reachZ_, corner + r), onFace)};
+      if (l.area() <= 0) {
+        error_ = named(f_) + ": its round bounds no material";
+        return false;
+      }
+      s_.removal = Region{{l}};
+      // The surface: in along the face onto the round, round it, on into
+      // the bore (a radius of each, tangent to the round).
+      s_.contour = {Seg::line(Vec2(z0, corner + 2 * r), onFace), Seg::arc(onFace, onBore, c, false),
+                    Seg::line(onBore, Vec2(z0 - 2 * r, corner))};
+      s_.inner = true;
+      return true;
+    }
+    // From the face (the free end's side) round the arc onto the diameter.
     const Vec2 onFace(z0, corner - r), onDiameter(z0 - r, corner), c(z0 - r, corner - r);
     Loop l;
     l.segs = {Seg::arc(onDiameter, onFace, c, false), Seg::line(onFace, Vec2(reachZ_, corner - r)),
