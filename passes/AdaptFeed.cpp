@@ -95,8 +95,18 @@ public:
         return {false, false};
     }
     CutOptions options{&*data, machine ? &*machine : nullptr};
+    // The planner moves a milling tool in x, y, z: on a lathe (or a generic
+    // chain) the feeds are not bounded by a plan, nor the steps timed here
+    // (plan-motion and sim plan and time a lathe's steps in its ZX plane).
+    std::optional<runtime::Machine> planned = machine;
+    if (machine && !machine->whyNotThreeAxis().empty()) {
+      planned.reset();
+      notPlanned_ = true;
+      report_.push_back("the machine \"" + machine->name + "\" is no 3-axis mill: feeds not bounded by its dynamics "
+                        "here and steps not timed (plan-motion and sim do, docs/turning.md for a lathe)");
+    }
     const CutAnalysis before = analyseCuts(module, options);
-    const std::map<const ir::Node *, double> timeBefore = stepTimes(module, machine);
+    const std::map<const ir::Node *, double> timeBefore = stepTimes(module, planned);
 
     std::map<const ir::Node *, StepFigures> figures;
     long long split = 0, lowered = 0, raised = 0;
@@ -158,15 +168,15 @@ public:
     // Lower feeds change the plan (blends, look-ahead), and so what the
     // machine reaches: cap again until the plan reaches every feed left.
     long long dynamics = 0;
-    for (int round = 0; machine && round < kCapRounds; ++round) {
-      const long long capped = capByDynamics(module, *machine);
+    for (int round = 0; planned && round < kCapRounds; ++round) {
+      const long long capped = capByDynamics(module, *planned);
       dynamics += capped;
       if (capped == 0)
         break;
     }
 
     const CutAnalysis after = analyseCuts(module, options);
-    const std::map<const ir::Node *, double> timeAfter = stepTimes(module, machine);
+    const std::map<const ir::Node *, double> timeAfter = stepTimes(module, planned);
     for (const CutStep &step : after.steps) {
       StepFigures &f = figures[step.executable];
       f.timeAfter = timeAfter.count(step.executable) ? timeAfter.at(step.executable) : 0;
@@ -177,9 +187,9 @@ public:
           f.torqueAfter = std::max(f.torqueAfter, s.torque);
         }
       if (step.tool && step.tool->mill && f.limitedLength.size())
-        writeComment(*const_cast<ir::Node *>(step.movesNode), f, machine.has_value());
+        writeComment(*const_cast<ir::Node *>(step.movesNode), f, planned.has_value());
     }
-    writeReport(before, after, figures, machine ? machine->name : std::string());
+    writeReport(before, after, figures, planned ? planned->name : std::string());
 
     double total0 = 0, total1 = 0;
     for (const auto &[exec, f] : figures) {
@@ -190,7 +200,7 @@ public:
     stats["feeds lowered"] = lowered;
     stats["feeds raised"] = raised;
     stats["feeds capped by machine dynamics"] = dynamics;
-    if (machine) {
+    if (planned) {
       stats["cycle time before (ms)"] = (long long)std::llround(total0 * 1000);
       stats["cycle time after (ms)"] = (long long)std::llround(total1 * 1000);
     }
@@ -395,10 +405,11 @@ private:
         line += (i ? ", " : " ") + tool.defaulted[i];
       report_.push_back(line);
     }
-    report_.push_back(machineName.empty() ? std::string("no machine: feeds not bounded by machine dynamics "
-                                                        "or spindle; no cycle times "
-                                                        "(give adapt-feed<machine=...> or --machine)")
-                                          : "cycle times planned on " + machineName);
+    if (!machineName.empty())
+      report_.push_back("cycle times planned on " + machineName);
+    else if (!notPlanned_)  // a machine the planner does not move said so already
+      report_.push_back("no machine: feeds not bounded by machine dynamics or spindle; no cycle times "
+                        "(give adapt-feed<machine=...> or --machine)");
     report_.push_back("workingstep: time before -> after (s), h_max before -> "
                       "after (mm), F_max before -> after (N), "
                       "feed limited by (share of cutting length)");
@@ -428,6 +439,7 @@ private:
   }
 
   std::string machineSpec_;
+  bool notPlanned_ = false;  ///< a machine given that the planner does not move (a lathe)
   bool allowIncrease_ = false;
   std::unique_ptr<SourceFile> machineFile_;
 };
