@@ -73,6 +73,7 @@ private:
     ir::attachMotion(module, plan->program, plan->trajectory);
     count(plan->program, plan->trajectory, stats);
     stats["spindle waits"] = plan->spindleWaits;
+    stats["planning rounds"] = plan->rounds;
     return {true, true};
   }
 

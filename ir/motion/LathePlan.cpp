@@ -106,6 +106,7 @@ public:
       return std::nullopt;
     LathePlan out;
     for (int round = 0;; ++round) {
+      out.rounds = round + 1;
       out.program = path();
       out.trajectory = runtime::plan(out.program.path, frame_, options_);
       out.trajectory.frame = runtime::Frame::Zxy;

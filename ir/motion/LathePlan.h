@@ -35,6 +35,7 @@ struct LathePlan {
   ProgramPath program;
   runtime::Trajectory trajectory;  ///< Frame::Zxy, each segment with its spindle
   int spindleWaits = 0;            ///< dwells added for the spindle to reach a cut's speed
+  int rounds = 0;                  ///< plans made (each after slowing cuts and adding waits)
 };
 
 /// Plans the lathe program `module` on the lathe `machine`. Errors (a step
