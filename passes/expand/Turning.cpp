@@ -250,21 +250,9 @@ public:
       return false;
     }
     const bool threadOp = op_.kind == ir::Kind::ThreadingRough || op_.kind == ir::Kind::ThreadingFinish;
-    if (tool_.threading != threadOp) {
-      x_.report(ws_, toolNode_,
-                threadOp ? "threading needs a threading tool; " + toolNode_.symbol + " is a " +
-                               toolNode_.text("type").value_or("")
-                         : "its threading tool " + toolNode_.symbol + " only cuts threads");
+    if (!toolFor(tool_.threading, threadOp, "threading", "cuts threads") ||
+        !toolFor(tool_.knurling, op_.kind == ir::Kind::Knurling, "knurling", "rolls knurls"))
       return false;
-    }
-    const bool knurlOp = op_.kind == ir::Kind::Knurling;
-    if (tool_.knurling != knurlOp) {
-      x_.report(ws_, toolNode_,
-                knurlOp ? "knurling needs a knurling tool; " + toolNode_.symbol + " is a " +
-                              toolNode_.text("type").value_or("")
-                        : "its knurling tool " + toolNode_.symbol + " only rolls knurls");
-      return false;
-    }
     if (shape_.inner && !holeToBore())
       return false;
     bool ok = false;
@@ -293,6 +281,18 @@ public:
 
 private:
   // --- reading the step ---------------------------------------------------------
+
+  /// A threading or knurling tool (`toolIs`) works its own operation only,
+  /// and that operation (`opIs`) needs it: else an error at the tool.
+  bool toolFor(bool toolIs, bool opIs, const std::string &process, const char *only) {
+    if (toolIs == opIs)
+      return true;
+    x_.report(ws_, toolNode_,
+              opIs ? process + " needs a " + process + " tool; " + toolNode_.symbol + " is a " +
+                         toolNode_.text("type").value_or("")
+                   : "its " + process + " tool " + toolNode_.symbol + " only " + only);
+    return false;
+  }
 
   bool readTool() {
     const std::string type = toolNode_.text("type").value_or("");
