@@ -76,6 +76,55 @@ std::string label(const ir::Node &e) {
   return s;
 }
 
+/// The program of an IR or STEP-NC input, with what it lacks made: its
+/// moves (the toolpath pipeline on the machine) and, with `motion`, its
+/// planned motion (plan-motion; planned again when --tolerance asks). Null
+/// after reporting why, with the exit status in `rc`.
+std::unique_ptr<ir::Module> loadProgram(const SimCommandOptions &opts, std::unique_ptr<SourceFile> &source,
+                                        const std::string &machineName, bool motion, DiagnosticEngine &diags,
+                                        int &rc) {
+  driver::SchemaSelection schemas(opts.schema);
+  if ((rc = loadSchemas(schemas, diags)) != kExitOk)
+    return nullptr;
+  std::string usageError;
+  std::unique_ptr<ir::Module> module =
+      driver::loadModule(source, schemas, diags, usageError, nullptr, lowering::LowerOptions{opts.units.conventions()});
+  if (!module) {
+    rc = usageError.empty() ? kExitDiagnostics : kExitUsage;
+    if (!usageError.empty())
+      printToolError(usageError);
+    return nullptr;
+  }
+  bool hasMoves = false, hasMotion = false;
+  for (const ir::Node *e : ir::programOrder(*module)) {
+    hasMoves |= e->child(ir::Kind::Moves) != nullptr;
+    hasMotion |= e->child(ir::Kind::Motion) != nullptr;
+  }
+  std::vector<std::string> passes;
+  if (!hasMoves) {
+    driver::ToolpathPipelineOptions toolpath;
+    toolpath.machine = machineName;
+    toolpath.allowOutOfRange = opts.allowOutOfRange;
+    passes.push_back(driver::toolpathPipeline(toolpath));
+  }
+  if (motion && (!hasMotion || opts.tolerance))
+    passes.push_back(driver::planMotionPipeline(machineName, opts.tolerance));
+  if (!passes.empty()) {
+    std::string pipeline = passes[0];
+    for (size_t k = 1; k < passes.size(); ++k)
+      pipeline += "," + passes[k];
+    driver::PipelineRun run;
+    run.log = &std::cerr;
+    if ((rc = driver::runPipeline(*module, pipeline, run, diags, usageError)) != kExitOk) {
+      if (rc == kExitUsage)
+        printToolError(usageError);
+      return nullptr;
+    }
+  }
+  rc = kExitOk;
+  return module;
+}
+
 /// A lathe's native motion (planned by plan-motion on a lathe, axes z x y):
 /// played on the lathe's z and x axes, which checks every axis's limits, and
 /// the spindle's speeds against the machine's range.
@@ -130,34 +179,10 @@ int runLatheSim(const SimCommandOptions &opts, const runtime::Machine &machine, 
   }
   if (source->text().starts_with("STEPNC-MOTION"))
     return playLatheMotion(opts, machine, *source, diags);
-  driver::SchemaSelection schemas(opts.schema);
-  if (const int rc = loadSchemas(schemas, diags); rc != kExitOk)
+  int rc = kExitOk;
+  std::unique_ptr<ir::Module> module = loadProgram(opts, source, machineName, false, diags, rc);
+  if (!module)
     return rc;
-  std::string usageError;
-  std::unique_ptr<ir::Module> module =
-      driver::loadModule(source, schemas, diags, usageError, nullptr, lowering::LowerOptions{opts.units.conventions()});
-  if (!module) {
-    if (usageError.empty())
-      return kExitDiagnostics;
-    printToolError(usageError);
-    return kExitUsage;
-  }
-  bool hasMoves = false;
-  for (const ir::Node *e : ir::programOrder(*module))
-    hasMoves |= e->child(ir::Kind::Moves) != nullptr;
-  if (!hasMoves) {
-    driver::ToolpathPipelineOptions toolpath;
-    toolpath.machine = machineName;
-    toolpath.allowOutOfRange = opts.allowOutOfRange;
-    driver::PipelineRun run;
-    run.log = &std::cerr;
-    if (const int rc = driver::runPipeline(*module, driver::toolpathPipeline(toolpath), run, diags, usageError);
-        rc != kExitOk) {
-      if (rc == kExitUsage)
-        printToolError(usageError);
-      return rc;
-    }
-  }
   for (const ir::Node *e : ir::programOrder(*module))
     if (e->child(ir::Kind::Moves) && !ir::isTurningStep(*e) && !ir::drillsOnTurningAxis(*e)) {
       diags.error(e->origin.loc, e->kindName() + " " + e->symbol + " mills or drills off the spindle axis: the lathe \"" +
@@ -217,44 +242,10 @@ int runSim(const SimCommandOptions &opts) {
   if (source->text().starts_with("STEPNC-MOTION")) {
     trajectory = runtime::readNative(*source, diags);
   } else {
-    driver::SchemaSelection schemas(opts.schema);
-    if (const int rc = loadSchemas(schemas, diags); rc != kExitOk)
+    int rc = kExitOk;
+    module = loadProgram(opts, source, machineName, true, diags, rc);
+    if (!module)
       return rc;
-    std::string usageError;
-    module = driver::loadModule(source, schemas, diags, usageError, nullptr,
-                                lowering::LowerOptions{opts.units.conventions()});
-    if (!module) {
-      if (usageError.empty())
-        return kExitDiagnostics;
-      printToolError(usageError);
-      return kExitUsage;
-    }
-    // Whatever the input lacks is made: moves, then the motion.
-    bool hasMoves = false, hasMotion = false;
-    for (const ir::Node *e : ir::programOrder(*module)) {
-      hasMoves |= e->child(ir::Kind::Moves) != nullptr;
-      hasMotion |= e->child(ir::Kind::Motion) != nullptr;
-    }
-    std::string pipeline;
-    if (!hasMoves) {
-      driver::ToolpathPipelineOptions toolpath;
-      toolpath.machine = machineName;
-      toolpath.allowOutOfRange = opts.allowOutOfRange;
-      pipeline = driver::toolpathPipeline(toolpath) + ",";
-    }
-    if (!hasMotion || opts.tolerance)
-      pipeline += driver::planMotionPipeline(machineName, opts.tolerance);
-    else if (!pipeline.empty())
-      pipeline.pop_back();
-    if (!pipeline.empty()) {
-      driver::PipelineRun run;
-      run.log = &std::cerr;
-      if (const int rc = driver::runPipeline(*module, pipeline, run, diags, usageError); rc != kExitOk) {
-        if (rc == kExitUsage)
-          printToolError(usageError);
-        return rc;
-      }
-    }
     trajectory = ir::readMotion(*module, diags);
     program = ir::programPath(*module);
   }
