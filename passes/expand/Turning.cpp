@@ -525,11 +525,16 @@ private:
       }
     if (away)
       for (const Seg &s : path) {
+        // From the corner centres' path, its ends drawn out along it by the
+        // corner radius (the insert is at least as wide as its corner
+        // circle beyond it: the edges above a pass's end cut to there too).
         const Vec2 far = *away * 2 * (raw_.radius + raw_.z1 - raw_.z0 + 10);
-        Loop l = geom::polygon({s.a, s.b, s.b + far, s.a + far});
+        const Vec2 a = s.isArc() ? s.a : Vec2(s.a - s.tangent(0) * tool_.rc);
+        const Vec2 b = s.isArc() ? s.b : Vec2(s.b + s.tangent(1) * tool_.rc);
+        Loop l = geom::polygon({a, b, b + far, a + far});
         if (std::abs(l.area()) > 1e-12) {
           if (l.area() < 0)
-            l = geom::polygon({s.a + far, s.b + far, s.b, s.a});
+            l = geom::polygon({a + far, b + far, b, a});
           // Towards the axis (inside a bore) it stops there: what lies past
           // it is the other side's, which the mirror image gives.
           parts.push_back(away->y() < 0 ? nearSide(Region{{l}}) : Region{{l}});
@@ -745,17 +750,45 @@ private:
     // (lines clipped to that band; arcs whole or not at all).
     geom::SegIndex surface(shape_.contour);
     const Region band = geom::sweptDisc(shape_.contour, off + 1e-5);
+    // Only on the side of the surface the step removes: the boundary of other material kept
+    // (a neighbour's stock) may lie as far from the surface on the part's side.
+    auto side = [&](const Vec2 &p) {
+      const Seg *nearest = nullptr;
+      Vec2 q = Vec2::Zero();
+      for (const Seg &sg : shape_.contour)
+        if (const Vec2 c = geom::closestPoint(sg, p); !nearest || (c - p).norm() < (q - p).norm()) {
+          nearest = &sg;
+          q = c;
+        }
+      Vec2 t = nearest->b - nearest->a;
+      if (nearest->isArc()) {
+        const Vec2 r = q - nearest->c;
+        t = nearest->turn > 0 ? Vec2(-r.y(), r.x()) : Vec2(r.y(), -r.x());
+      }
+      return geom::cross(t, p - q) > 0;
+    };
+    bool removalLeft = true;
+    for (const Seg &sg : shape_.contour) {
+      // The first piece with the removal on one side only says which.
+      const Vec2 normal(-sg.tangent(0.5).y(), sg.tangent(0.5).x());
+      const bool left = removal_.contains(sg.at(0.5) + normal * 1e-3), right = removal_.contains(sg.at(0.5) - normal * 1e-3);
+      if (left != right) {
+        removalLeft = left;
+        break;
+      }
+    }
     std::vector<Seg> along;
     for (const Loop &l : forbidden.loops)
       for (const Seg &s : l.segs) {
         if (s.isArc()) {
           if (std::abs(surface.distance(s.at(0.5)) - off) < 1e-5 && std::abs(surface.distance(s.a) - off) < 1e-5 &&
-              std::abs(surface.distance(s.b) - off) < 1e-5)
+              std::abs(surface.distance(s.b) - off) < 1e-5 && side(s.at(0.5)) == removalLeft)
             along.push_back(s);
           continue;
         }
         for (const Seg &piece : geom::clip(band, s.a, s.b))
-          if ((piece.b - piece.a).norm() > 1e-7 && std::abs(surface.distance(piece.at(0.5)) - off) < 1e-5)
+          if ((piece.b - piece.a).norm() > 1e-7 && std::abs(surface.distance(piece.at(0.5)) - off) < 1e-5 &&
+              side(piece.at(0.5)) == removalLeft)
             along.push_back(piece);
       }
     if (along.empty())
@@ -881,6 +914,13 @@ private:
       const Vec2 toNose = Vec2(-t0.y(), t0.x()) * (*noseLeft_ ? tool_.rc : -tool_.rc);
       const Vec2 onPart = path->front().a - toNose;
       entry = onPart - t0 * std::max(kLatheClearance, 2 * tool_.rc) - tool_.tip;
+    }
+    if (!onSurface && (!clearOfMaterial(entry) || !spares(entry, path->front().a))) {
+      // A nose larger than the clearance still touches the stock a
+      // clearance back from where the pass meets it: back by its radius more.
+      const Vec2 further = path->front().a - t0 * (kLatheClearance + tool_.rc);
+      if (clearOfMaterial(further) && spares(further, path->front().a))
+        entry = further;
     }
     if (!clearOfMaterial(entry) || !spares(entry, path->front().a)) {
       // Where the surface's tangent runs into the part (a round starting at
