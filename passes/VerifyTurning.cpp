@@ -343,15 +343,20 @@ private:
 
   /// After a finishing step: the material left in the feature's removal
   /// beyond its allowance is an error where the insert could have reached
-  /// it, a warning in corners narrower than its nose.
+  /// it, a warning in corners narrower than its nose (corners of the part,
+  /// or of the part and another feature's material still there).
   void finished(const Node &ws, const Workpiece &w, const ir::TurnedShape &s, const Insert &insert, double allowance,
                 double t) {
     const Region left = geom::subtract(geom::intersect(w.stock, s.removal), geom::growExact(w.part, allowance + t));
     if (!thick(left, t))
       return;
+    // What the step had to leave: the part, and the stock outside its
+    // feature's removal (another feature's material, not cut yet, which the
+    // strategies do not touch): a corner it makes with the surface is as
+    // much out of the nose's reach as one the part makes.
     const double reach = insert.rc + allowance;
-    const Region corners =
-        reach > 0 ? geom::shrinkExact(geom::growExact(w.part, reach), reach) : w.part;
+    const Region kept = geom::unite(w.part, geom::subtract(w.stock, s.removal));
+    const Region corners = reach > 0 ? geom::shrinkExact(geom::growExact(kept, reach), reach) : kept;
     const Region missed = geom::subtract(left, corners);
     if (thick(missed, t)) {
       error(ws, s.symbol + " is left uncut beyond its allowance at " + where(missed));
