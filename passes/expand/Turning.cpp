@@ -886,7 +886,11 @@ private:
       for (const Seg &s : *path)
         for (Region &r : geom::sweptDiscParts(s, tool_.rc + tool_.maxDepth))
           parts.push_back(std::move(r));
-      const Region left = geom::subtract(geom::intersect(stock_, removal_), withMirror(geom::uniteAll(parts)));
+      // What the pass leaves that it should cut: not the allowance it
+      // leaves on purpose (a corner of it lies farther from the pass).
+      const Region left = geom::subtract(
+          geom::subtract(geom::intersect(stock_, removal_), withMirror(geom::uniteAll(parts))),
+          withMirror(grown(keepRegion(), a + 1e-3)));
       if (left.area() > 1e-6) {
         x_.report(ws_, "the pass along " + shape_.symbol + " would cut more than its tool " + toolNode_.symbol +
                            " cuts in one pass (" + formatFixed(tool_.maxDepth, 4) + " mm): rough it first");
