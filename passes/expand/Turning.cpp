@@ -939,9 +939,11 @@ private:
     }
     if (!cut(entry, *path, role))
       return false;
-    // Off the surface along its normal away from the part, else on along its tangent.
+    // Off the surface along its normal away from the part (the side the
+    // nose is on), else on along its tangent. (Not towards the part where
+    // that only grazes the stock: it dips into the allowance.)
     const Vec2 end = path->back().b;
-    Vec2 normal(-t1.y(), t1.x());
+    Vec2 normal = Vec2(-t1.y(), t1.x()) * (*noseLeft_ ? 1.0 : -1.0);
     if (!spares(end, end + normal * kLatheClearance))
       normal = -normal;
     if (!leave(end, normal, t1, kLatheClearance, true))
