@@ -10,7 +10,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numbers>
 #include <set>
 
 namespace stepnc::ir {
@@ -47,19 +46,7 @@ struct Item {
 };
 
 /// A point of a move `t` (0..1) of the way along it, in IR coordinates.
-Vec3 along(const Move &m, double t) {
-  const Vec3 from = *m.from;
-  if (m.kind != MoveKind::Arc)
-    return from + t * (m.to - from);
-  const Vec3 c = m.plane.local(m.center), p0 = m.plane.local(from), p1 = m.plane.local(m.to);
-  const double a0 = std::atan2(p0.y() - c.y(), p0.x() - c.x()), a1 = std::atan2(p1.y() - c.y(), p1.x() - c.x());
-  constexpr double kTurn = 2 * std::numbers::pi;
-  double sweep = m.ccw ? a1 - a0 : a0 - a1;
-  sweep = std::fmod(std::fmod(sweep, kTurn) + kTurn, kTurn);
-  const double r = std::hypot(p0.x() - c.x(), p0.y() - c.y());
-  const double a = a0 + (m.ccw ? 1 : -1) * t * sweep;
-  return m.plane.world(Vec3(c.x() + r * std::cos(a), c.y() + r * std::sin(a), p0.z() + t * (p1.z() - p0.z())));
-}
+Vec3 along(const Move &m, double t) { return t >= 1 ? m.to : m.pointAt(t * m.length()); }
 
 /// The lowest and highest speed `spindle` asks over the part [t0, t1] of a
 /// cut, from samples (and the axis, where a line crosses it).
