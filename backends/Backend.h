@@ -5,6 +5,7 @@
 #pragma once
 
 #include "backends/Target.h"
+#include "runtime/Machine.h"
 #include "ir/Node.h"
 #include "support/Diagnostics.h"
 
@@ -24,6 +25,8 @@ struct EmitOptions {
   std::string optionsText;      ///< the options that shaped the program (header)
   std::optional<double> tolerance;  ///< --tolerance, mm
   const ToolTable *toolTable = nullptr;
+  /// The deposition head's codes of --machine, when it has one.
+  const runtime::DepositionCodes *deposition = nullptr;
 };
 
 class Backend {

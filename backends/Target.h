@@ -70,6 +70,12 @@ struct TargetDescriptor {
   /// Lathe programs: the target can write a finishing pass as the surface
   /// with the controller's nose radius compensation (G41/G42) ...
   bool latheCompensation = false;
+  /// Deposition programs: the target writes the head's state changes with
+  /// the machine's codes (docs/additive.md).
+  bool deposition = false;
+  /// Reading back a program that deposits: feed moves run with the spindle
+  /// off (a deposition head turns nothing).
+  bool feedsWithoutSpindle = false;
   /// ... and is asked to (--target-opt nose-compensation=controller);
   /// otherwise the moves carry the nose radius and the program stays G40.
   bool controllerNoseCompensation = false;

@@ -161,6 +161,11 @@ private:
   mutable uint32_t epoch_ = 0;
 };
 
+/// The convex hull of `points`, counter-clockwise from its lowest-x point,
+/// without collinear points (Andrew's monotone chain); fewer than three
+/// distinct points come back as they are, sorted.
+std::vector<Vec2> convexHull(std::vector<Vec2> points);
+
 /// The region's mirror image across the x axis (y negated), each loop
 /// reversed so that it keeps its orientation.
 Region mirroredAcrossX(const Region &r);

@@ -36,10 +36,12 @@ const Node *findIn(const Node &n, std::string_view symbol, const Node **parent) 
 std::string quotedKind(const Node &n) { return "'" + n.kindName() + "'"; }
 
 /// What of `n` itself (not its subtree) a 3-axis milling reader cannot take.
-std::optional<std::string> beyond(const Node &n, ArcPlanes planes) {
+std::optional<std::string> beyond(const Node &n, ArcPlanes planes, Deposition deposition) {
   if (n.is(Trait::ControlFlow))
     return "control flow (" + quotedKind(n) + ")";
-  if (n.category() == Category::Operation && !n.spec().isAny(Trait::Milling | Trait::HoleMaking))
+  const bool deposits = deposition == Deposition::Take;
+  if (n.category() == Category::Operation && !n.spec().isAny(Trait::Milling | Trait::HoleMaking) &&
+      !(deposits && n.is(Trait::Additive)))
     return std::string("an operation of another process (") + quotedKind(n) + ")";
   switch (n.kind) {
   case Kind::Moves:
@@ -48,7 +50,10 @@ std::optional<std::string> beyond(const Node &n, ArcPlanes planes) {
     if (n.has("x_mode"))
       return std::string("a lathe's X mode");
     break;
-  case Kind::State: return std::string("a change of process state ('state')");
+  case Kind::State:
+    if (deposits && !n.has("spindle") && !n.has("surface_speed") && !n.has("spindle_max") && !n.has("coolant"))
+      break;
+    return std::string("a change of process state ('state')");
   case Kind::Rapid:
   case Kind::Linear:
   case Kind::Arc:
@@ -71,13 +76,13 @@ std::optional<std::string> beyond(const Node &n, ArcPlanes planes) {
   return std::nullopt;
 }
 
-std::optional<Beyond> firstBeyond(const Node &n, ArcPlanes planes, TurningSteps turning) {
-  if (turning == TurningSteps::Skip && isTurningStep(n))
+std::optional<Beyond> firstBeyond(const Node &n, ArcPlanes planes, OtherProcesses others, Deposition deposition) {
+  if (others == OtherProcesses::Skip && (isTurningStep(n) || isAdditiveStep(n)))
     return std::nullopt;
-  if (auto what = beyond(n, planes))
+  if (auto what = beyond(n, planes, deposition))
     return Beyond{&n, *what};
   for (const Node &c : n.children)
-    if (auto found = firstBeyond(c, planes, turning))
+    if (auto found = firstBeyond(c, planes, others, deposition))
       return found;
   return std::nullopt;
 }
@@ -91,15 +96,25 @@ bool isTurningStep(const Node &exec) {
   return op && op->is(Trait::Turning);
 }
 
-const Node *millingMoves(const Node &exec) { return isTurningStep(exec) ? nullptr : exec.child(Kind::Moves); }
+bool isAdditiveStep(const Node &exec) {
+  if (exec.kind != Kind::Workingstep)
+    return false;
+  const Node *op = operationOf(exec);
+  return op && op->is(Trait::Additive);
+}
 
-std::optional<Beyond> beyondThreeAxisMilling(const Module &module, ArcPlanes planes, TurningSteps turning) {
-  return firstBeyond(module.root, planes, turning);
+const Node *millingMoves(const Node &exec) {
+  return isTurningStep(exec) || isAdditiveStep(exec) ? nullptr : exec.child(Kind::Moves);
+}
+
+std::optional<Beyond> beyondThreeAxisMilling(const Module &module, ArcPlanes planes, OtherProcesses others,
+                                             Deposition deposition) {
+  return firstBeyond(module.root, planes, others, deposition);
 }
 
 bool requireThreeAxisMilling(const Module &module, std::string_view consumer, DiagnosticEngine &diags,
-                             ArcPlanes planes, TurningSteps turning) {
-  const std::optional<Beyond> b = beyondThreeAxisMilling(module, planes, turning);
+                             ArcPlanes planes, OtherProcesses others, Deposition deposition) {
+  const std::optional<Beyond> b = beyondThreeAxisMilling(module, planes, others, deposition);
   if (!b)
     return true;
   std::string subject = b->node->kindName();

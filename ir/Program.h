@@ -74,14 +74,25 @@ bool runsAsWritten(const Node &executable);
 /// revolution, and the milling passes leave them to the turning ones.
 bool isTurningStep(const Node &exec);
 
+/// Whether `exec` is a deposition workingstep (its operation has the
+/// Additive trait): its moves lay beads with the energy on and off.
+bool isAdditiveStep(const Node &exec);
+
 /// The `moves` of an executable that a milling pass reads: null for a step
-/// without moves and for a turning step.
+/// without moves and for a turning or deposition step.
 const Node *millingMoves(const Node &exec);
 
-/// What a consumer of milling programs does with turning steps: refuses
-/// them (a reader that writes one program) or passes over them (a pass
-/// that works step by step and leaves lathe moves to the turning passes).
-enum class TurningSteps : uint8_t { Refuse, Skip };
+/// What a consumer of milling programs does with the steps of other
+/// processes (turning, deposition): refuses them (a reader that writes one
+/// program) or passes over them (a pass that works step by step and leaves
+/// lathe moves to the turning passes, beads to the deposition ones).
+enum class OtherProcesses : uint8_t { Refuse, Skip };
+
+/// Whether a reader of the IR takes deposition steps: their operations and
+/// the `state` changes of the head (energy, power, powder, wire), written
+/// with the machine's codes; the other process state changes (spindle,
+/// constant surface speed) stay beyond it.
+enum class Deposition : uint8_t { Refuse, Take };
 
 /// Which arcs a reader of the IR takes: in the XY plane only, or in any of
 /// the principal planes XY, ZX and YZ (an arc `normal` along x, y or z).
@@ -105,14 +116,16 @@ struct Beyond {
 /// Principal: it walks moves with ir::walkMoves, which gives them as chords,
 /// or writes them itself) is not stopped by them; an arc about any other
 /// axis stops every consumer.
-/// With `turning` Skip, turning workingsteps are passed over whole.
+/// With `others` Skip, turning and deposition workingsteps are passed over whole.
 std::optional<Beyond> beyondThreeAxisMilling(const Module &module, ArcPlanes planes = ArcPlanes::XYOnly,
-                                             TurningSteps turning = TurningSteps::Refuse);
+                                             OtherProcesses others = OtherProcesses::Refuse,
+                                             Deposition deposition = Deposition::Refuse);
 
 /// Reports the first construct `consumer` cannot take as an error at its
 /// node ("<consumer> cannot take <what> yet") and returns false; true when
 /// there is none.
 bool requireThreeAxisMilling(const Module &module, std::string_view consumer, DiagnosticEngine &diags,
-                             ArcPlanes planes = ArcPlanes::XYOnly, TurningSteps turning = TurningSteps::Refuse);
+                             ArcPlanes planes = ArcPlanes::XYOnly, OtherProcesses others = OtherProcesses::Refuse,
+                             Deposition deposition = Deposition::Refuse);
 
 } // namespace stepnc::ir

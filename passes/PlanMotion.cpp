@@ -56,7 +56,7 @@ private:
   /// planned in the ZX plane with the spindle (ir/motion/LathePlan.h).
   PassResult runLathe(ir::Module &module, const runtime::Machine &machine, DiagnosticEngine &diags,
                       PassStats &stats) {
-    if (!ir::requireThreeAxisMilling(module, "plan-motion", diags, ir::ArcPlanes::Principal, ir::TurningSteps::Skip))
+    if (!ir::requireThreeAxisMilling(module, "plan-motion", diags, ir::ArcPlanes::Principal, ir::OtherProcesses::Skip))
       return {false, false};
     if (!ir::hasMachiningSteps(module))
       return {true, false};

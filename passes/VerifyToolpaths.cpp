@@ -44,6 +44,7 @@
 #include "ir/geom/MoveWalk.h"
 #include "passes/FeatureWalls.h"
 #include "passes/InProcessStock.h"
+#include "passes/VerifyDeposition.h"
 #include "passes/VerifyTurning.h"
 #include "support/Format.h"
 
@@ -401,7 +402,8 @@ private:
     for (ir::Node &c : n.children) {
       if (c.kind == ir::Kind::Workplan)
         visit(c);
-      else if ((c.kind == ir::Kind::Workingstep || c.kind == ir::Kind::RapidMovement) && !ir::isTurningStep(c))
+      else if ((c.kind == ir::Kind::Workingstep || c.kind == ir::Kind::RapidMovement) && !ir::isTurningStep(c) &&
+               !ir::isAdditiveStep(c))
         for (ir::Node &m : c.children)
           if (m.kind == ir::Kind::Moves)
             verify(c, m);
@@ -1164,15 +1166,27 @@ public:
   std::string_view name() const override { return "verify-toolpaths"; }
 
   PassResult run(ir::Module &module, DiagnosticEngine &diags, PassStats &stats) override {
-    if (!ir::requireThreeAxisMilling(module, "verify-toolpaths", diags, ir::ArcPlanes::Principal, ir::TurningSteps::Skip))
+    if (!ir::requireThreeAxisMilling(module, "verify-toolpaths", diags, ir::ArcPlanes::Principal, ir::OtherProcesses::Skip))
       return {false, false};
     PassResult milling = ToolpathChecker(module, diags, stats, tolerance_).run();
     const bool turning = verifyTurning(module, diags, stats, tolerance_);
-    return {milling.ok && turning, milling.changed};
+    reports_.clear();
+    const bool deposition = verifyDeposition(module, diags, stats, std::nullopt, &reports_);
+    return {milling.ok && turning && deposition, milling.changed};
+  }
+
+  std::vector<std::string> report() const override {
+    if (reports_.empty())
+      return {};
+    std::vector<std::string> lines = {"deposition workingstep: layers, bead length, energy-on time at the feed; "
+                                      "largest uncovered gap and overflow (mm)"};
+    lines.insert(lines.end(), reports_.begin(), reports_.end());
+    return lines;
   }
 
 private:
   std::optional<double> tolerance_;
+  std::vector<std::string> reports_;
 };
 
 } // namespace

@@ -54,29 +54,6 @@ Region folded(const Region &r) {
   return geom::unite(r, geom::mirroredAcrossX(r));
 }
 
-/// Convex hull, counter-clockwise (Andrew's monotone chain).
-std::vector<Vec2> hull(std::vector<Vec2> p) {
-  std::sort(p.begin(), p.end(), [](const Vec2 &a, const Vec2 &b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
-  p.erase(std::unique(p.begin(), p.end(), [](const Vec2 &a, const Vec2 &b) { return (a - b).norm() < 1e-12; }),
-          p.end());
-  if (p.size() < 3)
-    return p;
-  std::vector<Vec2> h(2 * p.size());
-  size_t k = 0;
-  for (size_t i = 0; i < p.size(); ++i) {
-    while (k >= 2 && geom::cross(h[k - 1] - h[k - 2], p[i] - h[k - 2]) <= 1e-15)
-      --k;
-    h[k++] = p[i];
-  }
-  for (size_t i = p.size() - 1, t = k + 1; i > 0; --i) {
-    while (k >= t && geom::cross(h[k - 1] - h[k - 2], p[i - 1] - h[k - 2]) <= 1e-15)
-      --k;
-    h[k++] = p[i - 1];
-  }
-  h.resize(k - 1);
-  return h;
-}
-
 /// Material thicker than `t` somewhere in `r`: a loop whose mean width
 /// (twice its area over its perimeter) is more than a quarter of `t` (the
 /// slivers Booleans leave along a shared edge are far thinner), and that
@@ -133,7 +110,7 @@ struct Insert {
       pts.push_back(a + s);
       pts.push_back(b + s);
     }
-    const std::vector<Vec2> h = hull(pts);
+    const std::vector<Vec2> h = geom::convexHull(pts);
     std::vector<Seg> edges;
     Region body;
     if (h.size() >= 3) {

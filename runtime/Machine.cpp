@@ -378,7 +378,8 @@ std::optional<Machine> readMachine(const SourceFile &file, DiagnosticEngine &dia
   if (!parsed)
     return std::nullopt;
   const toml::table &root = *parsed;
-  r.onlyKnown(root, {"format", "name", "kinematics", "controller", "spindle", "axes"}, "the machine file");
+  r.onlyKnown(root, {"format", "name", "kinematics", "controller", "spindle", "axes", "deposition"},
+              "the machine file");
   Machine m;
   if (auto format = r.number(root, "format", "the machine file", "format version", 1, 1, true); !format)
     return std::nullopt;
@@ -410,6 +411,22 @@ std::optional<Machine> readMachine(const SourceFile &file, DiagnosticEngine &dia
     m.lookahead = static_cast<int>(r.number(*c, "lookahead", "controller", "segments", 1, 1e6, true).value_or(100));
     m.pathTolerance = r.number(*c, "path_tolerance", "controller", "mm", 1e-5, 10, true).value_or(m.pathTolerance);
     m.maxFeed = r.number(*c, "max_feed", "controller", "mm/min", 1, 1e7, false);
+  }
+  if (const toml::table *d = r.table(root, "deposition", "deposition", false)) {
+    r.onlyKnown(*d, {"target", "energy_on", "energy_off", "power", "powder", "wire", "max_power", "max_powder",
+                     "max_wire"},
+                "[deposition]");
+    DepositionCodes c;
+    c.target = r.text(*d, "target", "deposition", true).value_or("");
+    c.energyOn = r.text(*d, "energy_on", "deposition", true).value_or("");
+    c.energyOff = r.text(*d, "energy_off", "deposition", true).value_or("");
+    c.power = r.text(*d, "power", "deposition", true).value_or("");
+    c.powder = r.text(*d, "powder", "deposition", false).value_or("");
+    c.wire = r.text(*d, "wire", "deposition", false).value_or("");
+    c.maxPower = r.number(*d, "max_power", "deposition", "W", 1, 1e6, true).value_or(0);
+    c.maxPowder = r.number(*d, "max_powder", "deposition", "g/min", 0.01, 1e4, false);
+    c.maxWire = r.number(*d, "max_wire", "deposition", "mm/min", 1, 1e6, false);
+    m.deposition = std::move(c);
   }
   if (const toml::table *s = r.table(root, "spindle", "spindle")) {
     r.onlyKnown(*s, {"min_speed", "max_speed", "power", "torque", "acceleration"}, "[spindle]");

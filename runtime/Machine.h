@@ -87,6 +87,19 @@ struct KinematicsSpec {
   std::vector<std::pair<std::string, double>> parameters;
 };
 
+/// A deposition head's codes (a machine file's [deposition] table,
+/// docs/additive.md): the blocks that switch the energy and the material on
+/// and off and set them, in the syntax of the target named, where `{power}`
+/// (W), `{powder}` (g/min) and `{wire}` (mm/min) stand for the value; the
+/// most the head's source and feeders give.
+struct DepositionCodes {
+  std::string target;  ///< the target the codes are written for ("rs274", "siemens-840d")
+  std::string energyOn, energyOff, power, powder, wire;
+  double maxPower = 0;  ///< W
+  std::optional<double> maxPowder;  ///< g/min
+  std::optional<double> maxWire;    ///< mm/min
+};
+
 struct Machine {
   std::string name;
   KinematicsSpec kinematics;
@@ -105,6 +118,8 @@ struct Machine {
   int lookahead = 100;         ///< segments the planner may look ahead
   double pathTolerance = 0.01;  ///< mm, how far blending may leave the programmed path
   std::optional<double> maxFeed;  ///< mm/min along the path, when lower than the axes allow
+  /// A machine with a deposition head: its codes.
+  std::optional<DepositionCodes> deposition;
 
   const Axis *axis(std::string_view axisName) const;
   /// Index of the named axis in `axes`, or -1.

@@ -14,6 +14,7 @@
 #include "ir/Program.h"
 #include "support/Format.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace stepnc::backends {
@@ -43,7 +44,8 @@ public:
     }
     std::optional<Program> program =
         buildProgram(module, options.toolTable, diags,
-                     descriptor().arcPlanes ? ir::OutOfPlaneArcs::Exact : ir::OutOfPlaneArcs::Chords);
+                     descriptor().arcPlanes ? ir::OutOfPlaneArcs::Exact : ir::OutOfPlaneArcs::Chords,
+                     descriptor().deposition ? ir::Deposition::Take : ir::Deposition::Refuse, descriptor().name);
     if (!program)
       return std::nullopt;
     Emitter emitter(descriptor(), options, diags);
@@ -51,8 +53,16 @@ public:
     if (!text)
       return std::nullopt;
     const double tolerance = options.tolerance.value_or(descriptor().tolerance);
-    if (!checkReadBack(*program, descriptor(), emitter.stepLines(), *text, Emitter::read(*text, descriptor()),
-                       tolerance, diags))
+    // The head's codes are the machine's, not the dialect's: the reader
+    // reads the program without their lines.
+    std::string motion = *text;
+    if constexpr (requires { emitter.processLines(); })
+      motion = blankLines(*text, emitter.processLines());
+    TargetDescriptor reading = descriptor();
+    reading.feedsWithoutSpindle = std::any_of(program->steps.begin(), program->steps.end(),
+                                              [](const Step &s) { return s.deposits; });
+    if (!checkReadBack(*program, descriptor(), emitter.stepLines(), *text, Emitter::read(motion, reading), tolerance,
+                       diags))
       return std::nullopt;
     return text;
   }

@@ -96,6 +96,7 @@ std::optional<std::string> IsoEmitter::run(const Program &p) {
       continue;
     }
     for (size_t i = 0; i < s.moves.size();) {
+      process(s, s.moves[i].before);
       const size_t end = smoothRunEnd(s.moves, i);
       if (end >= i + 2) {
         spline(s.moves, i, end);
@@ -104,6 +105,7 @@ std::optional<std::string> IsoEmitter::run(const Program &p) {
         move(s.moves[i++]);
       }
     }
+    process(s, s.after);
     if (const std::string g17 = selectPlane(geom::ArcPlane::xy()); !g17.empty())
       out_.block(g17);
   }
@@ -114,6 +116,59 @@ std::optional<std::string> IsoEmitter::run(const Program &p) {
   if (!out_.overlong().empty() || diags_.hasErrors())
     return std::nullopt;
   return out_.text();
+}
+
+void IsoEmitter::process(const Step &s, const std::vector<ProcessChange> &changes) {
+  if (changes.empty())
+    return;
+  const runtime::DepositionCodes *codes = o_.deposition;
+  auto refuse = [&](const ir::Node *at, const std::string &why) {
+    const ir::Node &where = at && at->origin.loc.valid() ? *at : *s.exec;
+    diags_.error(where.origin.loc, "workingstep " + s.exec->symbol + ": " + why).entity(where.origin.entityId);
+  };
+  if (!codes || codes->target != d_.name) {
+    if (!saidNoCodes_)
+      refuse(s.exec, !codes ? "deposits: the codes that switch the head's energy and material and set them are "
+                              "machine data: give --machine with a [deposition] table (docs/additive.md)"
+                            : "deposits: the [deposition] codes of --machine are written for " + codes->target +
+                                  ", not " + d_.name);
+    saidNoCodes_ = true;
+    return;
+  }
+  auto write = [&](const std::string &code, const char *placeholder, std::optional<double> value) {
+    std::string text = code;
+    if (value)
+      if (size_t at = text.find(placeholder); at != std::string::npos)
+        text.replace(at, std::string_view(placeholder).size(), formatTrimmed(*value, 3));
+    out_.block(text);
+    processLines_.push_back(out_.lines());
+  };
+  for (const ProcessChange &c : changes) {
+    if (c.energy && !*c.energy)
+      write(codes->energyOff, "", std::nullopt);
+    if (c.power) {
+      if (*c.power > codes->maxPower)
+        refuse(c.node, "a power of " + formatShortest(*c.power) + " W is more than the machine's head gives (" +
+                           formatShortest(codes->maxPower) + " W)");
+      else
+        write(codes->power, "{power}", *c.power);
+    }
+    for (auto [value, code, limit, placeholder, what, unit] :
+         {std::tuple{c.powder, &codes->powder, codes->maxPowder, "{powder}", "powder feed", "g/min"},
+          {c.wire, &codes->wire, codes->maxWire, "{wire}", "wire feed", "mm/min"}}) {
+      if (!value)
+        continue;
+      if (code->empty())
+        refuse(c.node, std::string("the machine's [deposition] table has no code for the ") + what);
+      else if (limit && *value > *limit)
+        refuse(c.node, std::string("a ") + what + " of " + formatShortest(*value) + " " + unit +
+                           " is more than the machine's feeder gives (" + formatShortest(*limit) + " " + unit + ")");
+      else
+        write(*code, placeholder, *value);
+    }
+    if (c.energy && *c.energy)
+      write(codes->energyOn, "", std::nullopt);
+  }
 }
 
 std::string IsoEmitter::spindle(double rpm) const {

@@ -30,6 +30,9 @@ public:
   std::optional<std::string> run(const Program &p);
   /// Where each step of the program run() wrote starts in its text.
   const StepLines &stepLines() const { return stepLines_; }
+  /// The lines (1-based) of the deposition head's codes, in order: the
+  /// machine's words, which the dialect's reader does not read.
+  const std::vector<size_t> &processLines() const { return processLines_; }
 
 protected:
   // --- The dialect's words -----------------------------------------------------
@@ -85,6 +88,12 @@ protected:
 
 private:
   void arc(const Move &m);
+  /// The head's state changes of step `s` with the machine's codes
+  /// (EmitOptions::deposition); errors when there are none, or a value is
+  /// beyond what the head gives.
+  void process(const Step &s, const std::vector<ProcessChange> &changes);
+  std::vector<size_t> processLines_;
+  bool saidNoCodes_ = false;
   /// Where the run of smooth lines starting at `i` ends (one past its last
   /// move): lines marked smooth at one height; `i` when the target writes
   /// no splines or moves[i] is no such line.

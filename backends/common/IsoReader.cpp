@@ -531,7 +531,7 @@ private:
                                                : "a move without the tool's D offset (its length)");
     if (feedMove && needFeed && feed_ <= 0)
       r_.problem(n, "a feed move with no feed F");
-    if (feedMove && !spindleOn_)
+    if (feedMove && !spindleOn_ && !d_.feedsWithoutSpindle)
       r_.problem(n, "a feed move with the spindle off");
   }
 

@@ -9,6 +9,7 @@
 #include "support/Format.h"
 
 #include <algorithm>
+#include <map>
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -133,6 +134,28 @@ private:
     s.spindle = moves->number("spindle").value_or(0);
     s.coolant = moves->text("coolant").value_or("off");
     s.secplane = moves->number("secplane").value_or(0);
+    s.deposits = ir::isAdditiveStep(e);
+    // The head's state changes, each before the move that follows it (the
+    // walk gives moves in the order of their nodes; a state is no move).
+    std::map<const ir::Node *, std::vector<ProcessChange>> changesBefore;
+    std::vector<ProcessChange> pending;
+    for (const ir::Node &c : moves->children) {
+      if (c.kind != ir::Kind::State) {
+        if (!pending.empty())
+          changesBefore[&c] = std::move(pending);
+        pending.clear();
+        continue;
+      }
+      ProcessChange change;
+      change.node = &c;
+      if (auto energy = c.text("energy"))
+        change.energy = *energy == "on";
+      change.power = c.number("power");
+      change.powder = c.number("powder_feed");
+      change.wire = c.number("wire_feed");
+      pending.push_back(change);
+    }
+    s.after = std::move(pending);
     // The moves as every reader of the toolpath IR sees them (ir/geom/MoveWalk).
     std::set<const ir::Node *> chorded;  // arcs out of the XY plane written as lines
     for (const ir::Move &m : ir::walkMoves(*moves, position_, ir::PathKind::Programmed, arcs_)) {
@@ -156,6 +179,10 @@ private:
       mv.plane = m.plane;
       mv.ccw = m.ccw;
       mv.turns = m.turns;
+      if (auto it = changesBefore.find(m.node); it != changesBefore.end()) {
+        mv.before = std::move(it->second);
+        changesBefore.erase(it);
+      }
       s.moves.push_back(std::move(mv));
     }
     if (!chorded.empty())
@@ -379,8 +406,9 @@ std::string whyNotCycle(const TargetDescriptor &d, const HoleCycle &c) {
 }
 
 std::optional<Program> buildProgram(const ir::Module &module, const ToolTable *table, DiagnosticEngine &diags,
-                                    ir::OutOfPlaneArcs arcs) {
-  if (!ir::requireThreeAxisMilling(module, "the G-code targets", diags, ir::ArcPlanes::Principal))
+                                    ir::OutOfPlaneArcs arcs, ir::Deposition deposition, std::string_view target) {
+  if (!ir::requireThreeAxisMilling(module, target, diags, ir::ArcPlanes::Principal, ir::OtherProcesses::Refuse,
+                                   deposition))
     return std::nullopt;
   return Builder(module, table, diags, arcs).build();
 }

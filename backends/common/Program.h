@@ -29,6 +29,16 @@ struct ToolCall {
   double diameter = 0;
 };
 
+/// A change of the deposition head's state (toolpath IR `state`): what it
+/// gives changes, the rest stays.
+struct ProcessChange {
+  const ir::Node *node = nullptr;
+  std::optional<bool> energy;
+  std::optional<double> power;   ///< W
+  std::optional<double> powder;  ///< g/min
+  std::optional<double> wire;    ///< mm/min
+};
+
 struct Move {
   /// Dwell: the tool waits where it is for `dwell` seconds.
   enum class Kind { Rapid, Linear, Arc, Dwell } kind = Kind::Rapid;
@@ -50,6 +60,8 @@ struct Move {
   bool alongZOnly = false;
   std::string role;
   const ir::Node *node = nullptr;
+  /// Deposition: the head's state changes made before the move, in order.
+  std::vector<ProcessChange> before;
 
   /// A rapid that takes the tool to where a step starts: the clearance
   /// move and the moves the IR marks `position`.
@@ -110,6 +122,10 @@ struct Step {
   std::string coolant;    ///< off, flood, mist, through_tool
   double secplane = 0;
   std::vector<Move> moves;
+  /// Deposition: the head's state changes made after the last move.
+  std::vector<ProcessChange> after;
+  /// A deposition step (its moves lay beads with the head's energy on).
+  bool deposits = false;
   std::optional<HoleCycle> cycle;
 };
 
@@ -136,7 +152,11 @@ double clearanceHeight(const Step &s);
 /// `arcs`: how arcs in the ZX and YZ planes come (ir::OutOfPlaneArcs): as
 /// arcs for a target that writes them (G18, G19), else as lines along their
 /// chords.
+/// `deposition`: the target writes deposition steps (Move::before,
+/// Step::after); else they are refused.
 std::optional<Program> buildProgram(const ir::Module &module, const ToolTable *table, DiagnosticEngine &diags,
-                                    ir::OutOfPlaneArcs arcs = ir::OutOfPlaneArcs::Chords);
+                                    ir::OutOfPlaneArcs arcs = ir::OutOfPlaneArcs::Chords,
+                                    ir::Deposition deposition = ir::Deposition::Refuse,
+                                    std::string_view target = "the G-code targets");
 
 } // namespace stepnc::backends

@@ -427,4 +427,26 @@ bool wellFormedNumber(const std::string &text, bool needPoint, std::string &why)
   return true;
 }
 
+std::string blankLines(const std::string &text, const std::vector<size_t> &lines) {
+  if (lines.empty())
+    return text;
+  std::string out;
+  out.reserve(text.size());
+  size_t line = 1, next = 0, start = 0;
+  while (start < text.size()) {
+    size_t end = text.find('\n', start);
+    if (end == std::string::npos)
+      end = text.size();
+    while (next < lines.size() && lines[next] < line)
+      ++next;
+    if (!(next < lines.size() && lines[next] == line))
+      out.append(text, start, end - start);
+    if (end < text.size())
+      out += '\n';
+    start = end + 1;
+    ++line;
+  }
+  return out;
+}
+
 } // namespace stepnc::backends

@@ -54,6 +54,9 @@ struct ProgramReading {
   void problem(size_t line, std::string why) { problems.emplace_back(line, std::move(why)); }
 };
 
+/// `text` with the given lines (1-based) emptied, the others where they were.
+std::string blankLines(const std::string &text, const std::vector<size_t> &lines);
+
 /// Where each step of the program starts in the text: the 1-based line of
 /// its first block (a step that wrote nothing has the line of what follows).
 /// One entry per Program::steps element.

@@ -35,6 +35,7 @@ TargetDescriptor rs274Descriptor() {
   d.speedDecimals = 0;
   d.tolerance = 0.01;
   d.latheCompensation = true;  // G41/G42 with the tool table's radius and orientation
+  d.deposition = true;         // the machine's codes (M62-M68 on LinuxCNC)
   return d;
 }
 

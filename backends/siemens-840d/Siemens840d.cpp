@@ -25,6 +25,7 @@ namespace {
 TargetDescriptor siemensDescriptor() {
   TargetDescriptor d;
   d.name = "siemens-840d";
+  d.deposition = true;  // the machine's codes
   d.description = "Siemens SINUMERIK 840D / 840D sl";
   d.extension = ".mpf";
   d.arcs = ArcForm::IncrementalCentre;

@@ -42,7 +42,10 @@ const Model &aimEdition3() {
   return model;
 }
 
-constexpr std::string_view kExtensionName = "STEPNC_PATTERN_STRATEGIES";
+// stepnc's extension schemas, each interfacing the whole ARM; the additive
+// one also the pattern strategies, so that it sees every entity.
+constexpr std::string_view kPatternExtension = "STEPNC_PATTERN_STRATEGIES";
+constexpr std::string_view kAdditiveExtension = "STEPNC_ADDITIVE";
 constexpr std::string_view kAimEdition1 = "INTEGRATED_CNC_SCHEMA";
 constexpr std::string_view kAimEdition3 = "MODEL_BASED_INTEGRATED_MANUFACTURING_SCHEMA";
 
@@ -71,8 +74,8 @@ const std::vector<std::string_view> &builtinSchemaNames() {
   // AIM files name the AIM.
   static const std::vector<std::string_view> names = {
       "MACHINING_SCHEMA",    "MILLING_SCHEMA",  "TURNING_SCHEMA", "MILLING_TOOL_SCHEMA",
-      "TURNING_TOOL_SCHEMA", "COMBINED_SCHEMA", "ISO14649_ARM",   kExtensionName,
-      kAimEdition1,          kAimEdition3};
+      "TURNING_TOOL_SCHEMA", "COMBINED_SCHEMA", "ISO14649_ARM",   kPatternExtension,
+      kAdditiveExtension,    kAimEdition1,      kAimEdition3};
   return names;
 }
 
@@ -82,8 +85,8 @@ BuiltinSchema findBuiltinSchema(std::string_view name) {
     return {&aimEdition1(), aimEdition1().findSchema(kAimEdition1)};
   if (wanted == kAimEdition3)
     return {&aimEdition3(), aimEdition3().findSchema(kAimEdition3)};
-  if (wanted == kExtensionName)
-    return {&builtinModel(), builtinModel().findSchema(kExtensionName)};
+  if (wanted == kPatternExtension || wanted == kAdditiveExtension)
+    return {&builtinModel(), builtinModel().findSchema(wanted)};
   for (std::string_view n : builtinSchemaNames())
     if (n == wanted)
       return {&builtinModel(), builtinModel().findSchema("iso14649_arm")};
@@ -91,15 +94,20 @@ BuiltinSchema findBuiltinSchema(std::string_view name) {
 }
 
 BuiltinSchema findBuiltinSchema(const std::vector<std::string> &names) {
-  // The extension interfaces the whole ARM: when a file lists it, it is the
-  // schema that sees every entity the file may use.
+  // An extension interfaces the whole ARM: when a file lists one, it is the
+  // schema that sees every entity the file may use; the additive one sees
+  // the pattern strategies too.
+  auto rank = [](std::string_view key) { return key == kAdditiveExtension ? 2 : key == kPatternExtension ? 1 : 0; };
   BuiltinSchema chosen;
+  int chosenRank = -1;
   for (const std::string &n : names) {
-    const bool extension = schemaKey(n) == kExtensionName;
-    if (chosen && !extension)
+    const int r = rank(schemaKey(n));
+    if (r <= chosenRank)
       continue;
-    if (BuiltinSchema s = findBuiltinSchema(n))
+    if (BuiltinSchema s = findBuiltinSchema(n)) {
       chosen = s;
+      chosenRank = r;
+    }
   }
   return chosen;
 }

@@ -499,6 +499,9 @@ std::optional<std::string> Lowerer::feature(const Instance &f) {
       n.add(std::move(*profile));
     else
       missing(f, shape);
+  } else if (f.isA("am_feature")) {
+    if (!additiveFeature(f, n))
+      return std::nullopt;
   } else if (f.isA("boss")) {
     n.kind = ir::Kind::Boss;
     commonPlacementAndDepth();

@@ -178,6 +178,8 @@ std::optional<std::string> Lowerer::tool(const Instance &t) {
     return std::nullopt;
   if (auto it = lowered_.find(t.index()); it != lowered_.end())
     return it->second;
+  if (t.isA("deposition_head"))
+    return depositionHead(t);
   if (!t.isA("cutting_tool")) {
     unsupported(t, "tool");
     return std::nullopt;
@@ -481,6 +483,8 @@ Node machineFunctions(const Instance &mf) {
 } // namespace
 
 std::optional<Node> Lowerer::operation(const Instance &op) {
+  if (op.isA("am_operation"))
+    return additiveOperation(op);
   std::optional<ir::Kind> kind;
   for (auto [entity, k] : kOperations)
     if (op.isA(entity)) {

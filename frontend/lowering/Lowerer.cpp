@@ -378,7 +378,7 @@ std::optional<Node> Lowerer::workplan(const Instance &wp) {
 }
 
 bool Lowerer::executable(const Instance &exe, Node &parent) {
-  if (exe.isA("machining_workingstep")) {
+  if (exe.isA("machining_workingstep") || exe.isA("am_workingstep")) {
     if (auto ws = workingstep(exe)) {
       reclampBefore(*ws, parent);
       parent.add(std::move(*ws));
@@ -468,6 +468,11 @@ constexpr std::pair<std::string_view, std::string_view> kAngles[] = {
     {"angle_taper", "angle"},
     {"pocket", "slope"},
     {"boss", "slope"},
+    {"am_extruded_feature", "draft_angle"},
+    {"deposition_head", "nozzle_angle"},
+    {"deposition_strategy", "infill_angle"},
+    {"deposition_strategy", "layer_rotation"},
+    {"deposition_strategy", "seam_shift"},
     {"square_u_profile", "first_angle"},
     {"square_u_profile", "second_angle"},
     {"vee_profile", "profile_angle"},

@@ -229,6 +229,15 @@ public:
   /// Adds the toolpaths of a toolpath_list as children of `parent`.
   void toolpaths(const Instance &list, Node &parent);
 
+  // --- additive (LowerAdditive.cpp) -----------------------------------------
+  /// An added feature (am_feature) into `n`; false after reporting.
+  bool additiveFeature(const Instance &f, Node &n);
+  /// An additive operation: a deposition_operation (am_twod_operation) with
+  /// its technology and strategy; others are reported.
+  std::optional<Node> additiveOperation(const Instance &op);
+  /// A deposition head (stepnc_additive) as a tool node.
+  std::optional<std::string> depositionHead(const Instance &t);
+
   const binding::BoundFile &bound() const { return bound_; }
   DiagnosticEngine &diags() { return diags_; }
 

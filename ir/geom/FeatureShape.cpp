@@ -601,6 +601,14 @@ double cornerRadius(const ir::Node &tool) {
   return std::clamp(tool.number("corner_radius").value_or(0), 0.0, radius);
 }
 
+std::optional<geom::Loop> closedProfileLoop(const ir::Module &module, const ir::Node &owner, std::string &error) {
+  ShapeBuilder b(module, nullptr);
+  std::optional<Loop> l = b.closedProfile(owner, 0);
+  if (!l)
+    error = b.error;
+  return l;
+}
+
 ShapeResult featureShape(const ir::Module &module, const ir::Node &feature) {
   if (feature.kind == ir::Kind::ToolpathFeature)
     return {std::nullopt, "toolpath_feature " + feature.symbol +

@@ -111,6 +111,11 @@ struct ShapeResult {
   std::string error;  ///< why the feature has no shape (not supported, missing data)
 };
 
+/// The first closed profile child of `owner` (rectangular, circular or a
+/// closed general profile) as a loop in the owner's local coordinates;
+/// nullopt with `error` set when it has none.
+std::optional<geom::Loop> closedProfileLoop(const ir::Module &module, const ir::Node &owner, std::string &error);
+
 /// The shape of `feature` (a feature node of `module`).
 ShapeResult featureShape(const ir::Module &module, const ir::Node &feature);
 

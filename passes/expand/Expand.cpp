@@ -238,8 +238,7 @@ private:
       return;
     }
     if (op->is(ir::Trait::Additive)) {
-      x_.report(ws, std::string("its operation ") + op->kindName() + " '" + op->label +
-                        "' is a deposition operation: stepnc does not compile its process yet (docs/ir.md)");
+      expandDeposition(x_, ws, *op, setup);
       return;
     }
     const Node *feature = ir::findFeature(*x_.module, ws.text("feature").value_or(""));

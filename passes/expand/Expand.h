@@ -221,6 +221,9 @@ bool expandTrochoidal(Expander &x, const Step &step);
 /// Turning.cpp: the lathe moves of a turning workingstep, from its turned
 /// feature and the stock the steps before left; false after a diagnostic.
 bool expandTurning(Expander &x, Node &ws, const Node &op, const std::string &setup);
+/// Deposition.cpp: the beads of an additive workingstep, layer by layer,
+/// with the energy switched on and off along them; false after a diagnostic.
+bool expandDeposition(Expander &x, Node &ws, const Node &op, const std::string &setup);
 /// Turning.cpp: after a hole-making step drilled on the turning axis
 /// (ir::drillsOnTurningAxis), its workpiece's lathe stock loses what the
 /// drill's point and body swept, so that a boring step after it finds the hole.

@@ -28,6 +28,14 @@ Moves that go nowhere are left out on both sides. With canned cycles on,
 the cycles' own rapids are the controller's: only the feed moves must match
 (--cycles); with --no-cycles everything must.
 
+Deposition programs (compiled with a --machine whose [deposition] table
+gives LinuxCNC's output codes, docs/additive.md): the script reads that
+table, follows the outputs in the canonical output (SET/CLEAR_MOTION_OUTPUT_BIT
+for M62/M63, SET/CLEAR_AUX_OUTPUT_BIT for M64/M65, SET_MOTION/AUX_OUTPUT_VALUE
+for M67/M68) and checks that at every motion the energy output is on exactly
+when the IR's head is on, never during a rapid, and that the power and
+powder outputs hold the IR's values whenever the energy is on.
+
 Exit status 0 when every input matches, 1 otherwise (each difference is
 printed with the IR move and the canonical line).
 """
@@ -39,6 +47,7 @@ import re
 import subprocess
 import sys
 import tempfile
+import tomllib
 
 import toolpath_ir
 from toolpath_ir import arc_sweep, local, world
@@ -46,7 +55,34 @@ from toolpath_ir import arc_sweep, local, world
 TOL = 1e-3
 
 CANON_RE = re.compile(r"(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED|SET_FEED_RATE|NURBS_FEED|DWELL|SELECT_PLANE|"
-                      r"START_SPEED_FEED_SYNC|STOP_SPEED_FEED_SYNCH)\(([^)]*)\)")
+                      r"START_SPEED_FEED_SYNC|STOP_SPEED_FEED_SYNCH|SET_MOTION_OUTPUT_BIT|CLEAR_MOTION_OUTPUT_BIT|"
+                      r"SET_AUX_OUTPUT_BIT|CLEAR_AUX_OUTPUT_BIT|SET_MOTION_OUTPUT_VALUE|SET_AUX_OUTPUT_VALUE)"
+                      r"\(([^)]*)\)")
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+
+def deposition_outputs(extra):
+    """The outputs of the --machine among `extra` that its [deposition] codes
+    drive: {'energy': (kind, n), 'power': (kind, n), 'powder': ...}, kind
+    'bit' or 'value'; None without a machine or a [deposition] table."""
+    spec = next((a.split("=", 1)[1] for a in extra if a.startswith("--machine=")), None)
+    if spec is None:
+        return None
+    path = spec if os.path.exists(spec) else os.path.join(REPO, "machines", spec + ".toml")
+    with open(path, "rb") as f:
+        table = tomllib.load(f).get("deposition")
+    if not table:
+        return None
+    out = {}
+    for key in ("energy_on", "power", "powder", "wire"):
+        code = table.get(key, "")
+        m = re.match(r"M6([2-5]) P(\d+)", code)
+        if m:
+            out[key.replace("_on", "")] = ("bit", int(m.group(2)))
+        m = re.match(r"M6([78]) E(\d+)", code)
+        if m:
+            out[key] = ("value", int(m.group(2)))
+    return out
 CANON_PLANES = {"CANON_PLANE_XY": "xy", "CANON_PLANE_XZ": "zx", "CANON_PLANE_YZ": "yz"}
 G5_RE = re.compile(r"^G5 X(\S+) Y(\S+) I(\S+) J(\S+) P(\S+) Q(\S+)")
 SPLINE_TOL = 0.01
@@ -62,6 +98,7 @@ def g5_blocks(program):
 
 def canon_moves(path, program):
     out = []
+    bits, values = {}, {}
     feed = 0.0
     synced = None
     splines = iter(g5_blocks(program))
@@ -73,6 +110,12 @@ def canon_moves(path, program):
             if not m:
                 continue
             args = [a.strip() for a in m.group(2).split(",")]
+            if m.group(1).endswith("OUTPUT_BIT"):
+                bits[int(args[0])] = m.group(1).startswith("SET")
+                continue
+            if m.group(1).endswith("OUTPUT_VALUE"):
+                values[int(args[0])] = float(args[1])
+                continue
             if m.group(1) == "SELECT_PLANE":
                 plane = CANON_PLANES[args[0]]
                 continue
@@ -119,7 +162,38 @@ def canon_moves(path, program):
                     move["feed"] = feed if synced is None else synced
                 out.append(move)
             at = out[-1]["to"]
+            out[-1]["outputs"] = (dict(bits), dict(values))
     return out
+
+
+def head_problems(ir, canon, outputs):
+    """Each motion whose energy output is not the IR head's, a rapid with the
+    energy on, or a bead made with other power or powder outputs than the
+    IR's (moves compared one by one, those that go nowhere left out)."""
+    problems = []
+    a = [m for m in normalise(ir, False)]
+    b = [m for m in normalise(canon, False)]
+    kind, n = outputs["energy"]
+    for i, (x, y) in enumerate(zip(a, b)):
+        bits, values = y.get("outputs", ({}, {}))
+        on = bits.get(n, False) if kind == "bit" else values.get(n, 0.0) > 0
+        want = x.get("head", {}).get("energy", False)
+        why = None
+        if on and y["kind"] == "rapid":
+            why = "the energy is on during a rapid"
+        elif on != want:
+            why = "the energy output is %s, the IR's head %s" % ("on" if on else "off", "on" if want else "off")
+        elif on:
+            for key, ir_key in (("power", "power"), ("powder", "powder_feed"), ("wire", "wire_feed")):
+                if key in outputs and ir_key in x.get("head", {}):
+                    got = values.get(outputs[key][1])
+                    if got is None or abs(got - x["head"][ir_key]) > 1e-3:
+                        why = "%s output %s, the IR's %s %g" % (key, got, ir_key, x["head"][ir_key])
+        if why:
+            problems.append("move %d: %s\n    IR:    %s\n    %s" % (i + 1, why, x["text"], y["text"]))
+            if len(problems) >= 5:
+                break
+    return problems
 
 
 MOTION_RE = re.compile(r"(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED|NURBS_FEED)\(([^)]*)\)")
@@ -292,7 +366,17 @@ def check(stepnc, path, cycles, extra, workdir, program=None, target_opts=()):
     canon_path, error = run_rs274(ngc_path, workdir)
     if error:
         return [error]
-    problems, n = compare(toolpath_ir.read_moves(ir_path), canon_moves(canon_path, ngc_path), cycles, 0.05 + 1e-9)
+    ir_moves, canon = toolpath_ir.read_moves(ir_path), canon_moves(canon_path, ngc_path)
+    problems, n = compare(ir_moves, canon, cycles, 0.05 + 1e-9)
+    outputs = deposition_outputs(extra)
+    deposits = any("head" in m for m in ir_moves)
+    if deposits and not outputs:
+        problems.append("the IR deposits, and no --machine with a [deposition] table of LinuxCNC codes says which "
+                        "outputs to follow")
+    elif deposits and "energy" not in outputs:
+        problems.append("the machine's energy_on is no M62-M65 output code this check follows")
+    elif deposits:
+        problems += head_problems(ir_moves, canon, outputs)
     # A lathe's tool starts each step from outside the stock in X and Z
     # (verify-toolpaths checks that its rapids meet no stock); a mill's
     # goes up along Z alone first.

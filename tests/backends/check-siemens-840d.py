@@ -23,6 +23,11 @@ and reports what would be wrong there:
   * arcs, from the position tracked through the printed numbers: with I/J the
     radius at the start and at the end agree within 0.001 mm (whole circles
     too); with CR= the radius reaches across the chord; TURN= only with I/J;
+  * deposition programs (with --machine, or --option=--machine=..., naming
+    a machine whose [deposition] table is written for siemens-840d,
+    docs/additive.md): a block that is one of the table's codes (its value
+    a number) is the machine's word, accepted; feed moves then need no
+    spindle, and no rapid may run while the energy is on;
   * the first move of the program, and the first after each tool change,
     is Z alone (up to the clearance height): where the tool is then is the
     machine's business, so X and Y only move once it is up (not in a lathe
@@ -62,6 +67,7 @@ import re
 import subprocess
 import sys
 import tempfile
+import tomllib
 
 import toolpath_ir
 from toolpath_ir import arc_sweep
@@ -232,9 +238,39 @@ def compare_moves(planned, made, feeds_only, decimals=3):
     return problems, len(want)
 
 
+REPO = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+
+def deposition_codes(spec):
+    """The [deposition] codes of machine `spec` (a file or a shipped name) as
+    (key, regex) pairs; [] when it has none. A code written for another
+    target is an error of the caller's (returned as a string)."""
+    if not spec:
+        return []
+    path = spec if os.path.exists(spec) else os.path.join(REPO, "machines", spec + ".toml")
+    with open(path, "rb") as f:
+        table = tomllib.load(f).get("deposition")
+    if not table:
+        return []
+    if table.get("target") != "siemens-840d":
+        return "the machine's deposition codes are for %s" % table.get("target")
+    codes = []
+    for key in ("energy_on", "energy_off", "power", "powder", "wire"):
+        code = table.get(key)
+        if code:
+            pattern = re.escape(code)
+            for placeholder in ("power", "powder", "wire"):
+                pattern = pattern.replace(re.escape("{%s}" % placeholder), r"-?\d+(\.\d+)?")
+            codes.append((key, re.compile(pattern + "$")))
+    return codes
+
+
 class Checker:
-    def __init__(self, name, lines, max_line):
+    def __init__(self, name, lines, max_line, codes=()):
         self.name = name
+        self.codes = codes
+        self.energy = False
+        self.deposits = False
         self.lines = lines
         self.max_line = max_line
         self.problems = []
@@ -318,6 +354,12 @@ class Checker:
             if self.ended_at is not None:
                 self.problem(n, "block after M30 (line %d)" % self.ended_at)
             self.counts["blocks"] += 1
+            machine = next((key for key, pattern in self.codes if pattern.match(code)), None)
+            if machine:
+                self.deposits = True
+                if machine in ("energy_on", "energy_off"):
+                    self.energy = machine == "energy_on"
+                continue
             words = self.tokenize(n, code)
             if words is not None:
                 self.block(n, words)
@@ -515,8 +557,10 @@ class Checker:
         if feed_move:
             if need_feed and not self.feed:
                 lacking.append("a feed move with no feed F")
-            if not self.spindle_on:
+            if not self.spindle_on and not self.deposits:
                 lacking.append("a feed move with the spindle off")
+        elif self.energy:
+            self.problem(n, "a rapid with the deposition head's energy on")
         for text in lacking:
             if text not in self.lacking:
                 self.problem(n, text)
@@ -816,13 +860,13 @@ class Checker:
         self.counts["holes"] += 1
 
 
-def check_text(name, text, max_line):
+def check_text(name, text, max_line, codes=()):
     """The checker after reading `text`, its problems in c.problems."""
     lines = text.split("\n")
     last_newline = lines and lines[-1] == ""
     if last_newline:
         lines.pop()
-    c = Checker(name, lines, max_line)
+    c = Checker(name, lines, max_line, codes)
     c.run()
     if not last_newline:
         c.problems.append("%s:%d: the last line has no newline" % (name, len(lines)))
@@ -852,9 +896,15 @@ def main():
                     "toolpath IR")
     ap.add_argument("--option", action="append", default=[],
                     help="an option for stepnc compile (repeatable), e.g. --option=--no-cycles")
+    ap.add_argument("--machine", help="the machine whose [deposition] codes the programs write (a file or a "
+                    "shipped name; default: the --machine of --option)")
     args = ap.parse_args()
     if args.ir and (args.stepnc or len(args.files) != 1):
         ap.error("--ir goes with one program and no --stepnc")
+    machine = args.machine or next((o.split("=", 1)[1] for o in args.option if o.startswith("--machine=")), None)
+    codes = deposition_codes(machine)
+    if isinstance(codes, str):
+        ap.error(codes)
 
     failed = False
     suffix = " (%s)" % " ".join(args.option) if args.option else ""
@@ -868,7 +918,7 @@ def main():
                     failed = True
                     continue
             with open(path, newline="") as f:
-                c = check_text(name, f.read(), args.max_line_length)
+                c = check_text(name, f.read(), args.max_line_length, codes)
             problems = list(c.problems)
             compared = ""
             if ir and not problems:

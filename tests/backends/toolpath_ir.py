@@ -5,6 +5,7 @@ import re
 
 MOVE_RE = re.compile(r"^\s*(rapid|linear|arc|dwell)\s+(.*)$")
 ATTR_RE = re.compile(r"(\w+)=(\([^)]*\)|\S+)")
+STATE_RE = re.compile(r"^\s*state\s+(.*)$")
 
 
 def point(text):
@@ -63,9 +64,20 @@ def read_moves(path):
     full turns included); dwells their time (s), where the tool is."""
     out = []
     pos = (0.0, 0.0, 0.0)
+    # A deposition head's state: energy on or off, its power, powder, wire.
+    head = {}
     with open(path) as f:
         for n, line in enumerate(f, 1):
             code = line.split(";")[0]
+            st = STATE_RE.match(code)
+            if st:
+                attrs = dict(ATTR_RE.findall(st.group(1)))
+                if "energy" in attrs:
+                    head["energy"] = attrs["energy"] == "on"
+                for key, unit in (("power", "W"), ("powder_feed", "g/min"), ("wire_feed", "mm/min")):
+                    if key in attrs:
+                        head[key] = float(attrs[key].replace(unit, ""))
+                continue
             m = MOVE_RE.match(code)
             if not m:
                 continue
@@ -75,6 +87,8 @@ def read_moves(path):
                             "time": float(attrs["time"].replace("s", ""))})
                 continue
             move = {"kind": m.group(1), "start": pos, "to": point(attrs["to"]), "line": n, "text": code.strip()}
+            if head:
+                move["head"] = dict(head)
             if "feed" in attrs:
                 move["feed"] = float(attrs["feed"].replace("mm/min", ""))
             elif "feed_per_rev" in attrs:

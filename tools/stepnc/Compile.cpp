@@ -212,6 +212,18 @@ int compileSource(const CompileOptions &opts, const std::string &emit, std::uniq
     emitOptions.optionsText = optionsText(opts);
     emitOptions.tolerance = opts.tolerance;
     emitOptions.toolTable = table ? &*table : nullptr;
+    // A deposition program writes the head's codes of --machine.
+    std::optional<runtime::Machine> machine;
+    std::unique_ptr<SourceFile> machineFile;
+    if (!opts.machine.empty()) {
+      machine = runtime::loadMachine(opts.machine, machineFile, diags);
+      if (!machine) {
+        printStatus("the machine " + opts.machine + " has errors; nothing written");
+        return kExitDiagnostics;
+      }
+      if (machine->deposition)
+        emitOptions.deposition = &*machine->deposition;
+    }
     std::optional<std::string> program = backend->emit(*module, emitOptions, diags);
     if (!program || diags.hasErrors()) {
       printStatus("cannot write a " + opts.target + " program for " + opts.input + "; nothing written");
