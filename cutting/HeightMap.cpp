@@ -26,6 +26,15 @@ void HeightMap::addBlock(const Vec2 &lo, const Vec2 &hi, double top) {
 
 void HeightMap::cutDisc(const Vec2 &c, double r, double z) { cutCapsule(c, c, r, z); }
 
+void HeightMap::addRevolved(const Vec2 &axis, const std::function<double(double)> &top) {
+  for (int j = 0; j < ny_; ++j)
+    for (int i = 0; i < nx_; ++i) {
+      const Vec2 p(box_.lo.x() + (i + 0.5) * cell_, box_.lo.y() + (j + 0.5) * cell_);
+      float &h = h_[size_t(j) * nx_ + i];
+      h = std::max(h, float(top((p - axis).norm())));
+    }
+}
+
 /// Calls f(cell height, cell centre) for every cell whose centre lies in the
 /// area a disc of radius r sweeps from a to b.
 template <class F> void HeightMap::forCapsule(const Vec2 &a, const Vec2 &b, double r, F &&f) const {
@@ -60,6 +69,16 @@ void HeightMap::cutCapsule(const Vec2 &a, const Vec2 &b, double r, double z) {
     void operator()(size_t k, const Vec2 &) const { map.h_[k] = z; }
   };
   forCapsule(a, b, r, Cut{*this, float(z)});
+}
+
+void HeightMap::addCapsule(const Vec2 &a, const Vec2 &b, double r, double top) {
+  struct Raise {
+    HeightMap &map;
+    float top;
+    bool wants(float h) const { return h < top; }
+    void operator()(size_t k, const Vec2 &) const { map.h_[k] = top; }
+  };
+  forCapsule(a, b, r, Raise{*this, float(top)});
 }
 
 HeightMap::Peak HeightMap::highest(const Vec2 &a, const Vec2 &b, double r) const {

@@ -12,6 +12,7 @@
 
 #include "geom/Geometry.h"
 
+#include <functional>
 #include <limits>
 #include <vector>
 
@@ -35,6 +36,15 @@ public:
   /// Material from below up to `top` over the axis-aligned rectangle [lo, hi]
   /// (a block raw piece); raises cells, never lowers them.
   void addBlock(const Vec2 &lo, const Vec2 &hi, double top);
+
+  /// Material from below up to `top` over the area a disc of radius r
+  /// sweeps from a to b (a deposited bead); raises cells, never lowers them.
+  void addCapsule(const Vec2 &a, const Vec2 &b, double r, double top);
+
+  /// Material from below up to `top(d)` at each cell whose centre is d from
+  /// `axis` (a body of revolution standing on its axis: -infinity for
+  /// none); raises cells, never lowers them.
+  void addRevolved(const Vec2 &axis, const std::function<double(double)> &top);
 
   /// The material's top at p (the cell containing p); kAir outside the grid.
   float at(const Vec2 &p) const {

@@ -3,11 +3,15 @@
 
 #include "ir/Kinds.h"
 #include "ir/Program.h"
+#include "geom/Boolean.h"
 #include "ir/geom/FeatureShape.h"
+#include "ir/geom/MoveWalk.h"
+#include "ir/geom/TurnedShape.h"
 #include "support/Format.h"
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 
 namespace stepnc::passes {
@@ -46,14 +50,99 @@ const ir::Node *setupWorkpiece(const ir::Module &module, const std::string &setu
   return only;
 }
 
+namespace {
+
+/// The turning and deposition steps on `workpiece` that run before the
+/// first milling step of `setup`, in program order: what the milling stock
+/// starts from besides the raw piece.
+std::vector<const ir::Node *> otherProcessesBefore(const ir::Module &module, const std::string &setup,
+                                                   const ir::Node *workpiece) {
+  std::vector<const ir::Node *> out;
+  for (const ir::Node *e : ir::programOrder(module)) {
+    if (const ir::Node *moves = ir::millingMoves(*e); moves && moves->text("setup").value_or("") == setup)
+      break;
+    if (!ir::isTurningStep(*e) && !ir::isAdditiveStep(*e))
+      continue;
+    const ir::Node *feature = ir::findFeature(module, e->text("feature").value_or(""));
+    if (feature && ir::workpieceOf(module, *feature) == workpiece)
+      out.push_back(e);
+  }
+  return out;
+}
+
+/// The body a cylinder raw piece about the z axis is turned into by
+/// `steps` (their features' removals taken from it), as the height of its
+/// top at each distance from the axis (-infinity beyond it); none without a
+/// cylinder raw piece or a turning step.
+std::optional<std::function<double(double)>> turnedBody(const ir::Module &module, const ir::Node *workpiece,
+                                                       const std::vector<const ir::Node *> &steps, double step,
+                                                       double &radius) {
+  const ir::StockResult stock = ir::turnStock(workpiece);
+  if (!stock.stock)
+    return std::nullopt;
+  std::vector<geom::Region> removals;
+  for (const ir::Node *e : steps)
+    if (ir::isTurningStep(*e))
+      if (const ir::Node *f = ir::findFeature(module, e->text("feature").value_or("")))
+        if (auto shape = ir::turnedShape(*f, *stock.stock).shape)
+          removals.push_back(shape->removal);
+  if (removals.empty())
+    return std::nullopt;
+  const geom::Region part = geom::subtract(stock.stock->region(), geom::uniteAll(removals));
+  radius = stock.stock->radius;
+  // The top at radii `step` apart: the highest z of the part at that radius.
+  std::vector<double> tops;
+  for (double r = step / 2; r < radius; r += step) {
+    double top = -kInf;
+    for (const geom::Seg &piece : geom::clip(part, Vec2(stock.stock->z0 - 1, r), Vec2(stock.stock->z1 + 1, r)))
+      top = std::max({top, piece.a.x(), piece.b.x()});
+    tops.push_back(top);
+  }
+  return [tops, step](double d) {
+    const size_t k = static_cast<size_t>(d / step);
+    return k < tops.size() ? tops[k] : -kInf;
+  };
+}
+
+} // namespace
+
 InProcessStock::InProcessStock(const ir::Module &module, double cell) : module_(module), cell_(cell) {}
 
 cutting::HeightMap &InProcessStock::of(const std::string &setup) {
   if (auto it = stocks_.find(setup); it != stocks_.end())
     return it->second;
-  // The stock's extent: the raw piece and everything this setup's moves sweep.
-  const std::optional<ir::RawBlock> raw = ir::rawBlock(setupWorkpiece(module_, setup));
+  // The stock's extent: the raw piece, what the other processes made of it
+  // before (a turned body, deposited beads) and everything this setup's
+  // moves sweep.
+  const ir::Node *workpiece = setupWorkpiece(module_, setup);
+  const std::optional<ir::RawBlock> raw = ir::rawBlock(workpiece);
+  const std::vector<const ir::Node *> before = otherProcessesBefore(module_, setup, workpiece);
+  double bodyRadius = 0;
+  const std::optional<std::function<double(double)>> body =
+      raw ? std::nullopt : turnedBody(module_, workpiece, before, std::max(cell_ / 2, 0.01), bodyRadius);
   geom::Box box = raw ? raw->box : geom::Box{};
+  if (body)
+    box.add(geom::Box{Vec2(-bodyRadius, -bodyRadius), Vec2(bodyRadius, bodyRadius)});
+  // Beads: their centre lines, half their width, their tops.
+  struct Bead {
+    geom::Seg seg;
+    double halfWidth, top;
+  };
+  std::vector<Bead> beads;
+  for (const ir::Node *e : before) {
+    const ir::Node *op = ir::operationOf(*e);
+    const ir::Node *tech = op ? op->child(ir::Kind::DepositionTechnology) : nullptr;
+    const ir::Node *moves = e->child(ir::Kind::Moves);
+    if (!ir::isAdditiveStep(*e) || !tech || !moves)
+      continue;
+    const double w = tech->number("bead_width").value_or(0), t = tech->number("bead_height").value_or(0);
+    for (const auto &[m, energy] : ir::walkWithEnergy(*moves))
+      if (energy && m.isFeed() && m.from)
+        for (const geom::Seg &seg : m.planar()) {
+          beads.push_back({seg, w / 2, std::min(m.from->z(), m.to.z()) + t});
+          box.add(seg.box().grown(w / 2));
+        }
+  }
   double top = raw ? raw->top : -kInf;
   for (const ir::Node *e : ir::programOrder(module_)) {
     const ir::Node *moves = ir::millingMoves(*e);
@@ -63,8 +152,8 @@ cutting::HeightMap &InProcessStock::of(const std::string &setup) {
     for (const ir::Move &m : ir::walkMoves(*moves))
       if (m.isFeed())
         box.add(geom::Box{m.to.head<2>(), m.to.head<2>()}.grown(r + 1));
-    // No block raw piece: material up to the highest feature top.
-    if (!raw)
+    // No raw piece nor material made before: up to the highest feature top.
+    if (!raw && !body && beads.empty())
       if (auto f = e->text("feature"))
         if (const ir::Node *feature = ir::findFeature(module_, *f))
           if (auto shape = ir::featureShape(module_, *feature).shape)
@@ -78,8 +167,22 @@ cutting::HeightMap &InProcessStock::of(const std::string &setup) {
   while (size.x() / cell * size.y() / cell > 25e6)
     cell *= 1.25;
   cutting::HeightMap map(box.grown(2 * cell), cell);
-  if (raw) {
+  if (raw)
     map.addBlock(raw->box.lo, raw->box.hi, raw->top);
+  if (body)
+    map.addRevolved(Vec2::Zero(), *body);
+  for (const Bead &b : beads) {
+    const int pieces = std::max(1, static_cast<int>(std::ceil(b.seg.length() / std::max(cell, b.halfWidth / 2))));
+    for (int k = 0; k < pieces; ++k)
+      map.addCapsule(b.seg.at(static_cast<double>(k) / pieces), b.seg.at(static_cast<double>(k + 1) / pieces),
+                     b.halfWidth, b.top);
+  }
+  if (raw || body || !beads.empty()) {
+    if (body || !beads.empty())
+      notes_.push_back("setup " + (setup.empty() ? std::string("(none)") : setup) + ": the stock is what " +
+                       std::to_string(before.size()) + " turning and deposition steps before it made" +
+                       (body ? " (a turned body" : " (") + (beads.empty() ? ")" : (body ? " and " : "") +
+                       std::to_string(beads.size()) + " bead pieces)"));
   } else if (std::isfinite(top)) {
     map.addBlock(box.lo, box.hi, top);
     notes_.push_back("setup " + (setup.empty() ? std::string("(none)") : setup) +

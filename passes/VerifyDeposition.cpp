@@ -102,27 +102,6 @@ double segmentSegment(const Vec3 &p0, const Vec3 &p1, const Vec3 &q0, const Vec3
   return ((p0 + d1 * s) - (q0 + d2 * t)).norm();
 }
 
-/// The moves of `moves` in order, each with whether the head's energy is on
-/// while it runs (the `state` changes among them).
-std::vector<std::pair<ir::Move, bool>> energyWalk(const Node &moves) {
-  std::map<const Node *, std::vector<ir::Move>> walked;
-  for (ir::Move &m : ir::walkMoves(moves))
-    walked[m.node].push_back(m);
-  std::vector<std::pair<ir::Move, bool>> out;
-  bool energy = false;
-  for (const Node &c : moves.children) {
-    if (c.kind == ir::Kind::State) {
-      if (auto e = c.text("energy"))
-        energy = *e == "on";
-      continue;
-    }
-    if (auto it = walked.find(&c); it != walked.end())
-      for (const ir::Move &m : it->second)
-        out.emplace_back(m, energy);
-  }
-  return out;
-}
-
 /// The added feature as this check reads it, in its own frame.
 struct Solid {
   Vec3 origin = Vec3::Zero(), x = Vec3::UnitX(), y = Vec3::UnitY(), z = Vec3::UnitZ();
@@ -302,7 +281,7 @@ private:
     // The beads, and the energy against the moves.
     std::vector<Bead> beads;
     double energyTime = 0;
-    const std::vector<std::pair<ir::Move, bool>> walk = energyWalk(moves);
+    const std::vector<std::pair<ir::Move, bool>> walk = ir::walkWithEnergy(moves);
     for (const auto &[m, energy] : walk) {
       if (energy && m.kind == ir::MoveKind::Rapid) {
         error(ws, "the energy is on during a rapid to " + at(m.to));
@@ -445,7 +424,7 @@ private:
     const double nozzle = tool.number("diameter").value_or(0) / 2;
     const double half = tool.number("taper_angle").value_or(0) * kPi / 180;
     const double head = std::max(tool.number("holder_diameter").value_or(0) / 2, nozzle);
-    for (const auto &[m, energy] : energyWalk(moves)) {
+    for (const auto &[m, energy] : ir::walkWithEnergy(moves)) {
       if (!m.from)
         continue;
       const double tip = std::min(m.from->z(), m.to.z()) + standoff;

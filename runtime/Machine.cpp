@@ -7,6 +7,7 @@
 #include "runtime/TomlReader.h"
 #include "support/Format.h"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -378,7 +379,7 @@ std::optional<Machine> readMachine(const SourceFile &file, DiagnosticEngine &dia
   if (!parsed)
     return std::nullopt;
   const toml::table &root = *parsed;
-  r.onlyKnown(root, {"format", "name", "kinematics", "controller", "spindle", "axes", "deposition"},
+  r.onlyKnown(root, {"format", "name", "processes", "kinematics", "controller", "spindle", "axes", "deposition"},
               "the machine file");
   Machine m;
   if (auto format = r.number(root, "format", "the machine file", "format version", 1, 1, true); !format)
@@ -441,6 +442,26 @@ std::optional<Machine> readMachine(const SourceFile &file, DiagnosticEngine &dia
   }
   if (const toml::table *axes = r.table(root, "axes", "axes"); axes && chainKnown)
     readAxes(r, *axes, m);
+  // The processes it does: as the file lists them, else a lathe turns and
+  // any other machine mills, and deposits when it has a deposition head.
+  if (const toml::node *p = root.get("processes")) {
+    const toml::array *a = p->as_array();
+    if (a)
+      for (const toml::node &e : *a) {
+        const std::optional<std::string> name = e.value<std::string>();
+        if (name && (*name == "milling" || *name == "turning" || *name == "deposition"))
+          m.processes.push_back(*name);
+      }
+    if (!a || a->empty() || m.processes.size() != a->size())
+      r.error(p->source(), "processes must list some of \"milling\", \"turning\", \"deposition\"");
+  } else {
+    m.processes = {m.kinematics.chain == Chain::Lathe ? "turning" : "milling"};
+    if (m.deposition)
+      m.processes.push_back("deposition");
+  }
+  if (m.deposition && std::find(m.processes.begin(), m.processes.end(), "deposition") == m.processes.end())
+    r.error(root.get("deposition")->source(), "a machine with a [deposition] table deposits: list \"deposition\" "
+                                              "among its processes");
   if (!r.ok())
     return std::nullopt;
   return m;

@@ -118,6 +118,10 @@ struct Machine {
   int lookahead = 100;         ///< segments the planner may look ahead
   double pathTolerance = 0.01;  ///< mm, how far blending may leave the programmed path
   std::optional<double> maxFeed;  ///< mm/min along the path, when lower than the axes allow
+  /// The processes it does: "milling" (and drilling), "turning",
+  /// "deposition" (the file's `processes`, else from its kinematics and its
+  /// deposition head).
+  std::vector<std::string> processes;
   /// A machine with a deposition head: its codes.
   std::optional<DepositionCodes> deposition;
 

@@ -193,8 +193,9 @@ Region AmShape::section(double z) const {
 }
 
 Region AmShape::slab(double z0, double z1) const {
-  z0 = std::max(z0, 0.0);
-  z1 = std::min(z1, height);
+  // Above the top (the allowance's layers), the top face.
+  z0 = std::clamp(z0, 0.0, height);
+  z1 = std::clamp(z1, z0, height);
   if (form == Form::Extruded)
     return section(draftTan >= 0 ? z0 : z1);
   std::vector<Vec2> pts;

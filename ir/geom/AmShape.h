@@ -60,7 +60,7 @@ struct AmShape {
   /// The section at height z (0 <= z <= height), voids not removed.
   geom::Region section(double z) const;
   /// Every point of the solid between heights z0 < z1 seen along z: what a
-  /// layer between them must cover.
+  /// layer between them must cover (above the top: the top face).
   geom::Region slab(double z0, double z1) const;
   /// Every point of the channels between heights z0 < z1 seen along z, grown
   /// by `margin`: what a layer between them must keep clear of.

@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <numbers>
 
 namespace stepnc::ir {
@@ -215,6 +216,25 @@ std::vector<Move> walkMoves(const ir::Node &moves, std::optional<ir::Vec3> start
   std::vector<Move> out;
   std::optional<ir::Vec3> at = start;
   walk(moves, nullptr, at, path, arcs, out);
+  return out;
+}
+
+std::vector<std::pair<Move, bool>> walkWithEnergy(const ir::Node &moves) {
+  std::map<const ir::Node *, std::vector<Move>> walked;
+  for (Move &m : walkMoves(moves))
+    walked[m.node].push_back(m);
+  std::vector<std::pair<Move, bool>> out;
+  bool energy = false;
+  for (const ir::Node &c : moves.children) {
+    if (c.kind == ir::Kind::State) {
+      if (auto e = c.text("energy"))
+        energy = *e == "on";
+      continue;
+    }
+    if (auto it = walked.find(&c); it != walked.end())
+      for (const Move &m : it->second)
+        out.emplace_back(m, energy);
+  }
   return out;
 }
 

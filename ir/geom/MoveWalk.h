@@ -84,4 +84,8 @@ enum class PathKind : uint8_t { Programmed, Predicted };
 std::vector<Move> walkMoves(const ir::Node &moves, std::optional<ir::Vec3> start = std::nullopt,
                             PathKind path = PathKind::Programmed, OutOfPlaneArcs arcs = OutOfPlaneArcs::Chords);
 
+/// The moves of a deposition step's `moves` in order, each with whether the
+/// head's energy is on while it runs (the `state` changes among them).
+std::vector<std::pair<Move, bool>> walkWithEnergy(const ir::Node &moves);
+
 } // namespace stepnc::ir

@@ -366,8 +366,9 @@ bool expandDeposition(Expander &x, Node &ws, const Node &op, const std::string &
       x.assumed(ws, *feature, "its core's infill pattern '" + *pattern + "' is not one stepnc lays (zigzag, "
                               "parallel): laid as " + d.infill);
   }
-  // Layers.
-  const double layers = std::ceil(shape.height / d.layer - 1e-9);
+  // Layers: as many as end within the allowance above the feature (its top
+  // gets the allowance too), and at least up to its top.
+  const double layers = std::floor((shape.height + d.allowance) / d.layer + 1e-9);
   if (layers > kMaxLayers) {
     x.report(ws, op, "its layer thickness " + formatShortest(d.layer) + " mm makes " + formatShortest(layers) +
                          " layers of its " + formatShortest(shape.height) + " mm feature, more than " +
@@ -375,12 +376,14 @@ bool expandDeposition(Expander &x, Node &ws, const Node &op, const std::string &
     return false;
   }
   const long n = static_cast<long>(layers);
-  const double over = static_cast<double>(n) * d.layer - shape.height;
-  if (over > d.allowance + 1e-6) {
-    x.report(ws, op, std::to_string(n) + " layers of " + formatShortest(d.layer) + " mm end " +
+  if (static_cast<double>(n) * d.layer < shape.height - 1e-6) {
+    const double over = (static_cast<double>(n) + 1) * d.layer - shape.height;
+    x.report(ws, op, "layers of " + formatShortest(d.layer) + " mm end " +
+                         formatFixed(shape.height - static_cast<double>(n) * d.layer, 3) + " mm below or " +
                          formatFixed(over, 3) + " mm above its feature's height of " + formatShortest(shape.height) +
-                         " mm, more than the allowance of " + formatShortest(d.allowance) +
-                         " mm it may leave: give a layer thickness that divides the height, or an allowance");
+                         " mm, not within the allowance of " + formatShortest(d.allowance) +
+                         " mm above it: give a layer thickness that divides the height, or an allowance of " +
+                         formatFixed(over, 3) + " mm");
     return false;
   }
   Node moves = makeMoves(ws, tool->symbol, 0, "off", setup);

@@ -350,12 +350,15 @@ def run_rs274(ngc_path, workdir):
     return canon_path, None
 
 
-def check(stepnc, path, cycles, extra, workdir, program=None, target_opts=()):
+def check(stepnc, path, cycles, extra, workdir, program=None, target_opts=(), ir=None):
     base = os.path.join(workdir, "prog")
     ir_path, ngc_path = base + ".ir", base + ".ngc"
-    r = run([stepnc, "compile", path, "--emit=toolpath-ir", "-o", ir_path] + extra)
-    if r.returncode != 0:
-        return ["stepnc could not make the toolpath IR:\n" + r.stderr]
+    if ir:
+        ir_path = ir
+    else:
+        r = run([stepnc, "compile", path, "--emit=toolpath-ir", "-o", ir_path] + extra)
+        if r.returncode != 0:
+            return ["stepnc could not make the toolpath IR:\n" + r.stderr]
     if program:
         ngc_path = program
     else:
@@ -393,6 +396,8 @@ def main():
     ap.add_argument("--no-cycles", action="store_true", help="compile with --no-cycles and compare every move")
     ap.add_argument("--program", help="check this program against the (single) input's IR instead of "
                     "compiling one (to show that the check can fail)")
+    ap.add_argument("--ir", help="with --program: the toolpath IR the program was written from (a phase's, "
+                    "from compile --emit=toolpath-ir with several --machine), instead of compiling the input's")
     ap.add_argument("--target-opt", action="append", default=[], help="a target option for the program only "
                     "(the IR is the same): nose-compensation=controller")
     ap.add_argument("inputs", nargs="+")
@@ -400,7 +405,8 @@ def main():
     failed = False
     for path in args.inputs:
         with tempfile.TemporaryDirectory() as work:
-            problems = check(args.stepnc, path, not args.no_cycles, extra, work, args.program, args.target_opt)
+            problems = check(args.stepnc, path, not args.no_cycles, extra, work, args.program, args.target_opt,
+                             args.ir)
         for p in problems:
             print("FAIL: %s: %s" % (path, p))
         failed = failed or bool(problems)

@@ -11,6 +11,7 @@
 #include "backends/common/ToolTable.h"
 #include "backends/step-nc/OptimisedFile.h"
 #include "driver/LoadModule.h"
+#include "driver/Phases.h"
 #include "driver/Pipeline.h"
 #include "frontend/part21/Part21File.h"
 #include "frontend/part21/Writer.h"
@@ -130,6 +131,78 @@ int writeOptimised(const CompileOptions &opts, const driver::SchemaSelection &sc
   return kExitOk;
 }
 
+/// Where phase `index` (from 1) of a multi-machine program is written:
+/// `die.ngc` -> `die-1-lathe-2axis.ngc` (the machine as named, a path's stem).
+std::string phasePath(const std::string &output, size_t index, const std::string &machine) {
+  const std::filesystem::path out(output), m(machine);
+  const std::string name = out.stem().string() + "-" + std::to_string(index) + "-" + m.stem().string() +
+                           out.extension().string();
+  return (out.parent_path() / name).string();
+}
+
+/// A multi-process workplan on several machines (driver/Phases.h): a program
+/// per phase, each for its machine (its deposition codes), or with no
+/// backend the IR of each phase, all made before any is written, so that an
+/// error leaves no file.
+int writePhases(const CompileOptions &opts, const ir::Module &module, backends::Backend *backend,
+                backends::EmitOptions emitOptions, DiagnosticEngine &diags) {
+  if (opts.output == "-") {
+    printToolError("compile: several --machine write a program per machine: give -o FILE (each is FILE's name "
+                   "with the phase and the machine)");
+    return kExitUsage;
+  }
+  std::vector<driver::NamedMachine> machines;
+  std::vector<std::unique_ptr<SourceFile>> files;
+  for (const std::string &name : opts.machines) {
+    files.emplace_back();
+    std::optional<runtime::Machine> m = runtime::loadMachine(name, files.back(), diags);
+    if (!m) {
+      printStatus("the machine " + name + " has errors; nothing written");
+      return kExitDiagnostics;
+    }
+    machines.push_back({name, std::move(*m)});
+  }
+  std::optional<std::vector<driver::Phase>> phases = driver::splitIntoPhases(module, machines, diags);
+  if (!phases) {
+    printStatus("cannot assign " + opts.input + "'s workingsteps to the machines given; nothing written");
+    return kExitDiagnostics;
+  }
+  std::vector<std::pair<std::string, std::string>> programs;  // path, text
+  for (size_t i = 0; i < phases->size(); ++i) {
+    const driver::Phase &phase = (*phases)[i];
+    const driver::NamedMachine &m = machines[phase.machine];
+    const std::string path = phasePath(opts.output, i + 1, m.name);
+    backends::EmitOptions o = emitOptions;
+    o.programName = std::filesystem::path(path).stem().string();
+    o.optionsText = emitOptions.optionsText + (emitOptions.optionsText.empty() ? "" : " ") + "--machine " + m.name;
+    o.deposition = m.machine.deposition ? &*m.machine.deposition : nullptr;
+    const ir::Module part = driver::phaseModule(module, phase);
+    if (!backend) {
+      ir::PrintOptions printOptions;
+      printOptions.locations = opts.printLocations;
+      programs.emplace_back(path, ir::printModule(part, printOptions));
+      continue;
+    }
+    std::optional<std::string> program = backend->emit(part, o, diags);
+    if (!program || diags.hasErrors()) {
+      printStatus("cannot write the " + opts.target + " program of phase " + std::to_string(i + 1) + " (" + m.name +
+                  ") for " + opts.input + "; nothing written");
+      return kExitDiagnostics;
+    }
+    programs.emplace_back(path, std::move(*program));
+  }
+  for (size_t i = 0; i < programs.size(); ++i) {
+    const auto &[path, text] = programs[i];
+    if (const int rc = writeText(path, text); rc != kExitOk)
+      return rc;
+    const driver::Phase &phase = (*phases)[i];
+    printStatus("wrote " + path + " (" + (backend ? opts.target : std::string("process IR")) + ", " +
+                std::to_string(std::count(text.begin(), text.end(), '\n')) + " lines: " +
+                std::to_string(phase.executables.size()) + " executables on " + machines[phase.machine].name + ")");
+  }
+  return kExitOk;
+}
+
 /// Reads, lowers, runs the pipeline and writes what `emit` asks for, all
 /// diagnostics going to `diags`.
 int compileSource(const CompileOptions &opts, const std::string &emit, std::unique_ptr<SourceFile> &source,
@@ -177,6 +250,18 @@ int compileSource(const CompileOptions &opts, const std::string &emit, std::uniq
   // The motion IR and the native target add the motion planned on the machine.
   driver::ToolpathPipelineOptions toolpath;
   toolpath.machine = opts.machine;
+  // Several machines: feeds are bounded by the first that mills.
+  if (opts.machines.size() > 1)
+    for (const std::string &name : opts.machines) {
+      std::unique_ptr<SourceFile> file;
+      DiagnosticCollector quiet;
+      DiagnosticEngine quietDiags(quiet);
+      if (auto m = runtime::loadMachine(name, file, quietDiags);
+          m && std::find(m->processes.begin(), m->processes.end(), "milling") != m->processes.end()) {
+        toolpath.machine = name;
+        break;
+      }
+    }
   toolpath.adaptFeed = !opts.noAdaptFeed;
   toolpath.compensateDeflection = !opts.noCompensateDeflection;
   toolpath.cuttingData = opts.cuttingData;
@@ -212,6 +297,8 @@ int compileSource(const CompileOptions &opts, const std::string &emit, std::uniq
     emitOptions.optionsText = optionsText(opts);
     emitOptions.tolerance = opts.tolerance;
     emitOptions.toolTable = table ? &*table : nullptr;
+    if (opts.machines.size() > 1)
+      return writePhases(opts, *module, backend, emitOptions, diags);
     // A deposition program writes the head's codes of --machine.
     std::optional<runtime::Machine> machine;
     std::unique_ptr<SourceFile> machineFile;
@@ -235,6 +322,8 @@ int compileSource(const CompileOptions &opts, const std::string &emit, std::uniq
                   std::to_string(std::count(program->begin(), program->end(), '\n')) + " lines)");
     return rc;
   }
+  if (opts.machines.size() > 1 && emit != "motion-ir")
+    return writePhases(opts, *module, nullptr, {}, diags);
   ir::PrintOptions printOptions;
   printOptions.locations = opts.printLocations;
   return writeText(opts.output, ir::printModule(*module, printOptions));
@@ -272,6 +361,11 @@ int runCompile(const CompileOptions &opts) {
     }
   }
   const bool needsMotion = emit == "motion-ir" || opts.target == "native";
+  if (needsMotion && opts.machines.size() > 1) {
+    printToolError("compile: " + std::string(emit == "motion-ir" ? "--emit=motion-ir" : "--target=native") +
+                   " plans the motion on one machine: give one --machine");
+    return kExitUsage;
+  }
   if (needsMotion && opts.machine.empty()) {
     std::string names;
     for (const std::string &n : runtime::shippedMachineNames())
@@ -331,11 +425,15 @@ void registerCompile(CLI::App &app, std::function<void(int)> setResult) {
                   "motion-ir (with the motion planned on --machine) or stepnc (the input written back\n"
                   "as machine-optimised STEP-NC with the computed toolpaths and feeds, docs/feedback.md)")
       ->check(CLI::IsMember({"feature-ir", "toolpath-ir", "motion-ir", "program", "stepnc"}));
-  cmd->add_option("--machine", opts->machine,
+  cmd->add_option("--machine", opts->machines,
                   "Machine to plan the motion on, for --target=native and --emit=motion-ir: a TOML\n"
                   "file (docs/machine-model.md) or a shipped machine (hsc-3axis, conventional-3axis,\n"
                   "table-table-5axis, lathe-2axis: a lathe program planned in its ZX plane);\n"
-                  "feed adaptation also keeps feeds within its dynamics and spindle");
+                  "feed adaptation also keeps feeds within its dynamics and spindle; a deposition\n"
+                  "program writes its [deposition] codes. Given more than once (a multi-process\n"
+                  "workplan), each setup or workingstep runs on the first that does its process and\n"
+                  "a program is written per phase (docs/additive.md)")
+      ->allow_extra_args(false);
   cmd->add_flag("--no-adapt-feed", opts->noAdaptFeed,
                 "Keep the programmed feeds: leave out the adapt-feed pass (docs/feed-adaptation.md)");
   cmd->add_flag("--no-compensate-deflection", opts->noCompensateDeflection,
@@ -366,6 +464,8 @@ void registerCompile(CLI::App &app, std::function<void(int)> setResult) {
       printToolError("compile: an input file is required");
       return setResult(kExitUsage);
     }
+    if (!opts->machines.empty())
+      opts->machine = opts->machines.front();
     setResult(runCompile(*opts));
   });
 }

@@ -25,7 +25,8 @@ struct CompileOptions {
   std::optional<double> tolerance;
   std::vector<std::string> targetOptions;
   bool listTargets = false;
-  std::string machine;  ///< for motion-ir and the native target; bounds adapt-feed
+  std::string machine;  ///< for motion-ir and the native target; bounds adapt-feed (the first of `machines`)
+  std::vector<std::string> machines;  ///< compile's --machine, each given; several: a program per phase
   bool noAdaptFeed = false;
   bool noCompensateDeflection = false;
   std::string cuttingData;
