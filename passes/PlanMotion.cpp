@@ -25,7 +25,10 @@ public:
       return {false, false};
     if (machine->kinematics.chain == runtime::Chain::Lathe)
       return runLathe(module, *machine, diags, stats);
-    if (!ir::requireThreeAxisMilling(module, "plan-motion", diags, ir::ArcPlanes::Principal))
+    // Deposition steps are planned as any 3-axis moves (the head's state
+    // changes take no time); the native format refuses them.
+    if (!ir::requireThreeAxisMilling(module, "plan-motion", diags, ir::ArcPlanes::Principal,
+                                     ir::OtherProcesses::Refuse, ir::Deposition::Take))
       return {false, false};
     // The planner moves x, y and z: a generic chain is refused rather than
     // planned with its axes taken for x, y, z.

@@ -29,7 +29,13 @@ public:
                                   DiagnosticEngine &diags) override {
     // A re-clamp is an operator's work between two motions; the native
     // format carries motion only.
-    for (const ir::Node *e : ir::programOrder(module))
+    for (const ir::Node *e : ir::programOrder(module)) {
+      if (ir::isAdditiveStep(*e)) {
+        diags.error(e->origin.loc, "workingstep " + e->symbol + " deposits: the native motion format carries no "
+                                   "deposition head's state yet (docs/additive.md): write a G-code target")
+            .entity(e->origin.entityId);
+        return std::nullopt;
+      }
       if (e->kind == ir::Kind::ProgramStop && e->flag("reclamp").value_or(false)) {
         diags.error(e->origin.loc, "the program re-clamps the workpiece here, to reach features on another face "
                                    "(docs/setups.md); the native motion format has no stop for the operator: "
@@ -37,6 +43,7 @@ public:
             .entity(e->origin.entityId);
         return std::nullopt;
       }
+    }
     auto trajectory = ir::readMotion(module, diags);
     if (!trajectory)
       return std::nullopt;

@@ -30,6 +30,7 @@
 #include <cstdlib>
 #include <iostream>
 #include <limits>
+#include <map>
 
 namespace stepnc::tool {
 
@@ -123,6 +124,77 @@ std::unique_ptr<ir::Module> loadProgram(const SimCommandOptions &opts, std::uniq
   }
   rc = kExitOk;
   return module;
+}
+
+/// The deposition steps' figures (docs/additive.md): the time they take,
+/// the time the head's energy is on (the segments of the moves it is on
+/// for), the powder or wire fed meanwhile, and the beads laid (their length,
+/// and as strips of the bead pitch by the layer thickness their volume, and
+/// mass where the technology gives the density). Empty without deposition.
+std::string depositionReport(const ir::Module &module, const ir::ProgramPath &program,
+                             const runtime::Trajectory &trajectory) {
+  // Per move of the program: its step's technology when the energy is on.
+  std::vector<const ir::Node *> onWith(program.owners.size(), nullptr);
+  std::vector<bool> deposits(program.owners.size(), false);
+  std::map<const ir::Node *, std::vector<std::pair<ir::Move, bool>>> walked;
+  std::map<const ir::Node *, size_t> seen;
+  double length = 0, volume = 0, mass = 0;
+  bool massKnown = true;
+  size_t steps = 0;
+  for (size_t k = 0; k < program.owners.size(); ++k) {
+    const ir::Node *owner = program.owners[k];
+    if (!owner || !ir::isAdditiveStep(*owner))
+      continue;
+    deposits[k] = true;
+    auto it = walked.find(owner);
+    if (it == walked.end()) {
+      it = walked.emplace(owner, ir::walkWithEnergy(*owner->child(ir::Kind::Moves))).first;
+      ++steps;
+    }
+    const size_t i = seen[owner]++;
+    const ir::Node *tech = ir::operationOf(*owner)->child(ir::Kind::DepositionTechnology);
+    if (i < it->second.size() && it->second[i].second && it->second[i].first.isFeed() && tech) {
+      onWith[k] = tech;
+      const double l = it->second[i].first.length();
+      // Each bead stands for a strip its pitch wide and a layer high (the
+      // overlap with its neighbour counted once).
+      const double pitch = tech->number("bead_width").value_or(0) * (1 - tech->number("overlap").value_or(0));
+      const double layer = ir::operationOf(*owner)->number("layer_thickness").value_or(
+          tech->number("bead_height").value_or(0));
+      const double v = l * pitch * layer;
+      length += l;
+      volume += v;
+      if (auto rho = tech->number("density"))
+        mass += v / 1000 * *rho;
+      else
+        massKnown = false;
+    }
+  }
+  if (steps == 0)
+    return "";
+  double time = 0, on = 0, powder = 0, wire = 0;
+  for (size_t s = 0; s < trajectory.segments.size(); ++s) {
+    const uint32_t move = trajectory.info[s].move;
+    const double d = trajectory.profiles[s].duration();
+    if (move < deposits.size() && deposits[move])
+      time += d;
+    if (move < onWith.size() && onWith[move]) {
+      on += d;
+      powder += onWith[move]->number("powder_feed").value_or(0) * d / 60;
+      wire += onWith[move]->number("wire_feed").value_or(0) * d / 60;
+    }
+  }
+  std::string text = "deposition: " + std::to_string(steps) + (steps == 1 ? " step, " : " steps, ") +
+                     formatFixed(time, 1) + " s; energy on " + formatFixed(on, 1) + " s";
+  if (powder > 0)
+    text += "; powder fed " + formatFixed(powder, 1) + " g";
+  if (wire > 0)
+    text += "; wire fed " + formatFixed(wire / 1000, 2) + " m";
+  text += "; beads " + formatFixed(length / 1000, 2) + " m, " + formatFixed(volume / 1000, 2) + " cm3";
+  if (massKnown)
+    text += ", " + formatFixed(mass, 1) + " g deposited";
+  text += " (each bead a strip of its pitch by a layer)\n";
+  return text;
 }
 
 /// A lathe's native motion (planned by plan-motion on a lathe, axes z x y):
@@ -303,7 +375,9 @@ int runSim(const SimCommandOptions &opts) {
       --first;
     return label(*program->owners[move]) + ", move " + std::to_string(move - first + 1);
   };
-  const std::string text = runtime::formatReport(report, *trajectory, *machine, nameMove);
+  std::string text = runtime::formatReport(report, *trajectory, *machine, nameMove);
+  if (module && program)
+    text += depositionReport(*module, *program, *trajectory);
   if (!opts.samples.empty() && !samplesOut.commit(error)) {
     printToolError(error);
     return kExitUsage;
