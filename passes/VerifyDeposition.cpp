@@ -106,7 +106,8 @@ double segmentSegment(const Vec3 &p0, const Vec3 &p1, const Vec3 &q0, const Vec3
 struct Solid {
   Vec3 origin = Vec3::Zero(), x = Vec3::UnitX(), y = Vec3::UnitY(), z = Vec3::UnitZ();
   double height = 0;
-  std::vector<Vec2> polygon;  ///< extruded: the profile
+  std::vector<Vec2> polygon;  ///< extruded: the profile; revolved: the meridian (radius, height)
+  bool revolved = false;
   double draftTan = 0;
   std::vector<std::pair<Vec3, Vec3>> planes;  ///< faceted: point, outward normal
   struct Channel {
@@ -134,15 +135,17 @@ struct Solid {
     }
     double d = 1e300;
     bool inside = false;
+    // A revolved solid: the distance in its meridian plane, through p.
+    const Vec2 q = revolved ? Vec2(p.norm(), h) : p;
     for (size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++) {
       const Vec2 &a = polygon[j], &b = polygon[i];
       const Vec2 ab = b - a;
-      const double t = std::clamp((p - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
-      d = std::min(d, (a + ab * t - p).norm());
-      if ((a.y() > p.y()) != (b.y() > p.y()) && p.x() < a.x() + (p.y() - a.y()) * ab.x() / ab.y())
+      const double t = std::clamp((q - a).dot(ab) / std::max(ab.squaredNorm(), 1e-300), 0.0, 1.0);
+      d = std::min(d, (a + ab * t - q).norm());
+      if ((a.y() > q.y()) != (b.y() > q.y()) && q.x() < a.x() + (q.y() - a.y()) * ab.x() / ab.y())
         inside = !inside;
     }
-    return (inside ? -d : d) + h * draftTan;
+    return (inside ? -d : d) + (revolved ? 0.0 : h * draftTan);
   }
   /// The smallest distance from the vertical segment at p between heights
   /// h0 and h1 to a channel's axis, less its radius: negative inside.
@@ -210,7 +213,11 @@ std::optional<Solid> readSolid(const ir::Module &module, const Node &f, std::str
       error = "has a profile this check does not read";
       return std::nullopt;
     }
+    s.revolved = f.text("shape").value_or("") == "revolved";
     s.height = f.number("height").value_or(0);
+    if (s.revolved)
+      for (const Vec2 &p : s.polygon)
+        s.height = std::max(s.height, p.y());
     s.draftTan = std::tan(f.number("draft").value_or(0) * kPi / 180);
   }
   for (const Node *v : f.childrenOf(ir::Kind::AmVoid)) {
@@ -337,7 +344,10 @@ private:
         index.emplace(segs);
       // Coverage: the grid over the section's box at the layer's bottom.
       geom::Box box;
-      if (!solid->polygon.empty())
+      if (solid->revolved)
+        for (const Vec2 &p : solid->polygon)
+          box.add(geom::Box{Vec2(-p.x(), -p.x()), Vec2(p.x(), p.x())});
+      else if (!solid->polygon.empty())
         for (const Vec2 &p : solid->polygon)
           box.add(p);
       else

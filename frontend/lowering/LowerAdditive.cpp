@@ -28,11 +28,11 @@ bool inRange(Lowerer &l, const Instance &inst, std::string_view attribute, doubl
 
 bool Lowerer::additiveFeature(const Instance &f, Node &n) {
   n.kind = ir::Kind::AmSimpleFeature;
-  const bool extruded = f.isA("am_extruded_feature");
-  if (!extruded && !f.isA("am_faceted_feature")) {
+  const bool extruded = f.isA("am_extruded_feature"), revolved = f.isA("am_revolved_feature");
+  if (!extruded && !revolved && !f.isA("am_faceted_feature")) {
     unsupported(f, f.isA("am_simple_feature")
-                       ? "feature (an am_simple_feature without a shape: stepnc builds the extruded and faceted "
-                         "added features of its extension schema, docs/additive.md)"
+                       ? "feature (an am_simple_feature without a shape: stepnc builds the extruded, revolved and "
+                         "faceted added features of its extension schema, docs/additive.md)"
                        : "feature");
     return false;
   }
@@ -85,6 +85,14 @@ bool Lowerer::additiveFeature(const Instance &f, Node &n) {
       ok = false;
     }
     copyAngle(n, "draft", f, "draft_angle");
+    if (auto p = profile(f.ref("its_profile")))
+      n.add(std::move(*p));
+    else {
+      missing(f, "its_profile");
+      ok = false;
+    }
+  } else if (revolved) {
+    n.set("shape", Value::word("revolved"));
     if (auto p = profile(f.ref("its_profile")))
       n.add(std::move(*p));
     else {
@@ -244,6 +252,10 @@ std::optional<Node> Lowerer::additiveOperation(const Instance &op) {
     ok = false;
   }
   copyWord(t, "bead_profile", tech, "bead_profile");
+  if (tech.enumeration("bead_profile").value_or("rectangle") != "rectangle")
+    assumed(tech, "bead_profile",
+            "is " + *tech.enumeration("bead_profile") + ": stepnc lays and checks beads as rectangles of the bead's "
+            "width and height (docs/additive.md)");
   if (auto gas = tech.string("shielding_gas"))
     t.set("gas", Value::string(*gas));
   copyReal(t, "gas_flow", tech, "shielding_gas_flow", Value::real);

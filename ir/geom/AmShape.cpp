@@ -167,9 +167,42 @@ std::optional<std::vector<Vec3>> polylineOf(const Node &curve, std::string &erro
   return pts;
 }
 
+/// The radii [inner, outer] at which the meridian (x the radius, y the
+/// height) is solid at height z.
+std::vector<std::pair<double, double>> meridianSpans(const Loop &meridian, double z) {
+  Region r;
+  r.loops.push_back(meridian);
+  const geom::Box b = meridian.box();
+  std::vector<std::pair<double, double>> spans;
+  for (const geom::Seg &s : geom::clip(r, Vec2(b.lo.x() - 1, z), Vec2(b.hi.x() + 1, z)))
+    spans.push_back({std::min(s.a.x(), s.b.x()), std::max(s.a.x(), s.b.x())});
+  return spans;
+}
+
+/// Annuli about the origin, one per span (a disc when it reaches the axis),
+/// overlapping spans merged first.
+Region annuli(std::vector<std::pair<double, double>> spans) {
+  std::sort(spans.begin(), spans.end());
+  std::vector<std::pair<double, double>> merged;
+  for (const auto &s : spans)
+    if (!merged.empty() && s.first <= merged.back().second + 1e-9)
+      merged.back().second = std::max(merged.back().second, s.second);
+    else if (s.second > s.first + 1e-9)
+      merged.push_back(s);
+  Region r;
+  for (const auto &[inner, outer] : merged) {
+    r.loops.push_back(geom::circleLoop(Vec2::Zero(), outer, true));
+    if (inner > 1e-6)
+      r.loops.push_back(geom::circleLoop(Vec2::Zero(), inner, false));
+  }
+  return r;
+}
+
 } // namespace
 
 Region AmShape::section(double z) const {
+  if (form == Form::Revolved)
+    return annuli(meridianSpans(profile, z));
   if (form == Form::Extruded) {
     Region base;
     base.loops.push_back(profile);
@@ -198,6 +231,21 @@ Region AmShape::slab(double z0, double z1) const {
   z1 = std::clamp(z1, z0, height);
   if (form == Form::Extruded)
     return section(draftTan >= 0 ? z0 : z1);
+  if (form == Form::Revolved) {
+    // The spans at both heights, at the meridian's corners between them,
+    // and every tenth of the layer (its arcs' widest points within 1 %).
+    std::vector<double> heights = {z0, z1};
+    for (const geom::Seg &s : profile.segs)
+      if (s.a.y() > z0 && s.a.y() < z1)
+        heights.push_back(s.a.y());
+    for (int k = 1; k < 10; ++k)
+      heights.push_back(z0 + (z1 - z0) * k / 10);
+    std::vector<std::pair<double, double>> spans;
+    for (double z : heights)
+      for (const auto &span : meridianSpans(profile, std::clamp(z, 1e-9, height - 1e-9)))
+        spans.push_back(span);
+    return annuli(std::move(spans));
+  }
   std::vector<Vec2> pts;
   for (double z : {z0, z1})
     for (const geom::Loop &l : section(z).loops)
@@ -255,6 +303,25 @@ AmShapeResult amShape(const Module &module, const Node &feature) {
     if (s.draftTan > 0 && s.section(s.height).empty())
       return {std::nullopt, name + ": its walls, leaning in by " + formatShortest(draft) +
                                 " deg, meet below its height of " + formatShortest(s.height) + " mm"};
+  } else if (shape == "revolved") {
+    s.form = AmShape::Form::Revolved;
+    std::string error;
+    std::optional<Loop> l = closedProfileLoop(module, feature, error);
+    if (!l)
+      return {std::nullopt, error};
+    if (l->area() < 0)
+      l->reverse();
+    const geom::Box b = l->box();
+    if (l->area() < 1e-9)
+      return {std::nullopt, name + ": its meridian encloses no area"};
+    if (b.lo.x() < -1e-6)
+      return {std::nullopt, name + ": its meridian reaches " + formatShortest(-b.lo.x()) +
+                                " mm past the axis (x < 0): x is the distance from the axis"};
+    if (std::abs(b.lo.y()) > 1e-6)
+      return {std::nullopt, name + ": its meridian starts " + formatShortest(b.lo.y()) +
+                                " mm above its placement: the base (y = 0) is where it is built from"};
+    s.profile = std::move(*l);
+    s.height = b.hi.y();
   } else if (shape == "faceted") {
     s.form = AmShape::Form::Faceted;
     for (const Node *p : feature.childrenOf(Kind::BoundingPlane))
@@ -281,8 +348,8 @@ AmShapeResult amShape(const Module &module, const Node &feature) {
     if (s.height < 1e-6)
       return {std::nullopt, name + ": its bounding planes enclose a flat solid"};
   } else {
-    return {std::nullopt, name + " has no shape stepnc builds (an extruded or faceted added feature of stepnc's "
-                                 "extension, docs/additive.md)"};
+    return {std::nullopt, name + " has no shape stepnc builds (an extruded, revolved or faceted added feature of "
+                                 "stepnc's extension, docs/additive.md)"};
   }
   for (const Node *v : feature.childrenOf(Kind::AmVoid)) {
     VoidTube t;

@@ -42,13 +42,14 @@ struct VoidTube {
 inline constexpr double kVoidChordTolerance = 0.005;
 
 struct AmShape {
-  enum class Form { Extruded, Faceted };
+  enum class Form { Extruded, Revolved, Faceted };
   std::string symbol;
   Form form = Form::Extruded;
   SolidFrame frame;
   double height = 0;
   /// Extruded: the base profile (counter-clockwise) and tan(draft), > 0
-  /// when the walls lean in.
+  /// when the walls lean in. Revolved: `profile` is the meridian (x the
+  /// distance from the axis, y the height), counter-clockwise.
   geom::Loop profile;
   double draftTan = 0;
   /// Faceted: each plane as a point and its outward normal; the solid's
