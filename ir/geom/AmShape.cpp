@@ -279,17 +279,26 @@ AmShapeResult amShape(const Module &module, const Node &feature) {
   s.frame.x = ref.normalized();
   s.frame.y = s.frame.z.cross(s.frame.x);
   const std::string shape = feature.text("shape").value_or("");
-  if (shape == "extruded") {
-    s.form = AmShape::Form::Extruded;
-    std::string error;
+  // The closed profile child, counter-clockwise (an extruded feature's
+  // base, a revolved one's meridian); false with `error` set.
+  std::string error;
+  auto readProfile = [&](std::string_view what) {
     std::optional<Loop> l = closedProfileLoop(module, feature, error);
     if (!l)
-      return {std::nullopt, error};
+      return false;
     if (l->area() < 0)
       l->reverse();
-    if (l->area() < 1e-9)
-      return {std::nullopt, name + ": its profile encloses no area"};
+    if (l->area() < 1e-9) {
+      error = name + ": its " + std::string(what) + " encloses no area";
+      return false;
+    }
     s.profile = std::move(*l);
+    return true;
+  };
+  if (shape == "extruded") {
+    s.form = AmShape::Form::Extruded;
+    if (!readProfile("profile"))
+      return {std::nullopt, error};
     const std::optional<double> h = feature.number("height");
     if (!h || !(*h > 0))
       return {std::nullopt, name + ": an extruded added feature needs a height above 0"};
@@ -305,22 +314,15 @@ AmShapeResult amShape(const Module &module, const Node &feature) {
                                 " deg, meet below its height of " + formatShortest(s.height) + " mm"};
   } else if (shape == "revolved") {
     s.form = AmShape::Form::Revolved;
-    std::string error;
-    std::optional<Loop> l = closedProfileLoop(module, feature, error);
-    if (!l)
+    if (!readProfile("meridian"))
       return {std::nullopt, error};
-    if (l->area() < 0)
-      l->reverse();
-    const geom::Box b = l->box();
-    if (l->area() < 1e-9)
-      return {std::nullopt, name + ": its meridian encloses no area"};
+    const geom::Box b = s.profile.box();
     if (b.lo.x() < -1e-6)
       return {std::nullopt, name + ": its meridian reaches " + formatShortest(-b.lo.x()) +
                                 " mm past the axis (x < 0): x is the distance from the axis"};
     if (std::abs(b.lo.y()) > 1e-6)
       return {std::nullopt, name + ": its meridian starts " + formatShortest(b.lo.y()) +
                                 " mm above its placement: the base (y = 0) is where it is built from"};
-    s.profile = std::move(*l);
     s.height = b.hi.y();
   } else if (shape == "faceted") {
     s.form = AmShape::Form::Faceted;
@@ -359,7 +361,6 @@ AmShapeResult amShape(const Module &module, const Node &feature) {
       return {std::nullopt, name + ": its void '" + t.label + "' has no diameter"};
     if (v->children.empty())
       return {std::nullopt, name + ": its void '" + t.label + "' has no guide curve"};
-    std::string error;
     std::optional<std::vector<Vec3>> pts = polylineOf(v->children.front(), error);
     if (!pts)
       return {std::nullopt, name + ": the guide of its void '" + t.label + "': " + error};
