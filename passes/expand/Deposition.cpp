@@ -15,6 +15,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <set>
+#include <optional>
 
 namespace stepnc::passes::expand {
 
@@ -53,9 +56,10 @@ struct DepositionPlan {
 Vec2 unit(double deg) { return {std::cos(deg * kPi / 180), std::sin(deg * kPi / 180)}; }
 
 /// Zigzag: each stroke joined to the next by a straight link when the link
-/// lies inside the area grown by a quarter pitch (links run along its
-/// boundary: the margin keeps the decision off it), and the bead goes on
-/// along it; parallel: every stroke alone, all in one direction.
+/// lies inside the area (every quarter pitch along it inside, or on its
+/// boundary within a micrometre: links run along the boundary, where a
+/// clip would decide either way), and the bead goes on along it; parallel:
+/// every stroke alone, all in one direction.
 std::vector<Path2D> infillPaths(const Region &area, const Vec2 &dir, double pitch, bool zigzag) {
   std::vector<Path2D> strokesIn;
   // The outer strokes half a pitch inside the area's extremes across them
@@ -66,7 +70,16 @@ std::vector<Path2D> infillPaths(const Region &area, const Vec2 &dir, double pitc
       strokesIn.push_back(std::move(s));
   if (!zigzag)
     return strokesIn;
-  const Region linkArea = geom::offset(area, pitch / 4);
+  const geom::SegIndex boundary = geom::SegIndex::of(area);
+  auto inside = [&](const Vec2 &a, const Vec2 &b) {
+    const int n = std::max(1, static_cast<int>(std::ceil((b - a).norm() / (pitch / 4))));
+    for (int k = 0; k <= n; ++k) {
+      const Vec2 p = a + (b - a) * (static_cast<double>(k) / n);
+      if (!area.contains(p) && !boundary.within(p, 1e-6))
+        return false;
+    }
+    return true;
+  };
   std::vector<Path2D> out;
   for (Path2D &s : strokesIn) {
     if (s.empty())
@@ -74,15 +87,7 @@ std::vector<Path2D> infillPaths(const Region &area, const Vec2 &dir, double pitc
     if (!out.empty()) {
       const Vec2 a = out.back().back().b, b = s.front().a;
       const double gap = (b - a).norm();
-      bool inside = gap <= 2.5 * pitch;
-      if (inside && gap > geom::kEps) {
-        std::vector<Seg> pieces = geom::clip(linkArea, a, b);
-        double covered = 0;
-        for (const Seg &p : pieces)
-          covered += p.length();
-        inside = covered >= gap - 1e-6;
-      }
-      if (inside) {
+      if (gap <= 2.5 * pitch && inside(a, b)) {
         if (gap > geom::kEps)
           out.back().push_back(Seg::line(a, b));
         out.back().insert(out.back().end(), s.begin(), s.end());
@@ -124,73 +129,132 @@ LayerPaths layerPaths(const Region &region, const DepositionPlan &d, long layer,
   return out;
 }
 
-/// Beads that fill what the contours and the infill leave bare inside the
-/// region (concave corners of the infill area, slivers between a channel's
-/// contours and the outer ones): the region is sampled every quarter bead
-/// width; every bare point more than half a width from every bead centre
-/// line starts a cluster of the bare points within a width of it, covered by
-/// a bead along the cluster's longest extent, kept where a bead's centre
-/// may go (half a width inside the region). A bare point where no centre
-/// may go (a sharp convex corner) stays bare: the allowance is for it.
-std::vector<Path2D> gapFill(const Region &region, const LayerPaths &laid, const DepositionPlan &d) {
-  std::vector<Seg> centreLines;
-  for (const Loop &l : laid.contours)
-    centreLines.insert(centreLines.end(), l.segs.begin(), l.segs.end());
-  for (const Path2D &p : laid.infill)
-    centreLines.insert(centreLines.end(), p.begin(), p.end());
+/// Beads that fill what the contours and the infill leave bare of the
+/// feature's layer (`required`; `region` is it grown by the allowance: where
+/// beads may go): concave corners of the infill area, slivers between a
+/// channel's contours and the outer ones. The layer is sampled every quarter
+/// bead width; a bare point (more than half a width from every bead's centre
+/// line) is covered by a bead centred where a centre may go (half a width
+/// inside the region): at the point, else at the nearest such place within
+/// half a width of it. The bare points whose centres lie within a width of
+/// each other get one bead along the longest extent of their centres; a
+/// lone one a stub a quarter width long, in from the edge of where centres
+/// may go. A bare point with no such place near it (a sharp convex corner)
+/// stays bare: the allowance is for it.
+/// One round of gapFill: the layer sampled every `step` over `boxes`, a
+/// point bare when it is farther than `reach` from every centre line of
+/// `laid`; `bareBoxes` gets a box a width wide about each bare point.
+std::vector<Path2D> gapFillRound(const Region &region, const Region &required, const std::vector<Seg> &laid,
+                                 const DepositionPlan &d, double step, double reach,
+                                 const std::vector<geom::Box> &boxes, std::vector<geom::Box> &bareBoxes) {
   std::vector<Path2D> out;
-  if (centreLines.empty())
+  if (laid.empty())
     return out;
   const Region centres = geom::offset(region, -d.width / 2);
   if (centres.empty())
     return out;
-  geom::SegIndex laidIndex(centreLines);
-  const geom::Box box = region.box();
-  const double step = d.width / 4, reach = d.width / 2 - step / 4;
-  std::vector<Vec2> bare;
-  for (double x = box.lo.x() + step / 2; x < box.hi.x(); x += step)
-    for (double y = box.lo.y() + step / 2; y < box.hi.y(); y += step) {
-      const Vec2 p(x, y);
-      if (region.contains(p) && !laidIndex.within(p, reach))
-        bare.push_back(p);
-    }
-  std::vector<bool> done(bare.size(), false);
-  for (size_t i = 0; i < bare.size(); ++i) {
-    if (done[i])
-      continue;
-    std::vector<Vec2> cluster;
-    for (size_t j = i; j < bare.size(); ++j)
-      if (!done[j] && (bare[j] - bare[i]).norm() <= d.width) {
-        cluster.push_back(bare[j]);
-        done[j] = true;
+  const geom::SegIndex laidIndex(laid), edge = geom::SegIndex::of(centres);
+  // A bare point, where the bead for it is centred, and which way is in there.
+  struct Bare {
+    Vec2 point, centre, in;
+  };
+  std::vector<Bare> bare;
+  std::vector<uint32_t> near;
+  std::set<std::pair<long, long>> sampled;  // grid points already looked at (boxes overlap)
+  for (const geom::Box &box : boxes)
+  for (long i = std::lround(std::floor(box.lo.x() / step)); i * step <= box.hi.x(); ++i)
+    for (long j = std::lround(std::floor(box.lo.y() / step)); j * step <= box.hi.y(); ++j) {
+      if (!sampled.insert({i, j}).second)
+        continue;
+      const Vec2 p((static_cast<double>(i) + 0.5) * step, (static_cast<double>(j) + 0.5) * step);
+      if (!required.contains(p) || laidIndex.within(p, reach))
+        continue;
+      bareBoxes.push_back(geom::Box{p, p}.grown(d.width));
+      if (centres.contains(p)) {
+        bare.push_back({p, p, Vec2::UnitX()});
+        continue;
       }
-    // The cluster's two points furthest apart, or a short bead through a
-    // lone point.
-    Vec2 a = cluster.front(), b = cluster.front();
-    double far = 0;
-    for (const Vec2 &p : cluster)
-      for (const Vec2 &q : cluster)
-        if ((p - q).norm() > far) {
-          far = (p - q).norm();
-          a = p;
-          b = q;
+      // A centre on the edge may be as far as the bead's half width (less
+      // a hundredth of a millimetre).
+      const double pull = d.width / 2 - 0.01;
+      edge.query(geom::Box{p, p}.grown(pull), near);
+      double best = pull;
+      std::optional<Bare> at;
+      for (uint32_t k : near) {
+        const Seg &sg = edge.segs()[k];
+        const Vec2 q = geom::closestPoint(sg, p);
+        if ((q - p).norm() < best) {
+          best = (q - p).norm();
+          const Vec2 t = sg.tangent(std::clamp((q - sg.a).norm() / std::max(sg.length(), 1e-12), 0.0, 1.0));
+          // Centres' loops keep material on their left.
+          at = Bare{p, q, Vec2(-t.y(), t.x())};
         }
-    if (far < d.width / 4) {
-      const Vec2 mid = (a + b) / 2;
-      a = mid - Vec2(d.width / 8, 0);
-      b = mid + Vec2(d.width / 8, 0);
-    }
-    Seg best;
-    double bestLength = 0;
-    for (const Seg &piece : geom::clip(centres, a, b))
-      if (piece.length() > bestLength) {
-        best = piece;
-        bestLength = piece.length();
       }
-    if (bestLength > geom::kEps)
-      out.push_back({best});
+      if (at)
+        bare.push_back(*at);
+    }
+  // Inside where centres may go, or on its edge within a micrometre.
+  auto allowed = [&](const Vec2 &a, const Vec2 &b) {
+    const int n = std::max(1, static_cast<int>(std::ceil((b - a).norm() / step)));
+    for (int k = 0; k <= n; ++k) {
+      const Vec2 q = a + (b - a) * (static_cast<double>(k) / n);
+      if (!centres.contains(q) && !edge.within(q, 1e-6))
+        return false;
+    }
+    return true;
+  };
+  // The bare points by cell of a bead width, for their neighbours.
+  std::map<std::pair<long, long>, std::vector<size_t>> cells;
+  auto cellOf = [&](const Vec2 &p) {
+    return std::pair{std::lround(std::floor(p.x() / d.width)), std::lround(std::floor(p.y() / d.width))};
+  };
+  for (size_t i = 0; i < bare.size(); ++i)
+    cells[cellOf(bare[i].centre)].push_back(i);
+  // In order, each point not covered yet gets a bead from its centre to the
+  // furthest neighbour's (within a width) that it may run to straight, else
+  // a stub in from its centre.
+  for (const Bare &b : bare) {
+    if (std::any_of(out.begin(), out.end(),
+                    [&](const Path2D &g) { return geom::distance(g.front(), b.point) <= d.width / 2 - 0.01; }))
+      continue;
+    const Vec2 *to = nullptr;
+    double far = step;
+    const auto [cx, cy] = cellOf(b.centre);
+    for (long i = cx - 1; i <= cx + 1; ++i)
+      for (long j = cy - 1; j <= cy + 1; ++j)
+        if (auto it = cells.find({i, j}); it != cells.end())
+          for (size_t k : it->second) {
+            const double dist = (bare[k].centre - b.centre).norm();
+            if (dist > far && dist <= d.width && allowed(b.centre, bare[k].centre)) {
+              far = dist;
+              to = &bare[k].centre;
+            }
+          }
+    if (to) {
+      out.push_back({Seg::line(b.centre, *to)});
+      continue;
+    }
+    const Vec2 stub = b.centre + b.in * step;
+    if (allowed(b.centre, stub))
+      out.push_back({Seg::line(b.centre, stub)});
+    else if (allowed(b.centre, b.centre - b.in * step))
+      out.push_back({Seg::line(b.centre, b.centre - b.in * step)});
   }
   return out;
+}
+
+/// The layer sampled every eighth of a bead width (a sliver of bare layer
+/// narrower than that may pass between the samples), a point bare when it is
+/// more than half a width (less 0.02 mm) from every centre line.
+std::vector<Path2D> gapFill(const Region &region, const Region &required, const LayerPaths &laid,
+                            const DepositionPlan &d) {
+  std::vector<Seg> lines;
+  for (const Loop &l : laid.contours)
+    lines.insert(lines.end(), l.segs.begin(), l.segs.end());
+  for (const Path2D &p : laid.infill)
+    lines.insert(lines.end(), p.begin(), p.end());
+  std::vector<geom::Box> bareBoxes;
+  return gapFillRound(region, required, lines, d, d.width / 8, d.width / 2 - 0.02, {region.box()}, bareBoxes);
 }
 
 /// The segment in workpiece coordinates.
@@ -398,17 +462,19 @@ bool expandDeposition(Expander &x, Node &ws, const Node &op, const std::string &
   long emptyLayers = 0, gapBeads = 0;
   for (long k = 0; k < n; ++k) {
     const double z0 = static_cast<double>(k) * d.layer, z1 = z0 + d.layer;
-    Region region = shape.slab(z0, std::min(z1, shape.height));
-    if (d.allowance > 0 && !region.empty())
-      region = geom::offset(region, d.allowance);
+    // The feature's layer, and where beads may go: it grown by the allowance.
+    Region required = shape.slab(z0, std::min(z1, shape.height));
+    Region region = d.allowance > 0 && !required.empty() ? geom::offset(required, d.allowance) : required;
     if (!shape.voids.empty()) {
       Region v = shape.voidsIn(z0, z1, 0);
-      if (!v.empty())
+      if (!v.empty()) {
         region = geom::subtract(region, v);
+        required = geom::subtract(required, v);
+      }
     }
     LayerPaths paths = layerPaths(region, d, k, centre);
     if (d.pattern != "spiral")
-      for (Path2D &gap : gapFill(region, paths, d)) {
+      for (Path2D &gap : gapFill(region, required, paths, d)) {
         paths.infill.push_back(std::move(gap));
         ++gapBeads;
       }
@@ -429,6 +495,10 @@ bool expandDeposition(Expander &x, Node &ws, const Node &op, const std::string &
     x.warning(ws, std::to_string(emptyLayers) + " of its " + std::to_string(n) +
                       " layers have no room for a bead of " + formatShortest(d.width) +
                       " mm: the feature is narrower there than a bead, and nothing is deposited");
+  if (gapBeads * 4 > dep.beads())
+    x.warning(ws, std::to_string(gapBeads) + " of its " + std::to_string(dep.beads()) +
+                      " beads are short ones that fill what its strategy's contours and infill leave bare (around "
+                      "channels, in corners): contour beads (contour_then_infill) would lay them in one go");
   dep.material(false);
   dep.retract();
   (*x.stats)["layers deposited"] += n - emptyLayers;
