@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <set>
 #include <optional>
@@ -118,9 +119,11 @@ LayerPaths layerPaths(const Region &region, const DepositionPlan &d, long layer,
   }
   if (contourOnly)
     return out;
-  // The infill lines lie a pitch inside the last contour (their beads meet
-  // it as two contours meet), or half a bead inside the section.
-  const double infillInset = made > 0 ? inset - d.pitch + d.infillPitch : d.width / 2;
+  // The infill strokes end half a pitch inside the last contour (the band
+  // between them and it, and the corners of that band, lie within the
+  // contour bead's reach: their ends overlap it by half a pitch more than
+  // neighbours do), or half a bead inside the section.
+  const double infillInset = made > 0 ? inset - d.pitch + d.pitch / 2 : d.width / 2;
   Region area = geom::offset(region, -infillInset);
   if (area.empty())
     return out;
@@ -141,58 +144,83 @@ LayerPaths layerPaths(const Region &region, const DepositionPlan &d, long layer,
 /// lone one a stub a quarter width long, in from the edge of where centres
 /// may go. A bare point with no such place near it (a sharp convex corner)
 /// stays bare: the allowance is for it.
-/// One round of gapFill: the layer sampled every `step` over `boxes`, a
-/// point bare when it is farther than `reach` from every centre line of
-/// `laid`; `bareBoxes` gets a box a width wide about each bare point.
-std::vector<Path2D> gapFillRound(const Region &region, const Region &required, const std::vector<Seg> &laid,
-                                 const DepositionPlan &d, double step, double reach,
-                                 const std::vector<geom::Box> &boxes, std::vector<geom::Box> &bareBoxes) {
+/// Beads that fill what the contours and the infill leave bare of the
+/// feature's layer (`required`; `region` is it grown by the allowance: where
+/// beads may go): concave corners of the infill area, slivers between a
+/// channel's contours and the outer ones. The layer is sampled every quarter
+/// bead width, and a sample less than 0.71 spacings (its cell's half
+/// diagonal) clear of being bare is looked at again in its four quarters,
+/// down to cells of a hundredth of a bead: a point is bare when it is more
+/// than half a width from every centre line (so every point of the layer a
+/// bead can reach ends within half a width and 0.015 widths of one). Each bare point
+/// not covered by a bead placed already gets one centred where a bead's
+/// centre may go (half a width inside the region): at the point, else at the
+/// nearest such place within half a width of it; the bead runs to the
+/// furthest other bare point's centre within a width it may reach straight,
+/// or is a stub in from its centre. A bare point with no such place near it
+/// (a sharp convex corner) stays bare: the allowance is for it.
+std::vector<Path2D> gapFill(const Region &region, const Region &required, const LayerPaths &laid,
+                            const DepositionPlan &d) {
+  std::vector<Seg> lines;
+  for (const Loop &l : laid.contours)
+    lines.insert(lines.end(), l.segs.begin(), l.segs.end());
+  for (const Path2D &p : laid.infill)
+    lines.insert(lines.end(), p.begin(), p.end());
   std::vector<Path2D> out;
-  if (laid.empty())
+  if (lines.empty())
     return out;
   const Region centres = geom::offset(region, -d.width / 2);
   if (centres.empty())
     return out;
-  const geom::SegIndex laidIndex(laid), edge = geom::SegIndex::of(centres);
+  const geom::SegIndex laidIndex(lines), edge = geom::SegIndex::of(centres);
+  const double step = d.width / 4, reach = d.width / 2, finest = d.width / 100;
   // A bare point, where the bead for it is centred, and which way is in there.
   struct Bare {
     Vec2 point, centre, in;
   };
   std::vector<Bare> bare;
   std::vector<uint32_t> near;
-  std::set<std::pair<long, long>> sampled;  // grid points already looked at (boxes overlap)
-  for (const geom::Box &box : boxes)
-  for (long i = std::lround(std::floor(box.lo.x() / step)); i * step <= box.hi.x(); ++i)
-    for (long j = std::lround(std::floor(box.lo.y() / step)); j * step <= box.hi.y(); ++j) {
-      if (!sampled.insert({i, j}).second)
-        continue;
-      const Vec2 p((static_cast<double>(i) + 0.5) * step, (static_cast<double>(j) + 0.5) * step);
-      if (!required.contains(p) || laidIndex.within(p, reach))
-        continue;
-      bareBoxes.push_back(geom::Box{p, p}.grown(d.width));
-      if (centres.contains(p)) {
-        bare.push_back({p, p, Vec2::UnitX()});
-        continue;
-      }
-      // A centre on the edge may be as far as the bead's half width (less
-      // a hundredth of a millimetre).
-      const double pull = d.width / 2 - 0.01;
-      edge.query(geom::Box{p, p}.grown(pull), near);
-      double best = pull;
-      std::optional<Bare> at;
-      for (uint32_t k : near) {
-        const Seg &sg = edge.segs()[k];
-        const Vec2 q = geom::closestPoint(sg, p);
-        if ((q - p).norm() < best) {
-          best = (q - p).norm();
-          const Vec2 t = sg.tangent(std::clamp((q - sg.a).norm() / std::max(sg.length(), 1e-12), 0.0, 1.0));
-          // Centres' loops keep material on their left.
-          at = Bare{p, q, Vec2(-t.y(), t.x())};
-        }
-      }
-      if (at)
-        bare.push_back(*at);
+  auto add = [&](const Vec2 &p) {
+    if (centres.contains(p)) {
+      bare.push_back({p, p, Vec2::UnitX()});
+      return;
     }
+    // A centre on the edge may be as far as the bead's half width (less a
+    // hundredth of a millimetre).
+    const double pull = d.width / 2 - 0.01;
+    edge.query(geom::Box{p, p}.grown(pull), near);
+    double best = pull;
+    std::optional<Bare> at;
+    for (uint32_t k : near) {
+      const Seg &sg = edge.segs()[k];
+      const Vec2 q = geom::closestPoint(sg, p);
+      if ((q - p).norm() < best) {
+        best = (q - p).norm();
+        const Vec2 t = sg.tangent(std::clamp((q - sg.a).norm() / std::max(sg.length(), 1e-12), 0.0, 1.0));
+        // Centres' loops keep material on their left.
+        at = Bare{p, q, Vec2(-t.y(), t.x())};
+      }
+    }
+    if (at)
+      bare.push_back(*at);
+  };
+  // The cell of half size `half` about p: covered whole, or looked into.
+  std::function<void(const Vec2 &, double)> look = [&](const Vec2 &p, double half) {
+    if (laidIndex.within(p, reach - 1.42 * half))
+      return;  // every point of the cell is within reach
+    if (half <= finest) {
+      if (!laidIndex.within(p, reach) && required.contains(p))
+        add(p);
+      return;
+    }
+    for (double dx : {-0.5, 0.5})
+      for (double dy : {-0.5, 0.5})
+        look(p + Vec2(dx, dy) * half, half / 2);
+  };
+  const geom::Box box = required.box();
+  for (double x = box.lo.x() + step / 2; x < box.hi.x() + step / 2; x += step)
+    for (double y = box.lo.y() + step / 2; y < box.hi.y() + step / 2; y += step)
+      look(Vec2(x, y), step / 2);
   // Inside where centres may go, or on its edge within a micrometre.
   auto allowed = [&](const Vec2 &a, const Vec2 &b) {
     const int n = std::max(1, static_cast<int>(std::ceil((b - a).norm() / step)));
@@ -214,8 +242,7 @@ std::vector<Path2D> gapFillRound(const Region &region, const Region &required, c
   // furthest neighbour's (within a width) that it may run to straight, else
   // a stub in from its centre.
   for (const Bare &b : bare) {
-    if (std::any_of(out.begin(), out.end(),
-                    [&](const Path2D &g) { return geom::distance(g.front(), b.point) <= d.width / 2 - 0.01; }))
+    if (std::any_of(out.begin(), out.end(), [&](const Path2D &g) { return geom::distance(g.front(), b.point) <= reach; }))
       continue;
     const Vec2 *to = nullptr;
     double far = step;
@@ -241,20 +268,6 @@ std::vector<Path2D> gapFillRound(const Region &region, const Region &required, c
       out.push_back({Seg::line(b.centre, b.centre - b.in * step)});
   }
   return out;
-}
-
-/// The layer sampled every eighth of a bead width (a sliver of bare layer
-/// narrower than that may pass between the samples), a point bare when it is
-/// more than half a width (less 0.02 mm) from every centre line.
-std::vector<Path2D> gapFill(const Region &region, const Region &required, const LayerPaths &laid,
-                            const DepositionPlan &d) {
-  std::vector<Seg> lines;
-  for (const Loop &l : laid.contours)
-    lines.insert(lines.end(), l.segs.begin(), l.segs.end());
-  for (const Path2D &p : laid.infill)
-    lines.insert(lines.end(), p.begin(), p.end());
-  std::vector<geom::Box> bareBoxes;
-  return gapFillRound(region, required, lines, d, d.width / 8, d.width / 2 - 0.02, {region.box()}, bareBoxes);
 }
 
 /// The segment in workpiece coordinates.
