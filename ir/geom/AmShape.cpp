@@ -292,6 +292,19 @@ AmShapeResult amShape(const Module &module, const Node &feature) {
       error = name + ": its " + std::string(what) + " encloses no area";
       return false;
     }
+    // A loop that crosses itself bounds no solid.
+    const std::vector<geom::Seg> &segs = l->segs;
+    for (size_t i = 0; i < segs.size(); ++i)
+      for (size_t j = i + 2; j < segs.size(); ++j) {
+        if (i == 0 && j + 1 == segs.size())
+          continue;  // the last meets the first where the loop closes
+        if (!geom::intersect(segs[i], segs[j]).empty()) {
+          const Vec2 at = geom::intersect(segs[i], segs[j]).front();
+          error = name + ": its " + std::string(what) + " crosses itself near (" + formatFixed(at.x(), 3) + ", " +
+                  formatFixed(at.y(), 3) + ")";
+          return false;
+        }
+      }
     s.profile = std::move(*l);
     return true;
   };

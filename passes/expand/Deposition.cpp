@@ -27,6 +27,9 @@ namespace {
 /// Most layers one step deposits: more come only from a layer thickness far
 /// too small for the feature (a micrometre on a block).
 constexpr long kMaxLayers = 20000;
+/// The most bead one step lays (mm): 50 km, weeks of deposition; more comes
+/// only from a feature far larger than a deposition cell builds.
+constexpr double kMaxBeadLength = 5e7;
 /// How far above the layer being deposited the head travels between beads,
 /// over the bead height (mm).
 constexpr double kHopClearance = 1.0;
@@ -204,6 +207,7 @@ std::vector<Path2D> gapFill(const Region &region, const Region &required, const 
     if (at)
       bare.push_back(*at);
   };
+  static const Vec2 kCorners[] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
   // The cell of half size `half` about p: covered whole, or looked into.
   std::function<void(const Vec2 &, double)> look = [&](const Vec2 &p, double half) {
     if (laidIndex.within(p, reach - 1.42 * half))
@@ -212,6 +216,20 @@ std::vector<Path2D> gapFill(const Region &region, const Region &required, const 
       if (!laidIndex.within(p, reach) && required.contains(p))
         add(p);
       return;
+    }
+    // A cell bare whole, inside the layer and where centres may go: a bead
+    // through its centre covers all of it (its half diagonal is less than
+    // half a width).
+    if (!laidIndex.within(p, reach + 1.42 * half)) {
+      if (1.42 * half < reach && centres.contains(p) &&
+          std::all_of(std::begin(kCorners), std::end(kCorners),
+                      [&](const Vec2 &c) { return required.contains(p + c * half); })) {
+        add(p);
+        return;
+      }
+      // No centre may go near any of it: nothing to do there.
+      if (!centres.contains(p) && !edge.within(p, d.width / 2 + 1.42 * half))
+        return;
     }
     for (double dx : {-0.5, 0.5})
       for (double dy : {-0.5, 0.5})
@@ -462,6 +480,21 @@ bool expandDeposition(Expander &x, Node &ws, const Node &op, const std::string &
                          " mm above it: give a layer thickness that divides the height, or an allowance of " +
                          formatFixed(over, 3) + " mm");
     return false;
+  }
+  // The beads' length, at most: the whole feature seen along its axis in
+  // every layer, a pitch apart. Beyond kMaxBeadLength the feature is no
+  // deposition cell's (a length in another unit), and slicing it would run
+  // for hours.
+  {
+    const double widest = shape.slab(0, shape.height).area();
+    const double length = widest * static_cast<double>(n) / d.pitch;
+    if (!(length <= kMaxBeadLength)) {
+      x.report(ws, *feature, "its beads would run about " + formatFixed(length / 1e6, 0) + " km (a " +
+                                 formatFixed(widest / 1e6, 2) + " m2 section in " + std::to_string(n) +
+                                 " layers), more than " + formatShortest(kMaxBeadLength / 1e6) +
+                                 " km: check the feature's dimensions and the bead (a length in another unit?)");
+      return false;
+    }
   }
   Node moves = makeMoves(ws, tool->symbol, 0, "off", setup);
   Depositor dep(x, moves, d, shape.frame);

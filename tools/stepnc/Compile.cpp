@@ -16,6 +16,7 @@
 #include "frontend/part21/Part21File.h"
 #include "frontend/part21/Writer.h"
 #include "ir/Printer.h"
+#include "ir/Program.h"
 #include "ir/Verifier.h"
 #include "runtime/Machine.h"
 #include "support/Format.h"
@@ -299,6 +300,27 @@ int compileSource(const CompileOptions &opts, const std::string &emit, std::uniq
     emitOptions.toolTable = table ? &*table : nullptr;
     if (opts.machines.size() > 1)
       return writePhases(opts, *module, backend, emitOptions, diags);
+    // One program is for one machine: a workplan of several processes
+    // (turning, deposition, milling) needs a machine for each.
+    {
+      std::string first;
+      for (const ir::Node *e : ir::programOrder(*module)) {
+        const std::string process = driver::processOf(*e);
+        if (process.empty() || process == first)
+          continue;
+        if (first.empty()) {
+          first = process;
+          continue;
+        }
+        diags.error(e->origin.loc, "workingstep " + e->symbol + " is " + process + ", after " + first +
+                                       " steps: one program runs on one machine; give a --machine for each process "
+                                       "(such as --machine lathe-2axis --machine hsc-3axis --machine ded-3axis) and "
+                                       "a program is written for each (docs/additive.md)")
+            .entity(e->origin.entityId);
+        printStatus("cannot write a " + opts.target + " program for " + opts.input + "; nothing written");
+        return kExitDiagnostics;
+      }
+    }
     // A deposition program writes the head's codes of --machine.
     std::optional<runtime::Machine> machine;
     std::unique_ptr<SourceFile> machineFile;
