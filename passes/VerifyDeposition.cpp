@@ -160,14 +160,13 @@ struct Solid {
   }
 };
 
-std::optional<Solid> readSolid(const ir::Module &module, const Node &f, std::string &error) {
+std::optional<Solid> readSolid(const Node &f, std::string &error) {
   Solid s;
   s.origin = f.vec("at").value_or(Vec3::Zero());
   s.z = f.vec("axis").value_or(Vec3::UnitZ()).normalized();
   s.x = f.vec("ref").value_or(Vec3::UnitX());
   s.x = (s.x - s.z * s.x.dot(s.z)).normalized();
   s.y = s.z.cross(s.x);
-  (void)module;
   if (f.text("shape").value_or("") == "faceted") {
     for (const Node *p : f.childrenOf(ir::Kind::BoundingPlane))
       s.planes.push_back({*p->vec("at"), p->vec("normal")->normalized()});
@@ -276,7 +275,7 @@ private:
       return;
     }
     std::string why;
-    std::optional<Solid> solid = readSolid(module_, *feature, why);
+    std::optional<Solid> solid = readSolid(*feature, why);
     if (!solid) {
       error(ws, "its feature " + feature->symbol + " " + why);
       return;

@@ -17,7 +17,6 @@
 #include <cmath>
 #include <functional>
 #include <map>
-#include <set>
 #include <optional>
 
 namespace stepnc::passes::expand {
@@ -301,8 +300,8 @@ Seg mapSeg(const Seg &s, const ir::SolidFrame &f) {
 
 class Depositor {
 public:
-  Depositor(Expander &x, Node &moves, const DepositionPlan &d, const ir::SolidFrame &frame)
-      : x_(x), moves_(moves), e_(moves, *moves.number("secplane")), d_(d), frame_(frame) {}
+  Depositor(Node &moves, const DepositionPlan &d, const ir::SolidFrame &frame)
+      : moves_(moves), e_(moves, *moves.number("secplane")), d_(d), frame_(frame) {}
 
   /// Deposits one bead along `path` (feature frame) at height z (workpiece
   /// coordinates); `rise`: the spiral's climb along it.
@@ -367,7 +366,6 @@ private:
     moves_.add(std::move(s));
   }
 
-  Expander &x_;
   Node &moves_;
   Emitter e_;
   const DepositionPlan &d_;
@@ -497,7 +495,7 @@ bool expandDeposition(Expander &x, Node &ws, const Node &op, const std::string &
     }
   }
   Node moves = makeMoves(ws, tool->symbol, 0, "off", setup);
-  Depositor dep(x, moves, d, shape.frame);
+  Depositor dep(moves, d, shape.frame);
   dep.material(true);
   Vec2 centre = Vec2::Zero();
   {
