@@ -86,7 +86,6 @@ def deposition_outputs(extra):
 CANON_PLANES = {"CANON_PLANE_XY": "xy", "CANON_PLANE_XZ": "zx", "CANON_PLANE_YZ": "yz"}
 G5_RE = re.compile(r"^G5 X(\S+) Y(\S+) I(\S+) J(\S+) P(\S+) Q(\S+)")
 SPLINE_TOL = 0.01
-PRINTED = 1.5e-4  # the program's 4 decimals: ends this close may print as one point
 SWEEP_TOL = 0.005  # mm along an arc: the printed ends and the centre balanced between them
 
 
@@ -249,16 +248,50 @@ def close(a, b):
     return all(abs(x - y) <= TOL for x, y in zip(a, b))
 
 
+def prints_as_one(a, b):
+    """Whether two points print as one with the program's 4 decimals (the IR
+    text carries the same 4)."""
+    return all(round(x, 4) == round(y, 4) for x, y in zip(a, b))
+
+
+def same_centre(x, y):
+    """Whether the program's arc y has the IR arc x's centre. An IR arc whose
+    ends are not as far from its centre (a path offset for tool deflection
+    changing along it) is written with the centre moved onto the bisector of
+    its ends (backends/common/IsoEmitter.cpp, geom::balancedCentre): that
+    centre is taken when the two arcs then pass within the tolerance of each
+    other halfway along."""
+    if close(x["centre"], y["centre"]):
+        return True
+    (ax, ay), (bx, by) = local(x["start"], x["plane"])[:2], local(x["to"], x["plane"])[:2]
+    (cx, cy), (dx, dy) = x["centre"], (bx - ax, by - ay)
+    length = math.hypot(dx, dy)
+    if length == 0:
+        return False
+    along = ((cx - (ax + bx) / 2) * dx + (cy - (ay + by) / 2) * dy) / length
+    balanced = (cx - along * dx / length, cy - along * dy / length)
+    if not close(balanced, y["centre"]):
+        return False
+
+    def halfway(centre):
+        a0 = math.atan2(ay - centre[1], ax - centre[0])
+        mid = a0 + (x["sweep"] / 2) * (1 if x["ccw"] else -1)
+        r = (math.dist((ax, ay), centre) + math.dist((bx, by), centre)) / 2
+        return (centre[0] + r * math.cos(mid), centre[1] + r * math.sin(mid))
+    return close(halfway(x["centre"]), halfway(y["centre"]))
+
+
 def normalise(moves, feeds_only):
     """Leaves out moves that go nowhere and keeps the end of each run of rapids."""
     out = []
     at = None
     for mv in moves:
         if mv["kind"] == "arc" and "start" in mv and mv["sweep"] < math.pi and \
-                math.dist(local(mv["start"], mv["plane"])[:2], local(mv["to"], mv["plane"])[:2]) <= PRINTED:
+                prints_as_one(local(mv["start"], mv["plane"])[:2], local(mv["to"], mv["plane"])[:2]):
             # An IR arc whose ends print as one point is written as the line
             # it is within the last decimal: a controller reads an arc over its
             # start as a whole circle (backends/common/Words.h, arcPrintsClosed).
+            # Ends a last decimal apart print apart, and stay an arc.
             mv = dict(mv, kind="linear")
         if mv["kind"] not in ("arc", "dwell") and at is not None and close(mv["to"], at):
             continue
@@ -288,7 +321,7 @@ def compare(ir, canon, feeds_only, feed_tol):
             why = "feed %.3f != %.3f" % (x["feed"], y["feed"])
         elif x["kind"] == "arc" and x["plane"] != y["plane"]:
             why = "arc in the %s plane, the IR's in the %s plane" % (y["plane"].upper(), x["plane"].upper())
-        elif x["kind"] == "arc" and (not close(x["centre"], y["centre"]) or x["ccw"] != y["ccw"]
+        elif x["kind"] == "arc" and (not same_centre(x, y) or x["ccw"] != y["ccw"]
                                      or x["turns"] != y["turns"]):
             why = "arc centre, direction or turns differ"
         elif x["kind"] == "arc" and abs(x["sweep"] - y["sweep"]) * x["radius"] > SWEEP_TOL:
