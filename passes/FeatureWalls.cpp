@@ -92,8 +92,18 @@ Vec2 WallPiece::nearest(const Vec2 &p) const {
   const Vec2 v = p - centre;
   if (v.norm() < 1e-15)
     return a;
-  const double along = turnBetween(angleOf(a - centre), angleOf(v), sweep < 0 ? -1 : 1);
-  if (along <= std::abs(sweep))
+  // Whether v points into the arc's span, by the sides it lies on of the
+  // radii to its ends (no angles: this runs for every sample of every move).
+  const double sign = sweep < 0 ? -1 : 1;
+  const Vec2 ra = a - centre, rb = b - centre;
+  bool within;
+  if (std::abs(sweep) >= kTwoPi - 1e-12)
+    within = true;
+  else if (std::abs(sweep) <= std::numbers::pi)
+    within = sign * geom::cross(ra, v) >= 0 && sign * geom::cross(v, rb) >= 0;
+  else  // more than half a turn: anywhere but strictly within the rest of the circle
+    within = !(sign * geom::cross(rb, v) > 0 && sign * geom::cross(v, ra) > 0);
+  if (within)
     return centre + radius * v.normalized();
   return (p - a).norm() <= (p - b).norm() ? a : b;
 }
@@ -139,6 +149,151 @@ double Outline::clearance(const Vec2 &p) const {
   for (const WallPiece &w : pieces)
     d = std::min(d, w.distance(p));
   return contains(p) ? d : -d;
+}
+
+namespace {
+
+/// Twice the signed area the outline encloses (counter-clockwise positive).
+double doubleArea(const Outline &o) {
+  double a = 0;
+  for (const WallPiece &w : o.pieces) {
+    a += geom::cross(w.a, w.b);
+    if (w.arc)  // the circular segment between the chord and the arc
+      a += w.radius * w.radius * (w.sweep - std::sin(w.sweep));
+  }
+  return a;
+}
+
+/// Where the moved pieces `p` (ending) and `q` (starting) cross nearest to
+/// `near`; none when they do not.
+std::optional<Vec2> crossing(const WallPiece &p, const WallPiece &q, const Vec2 &near) {
+  std::vector<Vec2> found;
+  auto lineCircle = [&](const Vec2 &a, const Vec2 &d, const Vec2 &c, double r) {
+    // |a + t d - c| = r
+    const Vec2 f = a - c;
+    const double A = d.dot(d), B = 2 * f.dot(d), C = f.dot(f) - r * r;
+    const double disc = B * B - 4 * A * C;
+    if (disc < 0 || A <= 0)
+      return;
+    for (double sign : {-1.0, 1.0})
+      found.push_back(a + d * ((-B + sign * std::sqrt(disc)) / (2 * A)));
+  };
+  if (!p.arc && !q.arc) {
+    const Vec2 d1 = p.b - p.a, d2 = q.b - q.a;
+    const double den = geom::cross(d1, d2);
+    if (std::abs(den) < 1e-15)
+      return std::nullopt;
+    found.push_back(p.a + d1 * (geom::cross(q.a - p.a, d2) / den));
+  } else if (!p.arc || !q.arc) {
+    const WallPiece &line = p.arc ? q : p, &arc = p.arc ? p : q;
+    lineCircle(line.a, line.b - line.a, arc.centre, arc.radius);
+  } else {
+    const Vec2 d = q.centre - p.centre;
+    const double l = d.norm();
+    if (l < 1e-15 || l > p.radius + q.radius || l < std::abs(p.radius - q.radius))
+      return std::nullopt;
+    const double x = (l * l + p.radius * p.radius - q.radius * q.radius) / (2 * l);
+    const double y = std::sqrt(std::max(0.0, p.radius * p.radius - x * x));
+    const Vec2 u = d / l;
+    for (double sign : {-1.0, 1.0})
+      found.push_back(p.centre + u * x + left(u) * (sign * y));
+  }
+  if (found.empty())
+    return std::nullopt;
+  return *std::min_element(found.begin(), found.end(),
+                           [&](const Vec2 &a, const Vec2 &b) { return (a - near).norm() < (b - near).norm(); });
+}
+
+} // namespace
+
+std::optional<Outline> Outline::inset(double e) const {
+  const size_t n = pieces.size();
+  if (n == 0)
+    return std::nullopt;
+  const double inward = doubleArea(*this) >= 0 ? 1 : -1;  // the inside is left (+1) or right (-1)
+  // Each piece moved; for an arc, its centre stays and its radius changes.
+  std::vector<WallPiece> moved(pieces);
+  for (WallPiece &w : moved) {
+    if (w.arc) {
+      const bool centreInside = (w.sweep > 0) == (inward > 0);
+      const double r = w.radius + (centreInside ? -e : e);
+      if (r <= 1e-9)
+        return std::nullopt;
+      w.a = w.centre + (w.a - w.centre).normalized() * r;
+      w.b = w.centre + (w.b - w.centre).normalized() * r;
+      w.radius = r;
+    } else {
+      const Vec2 shift = inward * left((w.b - w.a).normalized()) * e;
+      w.a += shift;
+      w.b += shift;
+    }
+  }
+  if (n == 1) {
+    if (!moved[0].arc)
+      return std::nullopt;
+    return Outline{moved};
+  }
+  Outline out;
+  for (size_t i = 0; i < n; ++i) {
+    const WallPiece &p = pieces[i], &q = pieces[(i + 1) % n];
+    const Vec2 t1 = p.tangent(1), t2 = q.tangent(0);
+    const double turn = inward * geom::cross(t1, t2);
+    WallPiece &mp = moved[i], &mq = moved[(i + 1) % n];
+    if (std::abs(geom::cross(t1, t2)) < 1e-9 && t1.dot(t2) > 0) {
+      const Vec2 mid = (mp.b + mq.a) / 2;  // a smooth join: the moved ends meet
+      mp.b = mid;
+      mq.a = mid;
+    } else if (turn > 0) {
+      const std::optional<Vec2> x = crossing(mp, mq, (mp.b + mq.a) / 2);
+      if (!x)
+        return std::nullopt;
+      mp.b = *x;
+      mq.a = *x;
+    }
+    // A concave corner keeps the moved ends apart: an arc about it joins them
+    // (added after the piece, below).
+  }
+  for (size_t i = 0; i < n; ++i) {
+    const WallPiece &orig = pieces[i];
+    WallPiece w = moved[i];
+    if (w.arc) {
+      const double sign = orig.sweep < 0 ? -1 : 1;
+      double sweep = turnBetween(angleOf(w.a - w.centre), angleOf(w.b - w.centre), sign);
+      if (std::abs(orig.sweep) >= kTwoPi - 1e-12 && sweep < 1e-12)
+        sweep = kTwoPi;
+      if (sweep <= 1e-12 || sweep > std::abs(orig.sweep) + std::numbers::pi / 2)
+        return std::nullopt;  // turned round
+      w = WallPiece::arcFrom(w.centre, w.a, sign * sweep);
+    } else if ((w.b - w.a).dot(orig.b - orig.a) <= 1e-12) {
+      return std::nullopt;  // vanished or turned round
+    }
+    out.pieces.push_back(w);
+    const WallPiece &next = moved[(i + 1) % n];
+    if ((next.a - w.b).norm() > 1e-12) {
+      const Vec2 corner = orig.b;
+      const double sweep = -inward * turnBetween(angleOf(w.b - corner), angleOf(next.a - corner), -inward);
+      out.pieces.push_back(WallPiece::arcFrom(corner, w.b, sweep));
+    }
+  }
+  return out;
+}
+
+double bodyRadius(double radius, double corner, double h) {
+  if (h < 0)
+    return -1;
+  if (h >= corner)
+    return radius;
+  return radius - corner + std::sqrt(std::max(0.0, corner * corner - (corner - h) * (corner - h)));
+}
+
+const Outline &FeatureWalls::Island::shrunk(double e) const {
+  auto it = sections.find(e);
+  if (it != sections.end())
+    return it->second;
+  std::optional<Outline> o = e > 0 ? outline.inset(e) : std::optional<Outline>(outline);
+  // The reader made sure the outline shrinks to the island's top; a height
+  // between keeps its shape.
+  return sections.emplace(e, o ? std::move(*o) : outline).first->second;
 }
 
 // --- Reading the feature ----------------------------------------------------------
@@ -282,7 +437,17 @@ private:
       std::optional<Outline> o = closedProfile(*boss, *f);
       if (!o)
         return false;
-      w.islands_.push_back({boss->symbol, std::move(*o), f->z});
+      FeatureWalls::Island isl{boss->symbol, std::move(*o), f->z, f->z - boss->number("depth").value_or(0), 0, {}};
+      // A slope leans the walls in going up, the outline at the foot
+      // (docs/toolpaths.md, "Bosses with a slope").
+      if (const double deg = boss->number("slope").value_or(0); deg != 0) {
+        if (!(deg > 0 && deg < 90))
+          return failed("boss " + boss->symbol + " has a slope of " + formatShortest(deg) + " deg");
+        isl.slope = std::tan(deg * std::numbers::pi / 180);
+        if (!isl.outline.inset((isl.top - isl.foot) * isl.slope))
+          return failed("boss " + boss->symbol + ": its outline, shrunk by its slope to its top, changes shape");
+      }
+      w.islands_.push_back(std::move(isl));
     }
     return true;
   }
@@ -417,7 +582,7 @@ private:
     std::optional<Outline> o = closedProfile(feature, f);
     if (!o)
       return false;
-    w.islands_.push_back({feature.symbol, std::move(*o), f.z});
+    w.islands_.push_back({feature.symbol, std::move(*o), f.z, f.z - feature.number("depth").value_or(0), 0, {}});
     return true;
   }
 
@@ -581,7 +746,49 @@ WallContact FeatureWalls::tubeContact(const Vec2 &p, double radius) const {
   return out;
 }
 
-WallContact FeatureWalls::contact(const Vec2 &p, double z, double radius, double tol) const {
+double FeatureWalls::slopedDepth(const Island &i, const Vec2 &p, double radius, const ToolBody &body) const {
+  // The body's disc at each sampled height against the section there; the
+  // sections shrink going up, so heights above the corner meet no more than
+  // the corner's top does. The heights and their sections are made once per
+  // tip height (moves at one level share them).
+  constexpr int kSamples = 48;
+  Island::Heights &hs = i.heights;
+  if (!(hs.tip == body.tip && hs.lowered == body.lowered && hs.radius == radius && hs.corner == body.corner) ||
+      hs.at.empty()) {
+    hs = {body.tip, body.lowered, radius, body.corner, {}};
+    const double tip = body.tip - body.lowered, corner = body.corner;
+    const double lo = std::max(tip, i.foot), hi = std::min(tip + corner, i.top);
+    const int count = hi > lo ? std::clamp(static_cast<int>(std::ceil((hi - lo) / 0.01)), 1, kSamples) : 0;
+    if (i.sections.size() > 4096)
+      i.sections.clear();  // kept bounded; only the table (remade here) points into it
+    for (int k = 0; k <= count; ++k) {
+      const double v = count > 0 ? lo + (hi - lo) * k / count : lo;
+      hs.at.emplace_back(bodyRadius(radius, corner, v - tip), &i.shrunk((v - i.foot) * i.slope));
+    }
+  }
+  // Coarsely, then every height about the deepest: the depth over the
+  // heights is a disc's radius (concave in the height) less its distance to
+  // a section moving in at a constant rate (convex), so it has one peak on
+  // a wall or at a corner.
+  auto depthAt = [&](size_t k) { return hs.at[k].first + hs.at[k].second->clearance(p); };
+  constexpr size_t kCoarse = 4;
+  size_t best = 0;
+  double depth = -1e300;
+  for (size_t k = 0; k < hs.at.size(); k += kCoarse)
+    if (const double d = depthAt(k); d > depth) {
+      depth = d;
+      best = k;
+    }
+  const size_t from = best >= kCoarse ? best - kCoarse + 1 : 0, to = std::min(hs.at.size(), best + kCoarse);
+  for (size_t k = from; k < to; ++k)
+    if (k != best)
+      depth = std::max(depth, depthAt(k));
+  if (hs.at.size() > 1)
+    depth = std::max(depth, depthAt(hs.at.size() - 1));
+  return depth;
+}
+
+WallContact FeatureWalls::contact(const Vec2 &p, double z, double radius, double tol, const ToolBody &body) const {
   WallContact out;
   if (z < top_ - tol) {
     switch (bound_) {
@@ -595,7 +802,7 @@ WallContact FeatureWalls::contact(const Vec2 &p, double z, double radius, double
     const Island &i = islands_[k];
     if (z >= i.top - tol)
       continue;
-    const double depth = radius + i.outline.clearance(p);
+    const double depth = i.slope > 0 ? slopedDepth(i, p, radius, body) : radius + i.outline.clearance(p);
     if (depth > out.depth)
       out = {depth, WallContact::Where::Island, k};
   }
@@ -621,7 +828,8 @@ std::vector<double> FeatureWalls::levels(double tol) const {
 
 // --- Moves -------------------------------------------------------------------------
 
-MoveContact deepestContact(const FeatureWalls &walls, const ir::Move &m, double radius, double tol) {
+MoveContact deepestContact(const FeatureWalls &walls, const ir::Move &m, double radius, double tol, double corner,
+                           double lowered) {
   MoveContact best;
   const ir::Vec3 from = *m.from;
   const Vec2 a(from.x(), from.y()), b(m.to.x(), m.to.y());
@@ -665,7 +873,7 @@ MoveContact deepestContact(const FeatureWalls &walls, const ir::Move &m, double 
   const double minStep = std::max({tol / 2, 0.001, length / 2e6});
   auto sample = [&](double s, double z) {
     const ir::Vec3 p = at(s);
-    const WallContact c = walls.contact(Vec2(p.x(), p.y()), z, radius, tol);
+    const WallContact c = walls.contact(Vec2(p.x(), p.y()), z, radius, tol, ToolBody{corner, lowered, p.z()});
     ++best.samples;
     if (c.depth > best.contact.depth) {
       best.contact = c;

@@ -16,6 +16,7 @@
 #include "ir/Program.h"
 #include "ir/geom/MoveWalk.h"
 
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -47,7 +48,27 @@ struct Outline {
   bool contains(const geom::Vec2 &p) const;
   /// The distance from p to the outline, positive inside.
   double clearance(const geom::Vec2 &p) const;
+  /// The outline of its inside shrunk by e > 0: each piece moved e inwards
+  /// (lines along their normal, arcs about their centre), pieces meeting at
+  /// convex corners cut where the moved pieces cross, concave corners rounded
+  /// by an arc of radius e about the corner. None when a piece would vanish
+  /// or turn round (the shrinking changes the outline's shape).
+  std::optional<Outline> inset(double e) const;
 };
+
+/// The tool as a body, for walls that are not vertical: at height h above
+/// its tip a disc of radius `radius` - `corner` + sqrt(corner^2 - (corner -
+/// h)^2) through its corner, `radius` above; `radius` and `corner` grown by
+/// the side allowance, the tip `lowered` by it below the tip's height `tip`.
+struct ToolBody {
+  double corner = 0;
+  double lowered = 0;
+  double tip = 0;
+};
+
+/// The radius of a tool body of `radius` and `corner` at height h above its
+/// tip; -1 below it.
+double bodyRadius(double radius, double corner, double h);
 
 /// How a disc stands against the walls: how far it reaches into material
 /// (negative: the room it has to spare) and which wall that is
@@ -69,7 +90,9 @@ public:
   /// A disc of `radius` centred at p at height z: how far it reaches into
   /// the walls in force there. The feature's walls hold below its top less
   /// `tol`, an island's below its own top less `tol`.
-  WallContact contact(const geom::Vec2 &p, double z, double radius, double tol) const;
+  /// A boss whose walls lean in is met by the tool's `body` (its tip at
+  /// body.tip) at heights sampled through its corner.
+  WallContact contact(const geom::Vec2 &p, double z, double radius, double tol, const ToolBody &body = {}) const;
 
   /// The heights at which the walls in force change: the feature's top and
   /// the islands' tops, each less `tol`.
@@ -81,10 +104,26 @@ public:
 
 private:
   enum class Bound : uint8_t { None, Outline, Tube, HalfPlane };
+  /// A boss; one whose walls lean in (slope > 0, the tan of the lean) has
+  /// `outline` at its foot and, at height v, that outline shrunk by
+  /// (v - foot) * slope.
   struct Island {
     std::string symbol;
     Outline outline;
     double top = 0;
+    double foot = 0;
+    double slope = 0;
+    /// Its section's outline shrunk by e, for the heights sampled (a few
+    /// per level: moves at one level share them); kept bounded by slopedDepth.
+    const Outline &shrunk(double e) const;
+    mutable std::map<double, Outline> sections;
+    /// The heights sampled for the last tip height and body: the body's
+    /// radius there and the section's outline.
+    struct Heights {
+      double tip = 0, lowered = 0, radius = 0, corner = 0;
+      std::vector<std::pair<double, const Outline *>> at;
+    };
+    mutable Heights heights;
   };
   /// A slot's flat end: the square past it that the slot does not reach.
   struct FlatEnd {
@@ -93,6 +132,7 @@ private:
   };
 
   WallContact outlineContact(const geom::Vec2 &p, double radius) const;
+  double slopedDepth(const Island &i, const geom::Vec2 &p, double radius, const ToolBody &body) const;
   double distanceToCentres(const geom::Vec2 &p, double clearance) const;
   WallContact tubeContact(const geom::Vec2 &p, double radius) const;
 
@@ -122,6 +162,9 @@ struct MoveContact {
 /// far from the walls by the room the disc has there, near them every
 /// tol / 2 (at least 0.001 mm), so that a gouge deeper than 1.25 tol is
 /// always found and none shallower than tol is reported.
-MoveContact deepestContact(const FeatureWalls &walls, const ir::Move &move, double radius, double tol);
+/// `corner` and `lowered` make the tool a body (ToolBody) for bosses whose
+/// walls lean in.
+MoveContact deepestContact(const FeatureWalls &walls, const ir::Move &move, double radius, double tol,
+                           double corner = 0, double lowered = 0);
 
 } // namespace stepnc::passes

@@ -716,7 +716,9 @@ private:
     for (const ir::Move &m : s.moves) {
       if (!m.isFeed() || !m.from || std::min(m.from->z(), m.to.z()) >= highest)
         continue;
-      const MoveContact c = deepestContact(walls, m, reach, s.tol);
+      const MoveContact c =
+          deepestContact(walls, m, reach, s.tol, (s.tool ? ir::cornerRadius(*s.tool) : 0) + s.allowanceSide,
+                         s.allowanceSide);
       deepest = std::max(deepest, c.contact.depth);
       if (c.contact.depth > s.tol)
         offences.push_back({m.node, m.node->kindName() + " to " + pointText(m.to) + " gouges " + walls.describe(c.contact) +
@@ -820,15 +822,6 @@ private:
   // sampled: finely through the corner, at every vertex of the walls and at
   // the top, where the room left between body and wall is smallest on
   // straight walls and arcs that open upwards.
-
-  /// The grown tool's radius at height h above its (grown) tip; < 0 below it.
-  static double bodyRadius(double radius, double corner, double h) {
-    if (h < 0)
-      return -1;
-    if (h >= corner)
-      return radius;
-    return radius - corner + std::sqrt(std::max(0.0, corner * corner - (corner - h) * (corner - h)));
-  }
 
   /// The heights (workpiece z) at which a grown tool with its tip at `tip` is
   /// measured against the walls: through its corner, the walls' vertices, the top.

@@ -62,6 +62,9 @@ config.substitutions.append(("%check-rs274", "python3 %s --stepnc %s" % (
 config.substitutions.append(("%check-native-lathe", "python3 %s --stepnc %s" % (
     os.path.join(config.test_source_root, "backends", "check-native-lathe.py"),
     os.path.join(config.stepnc_tools_dir, "stepnc"))))
+# The flanks a program leaves on a boss whose walls lean in, measured independently.
+config.substitutions.append(("%check-sloped-flanks", "python3 %s" % (
+    os.path.join(config.test_source_root, "passes", "expand-strategies", "check-sloped-flanks.py"))))
 # Open CASCADE's STEP reader reads the STEP-NC that compile --emit=stepnc writes.
 occt_read_step = os.path.join(config.stepnc_tools_dir, "stepnc-occt-read-step")
 if config.occt_available == "ON" and os.path.exists(occt_read_step):

@@ -202,7 +202,7 @@ public:
     s.target = outer(geom::polygon(
         {stock.lo, Vec2(stock.hi.x(), stock.lo.y()), stock.hi, Vec2(stock.lo.x(), stock.hi.y())}));
     s.unbounded = true;
-    s.islands.push_back({feature.symbol, outer(mapLoop(*l, s.frame)), s.top});
+    s.islands.push_back({feature.symbol, outer(mapLoop(*l, s.frame)), s.top, s.bottom, 0});
     return true;
   }
 
@@ -219,8 +219,32 @@ public:
       std::optional<Loop> l = closedProfile(*boss, 0);
       if (!l)
         return;
-      s.islands.push_back({boss->symbol, outer(mapLoop(*l, *fr.frame)), fr.frame->z});
+      IslandShape isl{boss->symbol, outer(mapLoop(*l, *fr.frame)), fr.frame->z, fr.frame->z, 0};
+      if (!sloped(*boss, isl))
+        return;
+      s.islands.push_back(std::move(isl));
     }
+  }
+
+  /// A boss's slope (degrees from the vertical, leaning in going up) and foot:
+  /// refused when it leans out (an undercut), is 80 deg or more, or shrinks
+  /// its outline to nothing below its top.
+  bool sloped(const Node &boss, IslandShape &isl) {
+    const double depth = boss.number("depth").value_or(0);
+    isl.foot = isl.top - depth;
+    const double deg = boss.number("slope").value_or(0);
+    if (deg == 0)
+      return true;
+    if (!(deg > 0 && deg < 80))
+      return fail("boss " + boss.symbol + ": a slope of " + formatShortest(deg) +
+                  " deg is not expanded (walls leaning in going up, from more than 0 up to 80 deg)");
+    if (!(depth > 0))
+      return fail("boss " + boss.symbol + ": a slope needs a depth (the height of its walls) to stand on");
+    isl.slope = std::tan(deg * std::numbers::pi / 180);
+    if (isl.sectionAt(isl.top).area() <= 1e-9)
+      return fail("boss " + boss.symbol + ": its walls, leaning in by " + formatShortest(deg) + " deg over its " +
+                  formatShortest(depth) + " mm depth, close its outline below its top");
+    return true;
   }
 
   /// The feature's `path` when it is one straight piece, mapped to workpiece
@@ -601,6 +625,11 @@ double cornerRadius(const ir::Node &tool) {
   return std::clamp(tool.number("corner_radius").value_or(0), 0.0, radius);
 }
 
+geom::Region IslandShape::sectionAt(double z) const {
+  const double inset = (std::clamp(z, foot, top) - foot) * slope;
+  return inset > 0 ? geom::offset(region, -inset) : region;
+}
+
 std::optional<geom::Loop> closedProfileLoop(const ir::Module &module, const ir::Node &owner, std::string &error) {
   ShapeBuilder b(module, nullptr);
   std::optional<Loop> l = b.closedProfile(owner, 0);
@@ -627,6 +656,9 @@ ShapeResult featureShape(const ir::Module &module, const ir::Node &feature) {
   ShapeBuilder b(module, workpiece);
   bool ok = true;
   if (feature.kind == ir::Kind::ClosedPocket || feature.kind == ir::Kind::OpenPocket) {
+    if (const double slope = feature.number("slope").value_or(0); slope != 0)
+      return {std::nullopt, "pocket " + feature.symbol + " has walls with a slope of " + formatShortest(slope) +
+                                " deg; pockets are expanded with vertical walls only (bosses may slope)"};
     if (feature.text("bottom") != "planar" && feature.text("bottom") != "through")
       return {std::nullopt, "pocket " + feature.symbol + " has a " + feature.text("bottom").value_or("") +
                                 " bottom; only planar and through bottoms are expanded (plan: ball-end finishing)"};

@@ -31,11 +31,21 @@ struct PlaneFrame {
   bool mirrored() const { return geom::cross(x, y) < 0; }
 };
 
-/// Material a feature's machining must leave (a boss), up to its top.
+/// Material a feature's machining must leave (a boss), up to its top. A boss
+/// with a slope leans in going up: `region` is its outline at its foot (its
+/// depth below its top), and its section at height z is that outline shrunk
+/// by (z - foot) * slope: convex corners stay sharp, concave ones round
+/// (docs/toolpaths.md, "Bosses with a slope").
 struct IslandShape {
   std::string symbol;
   geom::Region region;
   double top = 0;
+  double foot = 0;   ///< z of its foot (the floor it stands on)
+  double slope = 0;  ///< tan of the walls' lean from the vertical; 0: vertical walls
+
+  bool sloped() const { return slope > 0; }
+  /// The section at height z (foot <= z <= top): `region` when the walls are vertical.
+  geom::Region sectionAt(double z) const;
 };
 
 /// A slot's cross-section across its course of travel: its walls as one

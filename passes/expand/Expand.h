@@ -268,11 +268,12 @@ struct LevelPaths {
 /// the stepover, the cut direction, the stroke direction.
 LevelStrategy levelStrategy(const Step &step, const ir::FeatureShape &s, const Plan &p);
 
-/// Milling2D.cpp: the centre area of shape `s` with `islands` standing and
-/// the strategy's paths in it (along the course of travel for center
-/// milling and slots no wider than the tool); false after a diagnostic.
+/// Milling2D.cpp: the centre area of shape `s` less the islands' `keepOut`
+/// areas (keepOutAt) and the strategy's paths in it (along the course of
+/// travel for center milling and slots no wider than the tool); false after
+/// a diagnostic.
 bool planLevel(Expander &x, const Step &step, const ir::FeatureShape &s, const Plan &p,
-               const std::vector<Region> &islands, LevelStrategy &ls, LevelPaths &out);
+               const std::vector<Region> &keepOut, LevelStrategy &ls, LevelPaths &out);
 
 /// Milling2D.cpp: the paths of one level cut at height z, each reached by a
 /// link at depth or by the approach; an open path along a slot is cut from
@@ -281,12 +282,20 @@ void cutLevel(Emitter &e, const Step &step, const ir::FeatureShape &s, const Pla
               const LevelStrategy &ls, int &fallbacks);
 
 /// Milling2D.cpp: where the tool centre may be at one level: away from walls
-/// and islands by the radius plus the side allowance; for faces, over the
-/// face and past it.
-Region centreArea(const ir::FeatureShape &s, const Region &area, const std::vector<Region> &islands, const Plan &p);
+/// by the radius plus the side allowance, out of the islands' `keepOut`
+/// areas; for faces, over the face and past it.
+Region centreArea(const ir::FeatureShape &s, const Region &area, const std::vector<Region> &keepOut, const Plan &p);
 
-/// Milling2D.cpp: the islands standing at height z, grown by the side allowance.
-std::vector<Region> islandsAt(const ir::FeatureShape &s, double z, double allowance);
+/// Milling2D.cpp: the scallop height finishing leaves on walls that are not
+/// vertical: --scallop-height, else the workpiece's global_tolerance, else
+/// kDefaultScallopHeight.
+double scallopHeight(const Expander &x, const Node &feature);
+
+/// Milling2D.cpp: where the tool's centre may not be, its tip at height z,
+/// for each island standing there: the island grown by the side allowance
+/// and the radius; a boss whose walls lean in, its sections met by the
+/// tool's body (corner and side) grown by the allowance.
+std::vector<Region> keepOutAt(const ir::FeatureShape &s, double z, const Plan &p);
 
 /// Milling2D.cpp: the tool centre's path along a slot: its course of travel,
 /// stopped the tool radius (and side allowance) short of flat ends, short of
@@ -302,12 +311,16 @@ std::optional<std::vector<Path2D>> strategyPaths(const std::string &type, bool f
                                                  bool followOrientation, double radius);
 
 /// Milling2D.cpp: one plane path at height z, reached by a link at depth when
-/// allowed and inside the centre area, else from the security plane by the
-/// operation's approach.
+/// allowed and inside the centre area (anywhere when `anywhere`: see
+/// linkAnywhere), else from the security plane by the operation's approach.
 /// `fallbacks` counts the paths whose helix or ramp did not fit and that
 /// were entered along the tool axis instead.
+/// Milling2D.cpp: whether links at depth may leave the centre area: on a face
+/// with nothing standing in it (the tool passes its edges in the air).
+bool linkAnywhere(const ir::FeatureShape &s);
+
 void cutPath(Emitter &e, const Path2D &path, double z, const Plan &p, const Node &op, const Region &centres,
-             bool mayLink, bool unbounded, int &fallbacks);
+             bool mayLink, bool anywhere, int &fallbacks);
 
 /// Milling2D.cpp: the warning, once per step, that `fallbacks` paths were
 /// entered along the tool axis because the operation's helix or ramp did

@@ -73,7 +73,117 @@ void approach(Emitter &e, const Path2D &path, double z, const Plan &p, const Nod
   e.linear(at(start, z), p.plungeFeed, "plunge");
 }
 
+/// How a boss whose walls lean in is sampled for the keep-out area of a tool
+/// whose corner, grown by the side allowance, is `corner` (slopedKeepOut):
+/// heights `step` apart, each section grown by `margin` more than the
+/// body's radius there, which bounds what the envelope between two samples
+/// stands out: step^2 (1 + slope^2)^1.5 / (8 corner), from the curvature of
+/// the corner's circle where it meets a wall. The tool stands off the wall
+/// by up to the margin, which finishing counts in its scallop.
+struct SliceSampling {
+  double step = 0, margin = 0;
+};
+
+SliceSampling sliceSampling(const ir::IslandShape &isl, double corner) {
+  if (corner <= 0)
+    return {};
+  const double step = std::min(0.05, corner / 16);
+  return {step, step * step * std::pow(1 + isl.slope * isl.slope, 1.5) / (8 * corner)};
+}
+
+/// The ridge levels dz apart leave on a long wall leaning `slope` (tan, in
+/// from the vertical going up), by a tool of `radius` and `corner`. In a
+/// section across the wall each level's silhouette (its diameter wide from
+/// its tip up, its lower corners rounded by `corner`) stands as far in as it
+/// touches the wall; from points of the wall over one period (the levels
+/// repeat) the material left is measured along the wall's normal to the
+/// first silhouette it meets (sphere tracing: the silhouettes' signed
+/// distance is a safe step), the largest of those being the ridge's height.
+double levelRidge(double slope, double radius, double corner, double dz) {
+  const double flat = radius - corner;
+  // The tool's axis with its tip at height 0, and where it touches the wall
+  // (the wall at height v is at u = -v slope, u out from it).
+  double axis0 = -1e300, contact = 0;
+  constexpr int kBody = 256;
+  for (int k = 0; k <= kBody; ++k) {
+    const double h = corner * k / kBody;
+    const double body = corner > 0 ? flat + std::sqrt(std::max(0.0, corner * corner - (corner - h) * (corner - h))) : radius;
+    if (-h * slope + body > axis0) {
+      axis0 = -h * slope + body;
+      contact = h;
+    }
+  }
+  // A level k dz higher stands k dz slope further in.
+  auto distance = [&](double u, double h, int k) {
+    const double tip = k * dz, axis = axis0 - tip * slope;
+    const double du = std::abs(u - axis);
+    const double dx = std::max(du - flat, 0.0), dy = std::max(tip + corner - h, 0.0);
+    if (dx > 0 || dy > 0)
+      return std::hypot(dx, dy) - corner;
+    return -std::min(flat - du + corner, h - tip);
+  };
+  const double norm = std::sqrt(1 + slope * slope);
+  const double nu = 1 / norm, nh = slope / norm;  // the wall's normal, out and up
+  double ridge = 0;
+  constexpr int kPoints = 400;
+  for (int i = 0; i <= kPoints; ++i) {
+    const double h0 = contact + dz * i / kPoints;
+    double t = 0;
+    for (int step = 0; step < 400; ++step) {
+      const double u = -h0 * slope + t * nu, h = h0 + t * nh;
+      // Only the levels whose tip is within a corner and two levels below
+      // the point, or a level above it, can be nearest.
+      double nearest = 1e300;
+      const int lo = static_cast<int>(std::floor((h - corner) / dz)) - 2, hi = static_cast<int>(std::ceil(h / dz)) + 1;
+      for (int k = lo; k <= hi; ++k)
+        nearest = std::min(nearest, distance(u, h, k));
+      if (nearest <= 1e-9 * (1 + radius))
+        break;
+      t += nearest;
+    }
+    ridge = std::max(ridge, t);
+  }
+  return ridge;
+}
+
+/// The largest step down between two levels that finish the walls of the
+/// sloped bosses of `s` within `scallop` (levelRidge, by bisection), less the
+/// keep-out area's margin (sliceSampling); none when no boss slopes. On a
+/// wall leaning alpha, a flat end mill leaves a step dz sin(alpha); a corner
+/// of radius rc, while the ridge stays on its arc, rc - sqrt(rc^2 - s^2 / 4)
+/// with s = dz / cos(alpha) along the wall.
+std::optional<double> slopedLevelStep(const ir::FeatureShape &s, const Plan &p, double scallop) {
+  std::optional<double> out;
+  const double rc = ir::cornerRadius(*p.tool), depth = s.top - s.bottom;
+  for (const ir::IslandShape &isl : s.islands) {
+    if (!isl.sloped())
+      continue;
+    const double h = std::max(scallop / 2, scallop - sliceSampling(isl, rc + p.allowanceSide).margin);
+    double good = 0, bad = depth;
+    if (levelRidge(isl.slope, p.radius, rc, depth) <= h) {
+      good = depth;
+    } else {
+      for (int i = 0; i < 50 && bad - good > 1e-6 * depth; ++i) {
+        const double mid = (good + bad) / 2;
+        (levelRidge(isl.slope, p.radius, rc, mid) <= h ? good : bad) = mid;
+      }
+    }
+    if (good <= 0)
+      good = bad;  // cannot happen for a scallop above 0; keeps the levels finite
+    out = out ? std::min(*out, good) : good;
+  }
+  return out;
+}
+
 } // namespace
+
+double scallopHeight(const Expander &x, const Node &feature) {
+  if (x.scallopHeight)
+    return *x.scallopHeight;
+  if (const Node *wp = ir::workpieceOf(*x.module, feature))
+    return wp->number("global_tolerance").value_or(kDefaultScallopHeight);
+  return kDefaultScallopHeight;
+}
 
 std::vector<double> levelsOf(Expander &x, const Node &ws, const Node &op, const ir::FeatureShape &s, const Plan &p) {
   const double floorZ = s.bottom + p.allowanceBottom;
@@ -94,7 +204,21 @@ std::vector<double> levelsOf(Expander &x, const Node &ws, const Node &op, const 
                      ": give a larger depth of cut");
     return {};
   }
-  const int count = ap > 0 ? std::max(1, static_cast<int>(std::ceil(depth / ap - 1e-9))) : 1;
+  int count = ap > 0 ? std::max(1, static_cast<int>(std::ceil(depth / ap - 1e-9))) : 1;
+  // Finishing a boss whose walls lean in: levels close enough that the ridge
+  // left on its walls between two stays within the scallop height.
+  if (op.is(ir::Trait::WallFinishing))
+    if (const std::optional<double> dz = slopedLevelStep(s, p, scallopHeight(x, *p.feature))) {
+      const int fine = static_cast<int>(std::ceil(depth / *dz - 1e-9));
+      if (fine > kMaxLevels) {
+        x.report(ws, "finishing the sloped walls of " + s.symbol + " within the scallop height takes " +
+                         std::to_string(fine) + " levels, more than the " + std::to_string(kMaxLevels) +
+                         " stepnc plans: give a larger scallop height (the workpiece's global_tolerance, or "
+                         "expand-strategies<scallop-height=>) or a tool with a larger corner radius");
+        return {};
+      }
+      count = std::max(count, fine);
+    }
   std::vector<double> out;
   for (int i = 1; i <= count; ++i)
     out.push_back(s.top - (s.top - floorZ) * i / count);
@@ -130,11 +254,11 @@ LevelStrategy levelStrategy(const Step &step, const ir::FeatureShape &s, const P
 }
 
 bool planLevel(Expander &x, const Step &step, const ir::FeatureShape &s, const Plan &p,
-               const std::vector<Region> &islands, LevelStrategy &ls, LevelPaths &out) {
+               const std::vector<Region> &keepOut, LevelStrategy &ls, LevelPaths &out) {
   const Node &ws = step.ws, &op = step.op;
   const Node *strategy = step.strategy;
   const std::string &type = ls.type;
-  out.centres = centreArea(s, s.unbounded ? s.target : s.limit, islands, p);
+  out.centres = centreArea(s, s.unbounded ? s.target : s.limit, keepOut, p);
   out.paths.clear();
   if (!out.centres.empty()) {
     const geom::Box box = out.centres.box();
@@ -213,7 +337,7 @@ void cutLevel(Emitter &e, const Step &step, const ir::FeatureShape &s, const Pla
     return;
   }
   for (size_t k = 0; k < level.paths.size(); ++k)
-    cutPath(e, level.paths[k], z, p, step.op, level.centres, ls.linkAtDepth && k > 0, s.unbounded, fallbacks);
+    cutPath(e, level.paths[k], z, p, step.op, level.centres, ls.linkAtDepth && k > 0, linkAnywhere(s), fallbacks);
 }
 
 bool expandMilling2D(Expander &x, const Step &step) {
@@ -229,19 +353,19 @@ bool expandMilling2D(Expander &x, const Step &step) {
   Emitter e(step.moves, step.moves.number("secplane").value_or(0));
   // The centre area and the paths depend on the level only through the
   // islands standing at it: they are made again only when that set changes.
+  // A boss whose walls lean in changes them at every level.
   std::optional<std::vector<bool>> standing;
   LevelPaths level;
   for (const double z : levels) {
     std::vector<bool> here;
-    for (const ir::IslandShape &isl : s.islands)
+    bool sloped = false;
+    for (const ir::IslandShape &isl : s.islands) {
       here.push_back(isl.top > z + 1e-9);
-    if (standing != here) {
+      sloped = sloped || (here.back() && isl.sloped());
+    }
+    if (standing != here || sloped) {
       standing = here;
-      std::vector<Region> islands;
-      for (size_t k = 0; k < s.islands.size(); ++k)
-        if (here[k])
-          islands.push_back(geom::offset(s.islands[k].region, p.allowanceSide));
-      if (!planLevel(x, step, s, p, islands, ls, level))
+      if (!planLevel(x, step, s, p, keepOutAt(s, z, p), ls, level))
         return false;
     }
     cutLevel(e, step, s, p, level, z, ls, fallbacks);
@@ -341,7 +465,7 @@ std::optional<std::vector<Path2D>> strategyPaths(const std::string &type, bool f
   return std::nullopt;
 }
 
-Region centreArea(const ir::FeatureShape &s, const Region &area, const std::vector<Region> &islands, const Plan &p) {
+Region centreArea(const ir::FeatureShape &s, const Region &area, const std::vector<Region> &keepOut, const Plan &p) {
   const double reach = p.radius + p.allowanceSide;
   Region centres;
   if (s.unbounded) {
@@ -352,16 +476,49 @@ Region centreArea(const ir::FeatureShape &s, const Region &area, const std::vect
     if (s.limit.area() > s.target.area() + 1e-6)
       centres = geom::intersect(centres, geom::offset(s.target, p.radius - 1e-6));
   }
-  for (const Region &isl : islands)
-    centres = geom::subtract(centres, geom::offset(isl, p.radius));
+  for (const Region &k : keepOut)
+    centres = geom::subtract(centres, k);
   return centres;
 }
 
-std::vector<Region> islandsAt(const ir::FeatureShape &s, double z, double allowance) {
+namespace {
+
+/// Where the centre of the tool, its tip at z, may not be for a boss whose
+/// walls lean in (ir::IslandShape::sectionAt). The tool is a body: at height
+/// h above its tip a disc of radius R - rc + sqrt(rc^2 - (rc - h)^2) through
+/// its corner (rc), R above; grown all round by the side allowance a (R + a,
+/// rc + a, its tip a lower), it must keep out of the boss's section at every
+/// height. The sections shrink going up, so only the heights through the
+/// grown corner count (above it the body is a cylinder meeting less): those
+/// heights are sampled (sliceSampling) and each section grown by the body's
+/// radius there plus the margin; the union is the keep-out area.
+Region slopedKeepOut(const ir::IslandShape &isl, double z, const Plan &p) {
+  const double a = p.allowanceSide, radius = p.radius + a, corner = ir::cornerRadius(*p.tool) + a, tip = z - a;
+  auto body = [&](double v) {
+    const double h = v - tip;
+    return h >= corner ? radius : radius - corner + std::sqrt(std::max(0.0, corner * corner - (corner - h) * (corner - h)));
+  };
+  const double lo = std::max(tip, isl.foot), hi = std::min(tip + corner, isl.top);
+  if (hi <= lo + 1e-9)
+    return geom::offset(isl.sectionAt(lo), body(lo));
+  const auto [step, margin] = sliceSampling(isl, corner);
+  const int count = static_cast<int>(std::ceil((hi - lo) / step - 1e-9));
+  std::vector<Region> slices;
+  for (int k = 0; k <= count; ++k) {
+    const double v = lo + (hi - lo) * k / count;
+    slices.push_back(geom::offset(isl.sectionAt(v), body(v) + margin));
+  }
+  return geom::uniteAll(slices);
+}
+
+} // namespace
+
+std::vector<Region> keepOutAt(const ir::FeatureShape &s, double z, const Plan &p) {
   std::vector<Region> out;
   for (const ir::IslandShape &isl : s.islands)
     if (isl.top > z + 1e-9)
-      out.push_back(geom::offset(isl.region, allowance));
+      out.push_back(isl.sloped() ? slopedKeepOut(isl, z, p)
+                                 : geom::offset(geom::offset(isl.region, p.allowanceSide), p.radius));
   return out;
 }
 
@@ -373,8 +530,10 @@ bool counterClockwise(const Node *strategy, double spindle) {
   return rotation.empty() || rotation == "ccw";
 }
 
+bool linkAnywhere(const ir::FeatureShape &s) { return s.unbounded && s.islands.empty(); }
+
 void cutPath(Emitter &e, const Path2D &given, double z, const Plan &p, const Node &op, const Region &centres,
-             bool mayLink, bool unbounded, int &fallbacks) {
+             bool mayLink, bool anywhere, int &fallbacks) {
   if (given.empty())
     return;
   // A closed ring starts where it is nearest to the tool.
@@ -393,7 +552,7 @@ void cutPath(Emitter &e, const Path2D &given, double z, const Plan &p, const Nod
     double len = 0;
     for (const Seg &sg : inside)
       len += sg.length();
-    if (unbounded || std::abs(len - (start - here).norm()) < 1e-6) {
+    if (anywhere || std::abs(len - (start - here).norm()) < 1e-6) {
       e.linear(at(start, z), p.feed, "link");
       linked = true;
     }

@@ -58,7 +58,7 @@ std::optional<std::vector<Path2D>> guidePaths(Expander &x, const Node &ws, const
                                               const ir::FeatureShape &s, const Plan &reach, double z, double spacing,
                                               double margin, Region &area) {
   const std::string type = guide.text("type").value_or("");
-  area = centreArea(s, s.unbounded ? s.target : s.limit, islandsAt(s, z, reach.allowanceSide), reach);
+  area = centreArea(s, s.unbounded ? s.target : s.limit, keepOutAt(s, z, reach), reach);
   if (margin > 0 && !area.empty())
     area = geom::offset(area, -margin);
   auto tooWide = [&](const std::string &what) {
@@ -99,11 +99,11 @@ std::optional<std::vector<Path2D>> guidePaths(Expander &x, const Node &ws, const
 /// between loops or plunges, and corners tighter than its reach).
 void wallPass(Emitter &e, const Node &op, const ir::FeatureShape &s, const Plan &p, double z, bool ccw,
               int &fallbacks) {
-  const Region centres = centreArea(s, s.unbounded ? s.target : s.limit, islandsAt(s, z, p.allowanceSide), p);
+  const Region centres = centreArea(s, s.unbounded ? s.target : s.limit, keepOutAt(s, z, p), p);
   if (centres.empty())
     return;
   for (const Path2D &ring : rings(centres, p.radius, ccw, /*all=*/false, p.radius))
-    cutPath(e, ring, z, p, op, centres, /*mayLink=*/true, s.unbounded, fallbacks);
+    cutPath(e, ring, z, p, op, centres, /*mayLink=*/true, linkAnywhere(s), fallbacks);
 }
 
 /// Paths joined into chains: each path goes on from the end of the one

@@ -231,12 +231,7 @@ bool expandSlotLevels(Expander &x, const Step &step) {
   // The levels, heights above the floor from the top down.
   std::vector<double> levels;
   if (finishing) {
-    double scallop = kDefaultScallopHeight;
-    if (x.scallopHeight)
-      scallop = *x.scallopHeight;
-    else if (const Node *wp = ir::workpieceOf(*x.module, *p.feature))
-      scallop = wp->number("global_tolerance").value_or(scallop);
-    levels = finishLevels(fit, section.depth, *lowest, maxStep, scallop);
+    levels = finishLevels(fit, section.depth, *lowest, maxStep, scallopHeight(x, *p.feature));
     levels.push_back(*lowest);
   } else {
     if (axial <= 1e-9)

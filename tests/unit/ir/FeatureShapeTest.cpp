@@ -254,3 +254,40 @@ TEST_CASE("a round hole and a tilted feature", "[shape]") {
   CHECK_FALSE(tilted.shape);
   CHECK(tilted.error.find("+z") != std::string::npos);
 }
+
+TEST_CASE("a boss whose walls lean in: its outline at its foot, shrunk going up", "[shape]") {
+  const std::string boss = "    planar_face %f \"F\" at=(0.0000,0.0000,30.0000)mm " + kZ +
+                           " depth=10.0000mm travel=80.0000mm travel_dir=(0.000000,1.000000,0.000000) "
+                           "width=100.0000mm width_dir=(1.000000,0.000000,0.000000)\n"
+                           "      island feature=%b\n"
+                           "    boss %b \"B\" at=(50.0000,40.0000,30.0000)mm " + kZ + " depth=10.0000mm ";
+  auto r = shapeOf(boss + "slope=45.0000deg\n      rectangular_profile width=30.0000mm length=30.0000mm\n", "%f");
+  REQUIRE(r.shape);
+  REQUIRE(r.shape->islands.size() == 1);
+  const ir::IslandShape &isl = r.shape->islands[0];
+  CHECK(isl.sloped());
+  CHECK(isl.foot == 20);
+  CHECK(isl.top == 30);
+  CHECK(isl.slope == Approx(1));
+  // 30 x 30 at the foot, 10 mm in at the top: 10 x 10, its corners sharp.
+  CHECK(isl.sectionAt(20).area() == Approx(900));
+  CHECK(isl.sectionAt(25).area() == Approx(400).epsilon(1e-9));
+  CHECK(isl.sectionAt(30).area() == Approx(100).epsilon(1e-9));
+  CHECK(isl.sectionAt(30).contains({54.99, 44.99}));
+  CHECK_FALSE(isl.sectionAt(30).contains({55.01, 40}));
+
+  // Walls that close the outline below the top, lean out (an undercut), or
+  // a pocket's slope: said, not cut as vertical walls.
+  auto closed = shapeOf(boss + "slope=60.0000deg\n      rectangular_profile width=30.0000mm length=30.0000mm\n", "%f");
+  CHECK_FALSE(closed.shape);
+  CHECK(closed.error.find("close its outline below its top") != std::string::npos);
+  auto out = shapeOf(boss + "slope=-5.0000deg\n      rectangular_profile width=30.0000mm length=30.0000mm\n", "%f");
+  CHECK_FALSE(out.shape);
+  CHECK(out.error.find("a slope of -5 deg is not expanded") != std::string::npos);
+  auto pocket = shapeOf("    closed_pocket %p \"P\" at=(50.0000,40.0000,30.0000)mm " + kZ +
+                            " depth=10.0000mm slope=5.0000deg bottom=planar\n"
+                            "      circular_profile diameter=60.0000mm\n",
+                        "%p");
+  CHECK_FALSE(pocket.shape);
+  CHECK(pocket.error.find("pockets are expanded with vertical walls only") != std::string::npos);
+}
