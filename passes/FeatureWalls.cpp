@@ -437,7 +437,7 @@ private:
       std::optional<Outline> o = closedProfile(*boss, *f);
       if (!o)
         return false;
-      FeatureWalls::Island isl{boss->symbol, std::move(*o), f->z, f->z - boss->number("depth").value_or(0), 0, {}};
+      FeatureWalls::Island isl{boss->symbol, std::move(*o), f->z, f->z - boss->number("depth").value_or(0), 0, {}, {}};
       // A slope leans the walls in going up, the outline at the foot
       // (docs/toolpaths.md, "Bosses with a slope").
       if (const double deg = boss->number("slope").value_or(0); deg != 0) {
@@ -582,7 +582,7 @@ private:
     std::optional<Outline> o = closedProfile(feature, f);
     if (!o)
       return false;
-    w.islands_.push_back({feature.symbol, std::move(*o), f.z, f.z - feature.number("depth").value_or(0), 0, {}});
+    w.islands_.push_back({feature.symbol, std::move(*o), f.z, f.z - feature.number("depth").value_or(0), 0, {}, {}});
     return true;
   }
 
