@@ -49,6 +49,7 @@ constexpr double kConverged = 1e-7; ///< mm: fixed-point tolerance
 constexpr double kDiverged = 1.0;   ///< mm: an offset this large means the iteration runs away
 constexpr int kMaxIterations = 200;
 constexpr double kSamePoint = 1e-6; ///< mm: closer positions need no connector
+constexpr double kAbsorbedGap = 1e-3; ///< mm: a gap a move's end is moved across instead of a connector
 /// Two moves meet tangentially (one run) when their directions differ by
 /// less than this (rad); otherwise they make a corner.
 constexpr double kTangentTurn = 0.01;
@@ -530,6 +531,16 @@ private:
           return;
         }
       }
+    }
+    // A gap of a micrometre or less (two arcs' ends moved along normals a
+    // little apart where the nominal path turns slightly): the first move
+    // ends where the next starts, not a connector whose own two sharp turns
+    // would stop the machine on the wall.
+    if (step <= kAbsorbedGap && a.move && b.move && a.move->isFeed() && b.move->isFeed() &&
+        std::abs(a.to.z() - b.from.z()) <= kSamePoint) {
+      a.to = b.from;
+      a.changed = true;
+      return;
     }
     ir::Node line(ir::Kind::Linear);
     line.set("to", ir::Value::point(b.from)).set("feed", ir::Value::feed(std::min(a.feed, b.feed)));
