@@ -27,6 +27,12 @@ struct EmitOptions {
   const ToolTable *toolTable = nullptr;
   /// The deposition head's codes of --machine, when it has one.
   const runtime::DepositionCodes *deposition = nullptr;
+  /// --machine, when one is given: a table-table machine turns its rotary
+  /// axes to each face of a program that re-clamps (rotaryIndexing).
+  const runtime::Machine *machine = nullptr;
+  /// --work-offset: where the workpiece's origin is on that machine, in
+  /// machine coordinates with every axis at 0 (needed to turn it).
+  std::optional<ir::Vec3> workOffset;
 };
 
 class Backend {

@@ -73,6 +73,10 @@ struct TargetDescriptor {
   /// Deposition programs: the target writes the head's state changes with
   /// the machine's codes (docs/additive.md).
   bool deposition = false;
+  /// Features on several faces on a machine with a rotary table: the target
+  /// turns its rotary axes to each face (3+2, positions computed by stepnc,
+  /// backends/common/Indexing.h) instead of stopping to re-clamp.
+  bool rotaryIndexing = false;
   /// Reading back a program that deposits: feed moves run with the spindle
   /// off (a deposition head turns nothing).
   bool feedsWithoutSpindle = false;

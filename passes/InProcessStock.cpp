@@ -251,17 +251,21 @@ double rapidCheckCell(const ir::Module &module) {
 void walkStock(const ir::Module &module, double cell, const std::function<void(const StockMove &)> &visit) {
   InProcessStock stocks(module, cell);
   std::optional<ir::Vec3> position;
-  std::string lastTool;
+  std::string lastTool, lastSetup;
   for (const ir::Node *e : ir::programOrder(module)) {
     const ir::Node *moves = ir::millingMoves(*e);
     if (!moves)
       continue;
     const std::string toolSymbol = moves->text("tool").value_or("");
     const ir::Node *tool = ir::findTool(module, toolSymbol);
-    // Where a tool change leaves the tool is the machine's business.
-    if (toolSymbol != lastTool)
+    // Where a tool change leaves the tool is the machine's business; so is
+    // where it is after the workpiece is re-clamped or turned to another
+    // face (another setup: the program goes up along z first).
+    const std::string setup = moves->text("setup").value_or("");
+    if (toolSymbol != lastTool || setup != lastSetup)
       position.reset();
     lastTool = toolSymbol;
+    lastSetup = setup;
     const double radius = toolRadius(tool), point = toolPoint(tool);
     cutting::HeightMap &stock = stocks.of(moves->text("setup").value_or(""));
     for (const ir::Move &m : ir::walkMoves(*moves, position)) {

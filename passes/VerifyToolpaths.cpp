@@ -305,15 +305,17 @@ private:
   void walkProgram() {
     std::optional<Vec3> position;
     double secplane = 0;
-    std::string lastTool;
+    std::string lastTool, lastSetup;
     for (const ir::Node *e : ir::programOrder(module_)) {
       const ir::Node *moves = ir::millingMoves(*e);
       if (!moves)
         continue;
       const std::string tool = moves->text("tool").value_or("");
-      if (position && tool == lastTool && position->z() < secplane - kLevelEps)
+      const std::string setup = moves->text("setup").value_or("");
+      if (position && tool == lastTool && setup == lastSetup && position->z() < secplane - kLevelEps)
         starts_[e] = *position;
       lastTool = tool;
+      lastSetup = setup;
       secplane = moves->number("secplane").value_or(0);
       for (const ir::Move &m : ir::walkMoves(*moves, position, ir::PathKind::Predicted))
         position = m.to;

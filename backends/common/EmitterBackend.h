@@ -9,6 +9,7 @@
 
 #include "backends/Backend.h"
 #include "backends/common/LatheEmitter.h"
+#include "backends/common/Indexing.h"
 #include "backends/common/Program.h"
 #include "backends/common/ReadBack.h"
 #include "ir/Program.h"
@@ -46,7 +47,7 @@ public:
         buildProgram(module, options.toolTable, diags,
                      descriptor().arcPlanes ? ir::OutOfPlaneArcs::Exact : ir::OutOfPlaneArcs::Chords,
                      descriptor().deposition ? ir::Deposition::Take : ir::Deposition::Refuse, descriptor().name);
-    if (!program)
+    if (!program || !index(*program, module, options, diags))
       return std::nullopt;
     Emitter emitter(descriptor(), options, diags);
     std::optional<std::string> text = emitter.run(*program);
@@ -68,6 +69,36 @@ public:
   }
 
 private:
+  /// A program that re-clamps for features on other faces, for a machine
+  /// with a rotary table: the rotary axes turn each face to the tool
+  /// (Indexing.h) where the target writes it, with the workpiece's place on
+  /// the table given; elsewhere the re-clamps stay, and a warning says why.
+  bool index(Program &program, const ir::Module &module, const EmitOptions &options, DiagnosticEngine &diags) const {
+    if (program.clampings.empty() || !options.machine ||
+        options.machine->kinematics.chain != runtime::Chain::TableTable)
+      return true;
+    if (!descriptor().rotaryIndexing) {
+      diags.warning(SourceLoc{}, descriptor().name + " does not turn a rotary table to each face yet (rs274 does): "
+                                 "the program stops for the operator to re-clamp the workpiece for each face");
+      return true;
+    }
+    if (!options.workOffset) {
+      // Said at the first step on another face.
+      const auto other = std::find_if(program.steps.begin(), program.steps.end(),
+                                      [](const Step &s) { return s.kind == Step::Kind::Moves && s.workOffset > 1; });
+      const ir::Node *at = other != program.steps.end() ? other->exec : nullptr;
+      diags.error(at ? at->origin.loc : SourceLoc{},
+                  "workingstep " + (at ? at->symbol + " " : std::string()) + "is on another face of the workpiece (" +
+                      std::to_string(program.clampings.size()) +
+                      " faces in all), which the machine's rotary table turns to the tool: give where the "
+                      "workpiece's origin is on the machine (--work-offset=X,Y,Z, machine coordinates with every "
+                      "axis at 0)")
+          .entity(at ? at->origin.entityId : 0);
+      return false;
+    }
+    return indexClampings(program, module, *options.machine, *options.workOffset, diags);
+  }
+
   /// Positions printed in steps coarser than half the contour tolerance
   /// (--target-opt decimals=N) cannot keep the path within it: the ends of
   /// a move move by half a step, an arc's centre by more. Refused, with the

@@ -20,6 +20,8 @@ std::vector<std::string> headerLines(const Program &p, const EmitOptions &o, con
   lines.push_back("target " + d.name + (o.optionsText.empty() ? "" : ", options " + o.optionsText));
   lines.push_back("units mm, feeds mm/min, spindle rev/min; coordinates are the workpiece's: set the work "
                   "offset to its origin");
+  for (const std::string &line : p.indexing)
+    lines.push_back(line);
   if (!p.clampings.empty()) {
     const auto stops = std::count_if(p.steps.begin(), p.steps.end(), [](const Step &s) { return s.reclamp; });
     lines.push_back("the program re-clamps the workpiece " + std::to_string(stops) +
@@ -56,6 +58,16 @@ std::optional<std::string> IsoEmitter::run(const Program &p) {
       break;
     }
     out_.block(comment(s.label));
+    if (s.index) {
+      // The tool up out of the way (machine coordinates), then the turn.
+      out_.block("G53 G0 Z" + num(s.index->retractZ));
+      std::string turn = "G0";
+      for (const auto &[axis, deg] : s.index->axes)
+        turn += " " + axis + num(deg);
+      out_.block(turn);
+      for (const char *w : {"G", "X", "Y", "Z"})
+        modal_.forget(w);
+    }
     if (s.workOffset > 0) {
       const std::string offset = workOffsetWord(s.workOffset);
       if (offset.empty())

@@ -31,8 +31,8 @@ int gKey(double value) { return static_cast<int>(std::lround(value * 10)); }
 const std::set<int> &allowedG(Dialect dialect) {
   static const std::set<int> rs274 = [] {
     std::set<int> s;
-    for (int g : {0, 1, 2, 3, 4, 5, 17, 18, 19, 21, 40, 43, 49, 54, 55, 56, 57, 58, 59, 64, 74, 80, 81, 82, 83, 84,
-                  85, 89, 90, 94, 98, 99})
+    for (int g : {0, 1, 2, 3, 4, 5, 17, 18, 19, 21, 40, 43, 49, 53, 54, 55, 56, 57, 58, 59, 64, 74, 80, 81, 82, 83,
+                  84, 85, 89, 90, 94, 98, 99})
       s.insert(g * 10);
     s.insert({591, 592, 593});
     return s;
@@ -265,10 +265,10 @@ private:
   /// (reported) when one is wrong.
   bool numbers(size_t n, std::vector<Word> &ws) {
     static const std::set<std::string> rs274Words = {"G", "M", "X", "Y", "Z", "I", "J", "K", "P", "Q", "R", "F",
-                                                     "S", "T", "H"};
+                                                     "S", "T", "H", "A", "B", "C"};
     static const std::set<std::string> siemensWords = {"G", "M", "X", "Y", "Z", "I", "J", "K", "F", "S", "T", "D",
                                                        "CR", "TURN"};
-    static const std::set<std::string> lengths = {"X", "Y", "Z", "I", "J", "K", "R", "Q", "F", "CR"};
+    static const std::set<std::string> lengths = {"X", "Y", "Z", "I", "J", "K", "R", "Q", "F", "CR", "A", "B", "C"};
     static const std::set<std::string> wholes = {"M", "S", "T", "D", "H", "TURN"};
     bool ok = true;
     for (Word &w : ws) {
@@ -358,6 +358,23 @@ private:
       r_.problem(n, "MSG shares its block");
     if (has(4)) {
       dwell(n, *ws, seen);
+      return;
+    }
+    // 3+2 (backends/common/Indexing.h): the tool up in machine coordinates
+    // (G53 G0 Z..), then the rotary axes turned (G0 A.. C..): no move of the
+    // program's, and where the axes are in it is not known after either.
+    if (has(53)) {
+      if (!has(0) || seen.size() != 1 || !seen.count("Z"))
+        r_.problem(n, "G53 other than G53 G0 Z.. (the tool up before the table turns)");
+      pos_ = Vec3(kNaN, kNaN, kNaN);
+      return;
+    }
+    if (seen.count("A") || seen.count("B") || seen.count("C")) {
+      if (!has(0) || std::any_of(seen.begin(), seen.end(), [](const auto &w) {
+            return w.first != "A" && w.first != "B" && w.first != "C";
+          }))
+        r_.problem(n, "rotary axes turned other than alone at rapid (G0 A.. C..)");
+      pos_ = Vec3(kNaN, kNaN, kNaN);
       return;
     }
     if (std::count(keywords.begin(), keywords.end(), "MCALL")) {

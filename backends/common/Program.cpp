@@ -192,6 +192,8 @@ private:
                                       formatShortest(ir::kOutOfPlaneArcChord) +
                                       " mm from its arc: the target writes arcs in the XY plane only")
           .entity(e.origin.entityId);
+    if (const std::optional<std::string> setup = moves->text("setup"))
+      s.setup = ir::findResource(module_, ir::Kind::Setup, *setup);
     // A program that re-clamps selects each setup's work offset.
     if (reclamps_) {
       const std::string setup = moves->text("setup").value_or("");

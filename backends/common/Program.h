@@ -99,6 +99,14 @@ struct HoleCycle {
 /// emitter may still find that its cycle does not make the planned moves.
 std::string whyNotCycle(const TargetDescriptor &d, const HoleCycle &c);
 
+/// 3+2 machining (backends/common/Indexing.h): the rotary axes' positions
+/// a step's face needs, reached before it with the tool up out of the way.
+struct Index {
+  std::vector<std::pair<std::string, double>> axes;  ///< name ("A"), deg
+  double retractZ = 0;  ///< machine z the tool goes up to first (the top of its travel), mm
+  std::string face;     ///< "+X": the face the turn brings to the tool
+};
+
 struct Step {
   enum class Kind { Moves, Message, Stop, OptionalStop } kind = Kind::Moves;
   const ir::Node *exec = nullptr;
@@ -118,6 +126,11 @@ struct Step {
   /// In a program that re-clamps, the work offset (1: the program's first)
   /// its first step and the first step after each re-clamp select.
   int workOffset = 0;
+  /// Its setup (the IR's `setup` node), when its moves name one.
+  const ir::Node *setup = nullptr;
+  /// In a program that turns the rotary axes to each face instead of
+  /// re-clamping: the turn before the step.
+  std::optional<Index> index;
   double spindle = 0;     ///< rev/min, negative clockwise (M3); 0 on a rapid movement: keep
   std::string coolant;    ///< off, flood, mist, through_tool
   double secplane = 0;
@@ -140,6 +153,9 @@ struct Program {
   /// work offset and what the operator does ("work offset 2: ..."), the
   /// first clamping's first.
   std::vector<std::pair<int, std::string>> clampings;
+  /// A program that turns the rotary axes to each face instead
+  /// (Indexing.h): what the header says of it, line by line.
+  std::vector<std::string> indexing;
 };
 
 /// How high a step starts when where the tool is cannot be relied on (after

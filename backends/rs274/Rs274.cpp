@@ -36,6 +36,7 @@ TargetDescriptor rs274Descriptor() {
   d.tolerance = 0.01;
   d.latheCompensation = true;  // G41/G42 with the tool table's radius and orientation
   d.deposition = true;         // the machine's codes (M62-M68 on LinuxCNC)
+  d.rotaryIndexing = true;     // G53 G0 Z up, G0 A.. C.. (docs/five-axis.md)
   return d;
 }
 

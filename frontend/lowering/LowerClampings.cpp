@@ -205,7 +205,11 @@ std::string Lowerer::turnedSetup(const std::string &workpiece, const Turn &turn,
   s.set("at", Value::point(Vec3::Zero()));
   s.set("axis", Value::direction(Vec3::UnitZ()));
   s.set("ref", Value::direction(Vec3::UnitX()));
-  std::optional<double> secplane = setupInForce_ ? turnedSecplane(setupInForce_, turn, raw) : std::nullopt;
+  // The security plane of the first workingstep on the face, when it gives
+  // one for that face; else the file's setup's, turned.
+  std::optional<double> secplane = stepInstance ? faceSecplane(stepInstance, turn, raw) : std::nullopt;
+  if (!secplane && setupInForce_)
+    secplane = turnedSecplane(setupInForce_, turn, raw);
   if (!secplane)
     secplane = raw ? turnedBox(*raw, turn).second.z() : 0.0;
   s.set("secplane", Value::length(*secplane));
@@ -233,6 +237,21 @@ std::string Lowerer::turnedSetup(const std::string &workpiece, const Turn &turn,
   return turned_[key] = symbol;
 }
 
+std::optional<double> Lowerer::faceSecplane(const Instance &owner, const Turn &turn,
+                                            const std::optional<RawExtent> &raw) {
+  const Instance plane = owner.ref("its_secplane");
+  if (!plane || !plane.isA("plane"))
+    return std::nullopt;
+  const std::optional<Placement> p = placement(plane.ref("position"));
+  if (!p)
+    return std::nullopt;
+  const Vec3 up = turn.rotation.transpose() * Vec3::UnitZ();  // the face's normal in workpiece coordinates
+  const std::optional<double> top = raw ? std::optional(turnedBox(*raw, turn).second.z()) : std::nullopt;
+  if (std::abs(std::abs(p->axis.dot(up)) - 1) < kAlong && (!top || turn.point(p->at).z() > *top))
+    return turn.point(p->at).z();
+  return std::nullopt;
+}
+
 std::optional<double> Lowerer::turnedSecplane(const Instance &owner, const Turn &turn,
                                               const std::optional<RawExtent> &raw) {
   Instance plane = owner.ref("its_secplane");
@@ -249,11 +268,10 @@ std::optional<double> Lowerer::turnedSecplane(const Instance &owner, const Turn 
     missing(plane, "position");
     return std::nullopt;
   }
-  const Vec3 up = turn.rotation.transpose() * Vec3::UnitZ();  // the face's normal in workpiece coordinates
-  const std::optional<double> top = raw ? std::optional(turnedBox(*raw, turn).second.z()) : std::nullopt;
   // A plane parallel to the face, outside it: it turns with the workpiece.
-  if (std::abs(std::abs(p->axis.dot(up)) - 1) < kAlong && (!top || turn.point(p->at).z() > *top))
-    return turn.point(p->at).z();
+  if (std::optional<double> h = faceSecplane(owner, turn, raw))
+    return h;
+  const std::optional<double> top = raw ? std::optional(turnedBox(*raw, turn).second.z()) : std::nullopt;
   if (std::abs(std::abs(p->axis.z()) - 1) < kAlong && raw) {
     // A plane over the workpiece's top, where the file gives one plane for
     // every face: as far above the turned raw piece as it is above the top.

@@ -262,6 +262,9 @@ private:
   /// The security plane of `owner` (attribute its_secplane) as a height in
   /// the turned setup; reports what it assumes.
   std::optional<double> turnedSecplane(const Instance &owner, const Turn &turn, const std::optional<RawExtent> &raw);
+  /// The height of `owner`'s security plane in the turned setup when it is
+  /// parallel to the face and outside it; none (and nothing said) otherwise.
+  std::optional<double> faceSecplane(const Instance &owner, const Turn &turn, const std::optional<RawExtent> &raw);
   /// Decides how the file's angles are read (options_.units.angles), from
   /// the instances that have angles.
   void chooseAngleUnit(const std::vector<Instance> &withAngles);

@@ -3,6 +3,8 @@
 #include "support/OutputFile.h"
 
 #include <CLI/CLI.hpp>
+#include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <span>
@@ -195,6 +197,23 @@ std::unique_ptr<SourceFile> openInput(const std::string &path) {
   if (!file)
     printToolError(error);
   return file;
+}
+
+std::optional<Eigen::Vector3d> parseWorkOffset(const std::string &text) {
+  Eigen::Vector3d v;
+  size_t at = 0;
+  for (int k = 0; k < 3; ++k) {
+    const size_t comma = text.find(',', at);
+    if ((k < 2) != (comma != std::string::npos))
+      return std::nullopt;
+    const std::string part = text.substr(at, k < 2 ? comma - at : std::string::npos);
+    char *end = nullptr;
+    v[k] = std::strtod(part.c_str(), &end);
+    if (part.empty() || *end != '\0' || !std::isfinite(v[k]))
+      return std::nullopt;
+    at = comma + 1;
+  }
+  return v;
 }
 
 } // namespace stepnc::tool

@@ -9,7 +9,10 @@
 #include "support/Diagnostics.h"
 #include "support/SourceFile.h"
 
+#include <Eigen/Core>
+
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -53,6 +56,9 @@ void addUnitOptions(CLI::App &cmd, UnitOptions &opts);
 
 /// --schema FILE.exp (repeatable) and --no-schema.
 void addSchemaOptions(CLI::App &cmd, driver::SchemaOptions &opts);
+
+/// "X,Y,Z" as three finite numbers (--work-offset of sim and compile).
+std::optional<Eigen::Vector3d> parseWorkOffset(const std::string &text);
 
 /// Owns the consumer and engine configured from DiagnosticOptions. With
 /// --diagnostics=json, standard error is one JSON array for as long as the

@@ -69,6 +69,8 @@ std::string optionsText(const CompileOptions &opts) {
     add("--tolerance " + formatShortest(*opts.tolerance));
   for (const std::string &o : opts.targetOptions)
     add("--target-opt " + o);
+  if (!opts.workOffset.empty())
+    add("--work-offset " + opts.workOffset);
   return text;
 }
 
@@ -332,6 +334,15 @@ int compileSource(const CompileOptions &opts, const std::string &emit, std::uniq
       }
       if (machine->deposition)
         emitOptions.deposition = &*machine->deposition;
+      emitOptions.machine = &*machine;
+    }
+    if (!opts.workOffset.empty()) {
+      emitOptions.workOffset = parseWorkOffset(opts.workOffset);
+      if (!emitOptions.workOffset) {
+        printToolError("compile: --work-offset='" + opts.workOffset +
+                       "' is not a position: expected three numbers of mm, X,Y,Z, such as --work-offset=200,195,-250");
+        return kExitUsage;
+      }
     }
     std::optional<std::string> program = backend->emit(*module, emitOptions, diags);
     if (!program || diags.hasErrors()) {
@@ -467,6 +478,10 @@ void registerCompile(CLI::App &app, std::function<void(int)> setResult) {
                 "Write spindle speeds, feeds and extents outside the machine's range (with --machine)\n"
                 "or plausibility, and chip loads beyond the tool's, with a warning each instead of\n"
                 "refusing them (check-limits, docs/diagnostics.md)");
+  cmd->add_option("--work-offset", opts->workOffset,
+                  "Where the workpiece's origin is on --machine: X,Y,Z in mm, machine coordinates with every\n"
+                  "axis at 0. A machine with a rotary table then turns each face of a part with features on\n"
+                  "several faces to the tool (3+2) instead of stopping to re-clamp (docs/five-axis.md)");
   cmd->add_flag("--allow-feed-increase", opts->allowFeedIncrease,
                 "Let feed adaptation raise feeds above the programmed ones where the cut allows");
   cmd->add_option("--tool-table", opts->toolTable,

@@ -32,6 +32,9 @@ struct CompileOptions {
   std::string cuttingData;
   bool allowFeedIncrease = false;
   bool allowOutOfRange = false;
+  /// --work-offset: where the workpiece's origin is on --machine (X,Y,Z, machine
+  /// coordinates with every axis at 0): a rotary table turns each face to the tool.
+  std::string workOffset;
   // opt only
   std::string passes;
   std::vector<std::string> printAfter;

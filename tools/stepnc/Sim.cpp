@@ -52,24 +52,6 @@ struct SimCommandOptions {
   DiagnosticOptions diag;
 };
 
-/// "X,Y,Z" as three finite numbers.
-std::optional<runtime::Vec3> parseWorkOffset(const std::string &text) {
-  runtime::Vec3 v;
-  size_t at = 0;
-  for (int k = 0; k < 3; ++k) {
-    const size_t comma = text.find(',', at);
-    if ((k < 2) != (comma != std::string::npos))
-      return std::nullopt;
-    const std::string part = text.substr(at, k < 2 ? comma - at : std::string::npos);
-    char *end = nullptr;
-    v[k] = std::strtod(part.c_str(), &end);
-    if (part.empty() || *end != '\0' || !std::isfinite(v[k]))
-      return std::nullopt;
-    at = comma + 1;
-  }
-  return v;
-}
-
 std::string label(const ir::Node &e) {
   std::string s = e.kindName() + " " + e.symbol;
   if (!e.label.empty())

@@ -1,0 +1,235 @@
+#include "backends/common/Indexing.h"
+
+#include "ir/Program.h"
+#include "runtime/Kinematics.h"
+#include "support/Format.h"
+
+#include <Eigen/Dense>
+
+#include <cctype>
+#include <cmath>
+
+namespace stepnc::backends {
+
+namespace {
+
+/// Where a setup places the workpiece: q = at + turn p (p in workpiece
+/// coordinates, q in the setup's frame), from its workpiece_setup.
+struct Placement {
+  Eigen::Matrix3d turn = Eigen::Matrix3d::Identity();
+  Vec3 at = Vec3::Zero();
+};
+
+Placement placementOf(const ir::Node *setup) {
+  Placement out;
+  const ir::Node *ws = setup ? setup->child(ir::Kind::WorkpieceSetup) : nullptr;
+  if (!ws)
+    return out;
+  const Vec3 axis = ws->vec("axis").value_or(Vec3::UnitZ()).normalized();
+  const Vec3 ref = ws->vec("ref").value_or(Vec3::UnitX()).normalized();
+  out.turn.col(0) = ref;
+  out.turn.col(1) = axis.cross(ref);
+  out.turn.col(2) = axis;
+  out.at = ws->vec("at").value_or(Vec3::Zero());
+  return out;
+}
+
+/// "+X" for a direction along an axis, else its components.
+std::string faceName(const Vec3 &d) {
+  static constexpr const char *kNames[] = {"X", "Y", "Z"};
+  for (int k = 0; k < 3; ++k)
+    if (std::abs(std::abs(d[k]) - 1) < 1e-9)
+      return std::string(d[k] > 0 ? "+" : "-") + kNames[k];
+  return "(" + formatTuple({d.x(), d.y(), d.z()}, 6) + ")";
+}
+
+std::string upper(std::string s) {
+  for (char &c : s)
+    c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return s;
+}
+
+} // namespace
+
+bool indexClampings(Program &p, const ir::Module &, const runtime::Machine &machine, const Vec3 &workOffset,
+                    DiagnosticEngine &diags) {
+  if (p.clampings.empty())
+    return true;
+  std::string error;
+  const std::unique_ptr<runtime::Kinematics> kinematics = runtime::makeKinematics(machine, error);
+  if (!kinematics) {
+    diags.error(SourceLoc{}, "the machine's kinematics: " + error);
+    return false;
+  }
+  std::vector<size_t> rotary;
+  for (size_t k = 0; k < machine.axes.size(); ++k)
+    if (machine.axes[k].rotary)
+      rotary.push_back(k);
+  const double retractZ = machine.axes.at(2).travelMax;
+  // The table turns with the tool at the top of z: whatever the angles, the
+  // workpiece stays within the outermost pivot's distance to the next, and so
+  // on inwards, plus the raw block's farthest corner from the innermost.
+  if (p.blank && !rotary.empty()) {
+    const auto &[lo, hi] = *p.blank;
+    std::vector<const runtime::Axis *> table;
+    for (const std::string &name : machine.kinematics.table)
+      for (const runtime::Axis &a : machine.axes)
+        if (a.name == name)
+          table.push_back(&a);
+    if (!table.empty()) {
+      double reach = 0;
+      for (size_t k = 0; k + 1 < table.size(); ++k)
+        reach += (table[k + 1]->pivotMm - table[k]->pivotMm).norm();
+      double corner = 0;
+      for (int c = 0; c < 8; ++c) {
+        const Vec3 q((c & 1) ? hi.x() : lo.x(), (c & 2) ? hi.y() : lo.y(), (c & 4) ? hi.z() : lo.z());
+        corner = std::max(corner, (q + workOffset - table.back()->pivotMm).norm());
+      }
+      const double top = table.front()->pivotMm.z() + reach + corner;
+      if (top >= retractZ) {
+        diags.error(SourceLoc{}, "the workpiece turning on the machine's table may reach up to z " +
+                                     formatFixed(top, 3) + " mm, above the top of z travel " +
+                                     formatShortest(retractZ) + " mm where the tool waits while it turns (its raw "
+                                     "block at --work-offset " +
+                                     formatTuple({workOffset.x(), workOffset.y(), workOffset.z()}, 3) + ")");
+        return false;
+      }
+    }
+  }
+
+  // The re-clamp stops go, and the operator's message before each (on a
+  // copy: a face out of reach keeps the program as it was).
+  std::vector<Step> steps;
+  for (size_t i = 0; i < p.steps.size(); ++i) {
+    const bool message = p.steps[i].kind == Step::Kind::Message && i + 1 < p.steps.size() &&
+                         p.steps[i + 1].kind == Step::Kind::Stop && p.steps[i + 1].reclamp;
+    if (message || (p.steps[i].kind == Step::Kind::Stop && p.steps[i].reclamp))
+      continue;
+    steps.push_back(p.steps[i]);
+  }
+
+  // What stops the turns (a face out of reach): the re-clamps stay.
+  struct Problem {
+    const ir::Node *exec;
+    std::string why;
+  };
+  std::optional<Problem> problem;
+  runtime::Joints near = runtime::Joints::Zero(static_cast<Eigen::Index>(kinematics->jointCount()));
+  std::optional<runtime::Joints> turned;  // the rotary axes' positions in force
+  bool ok = true, first = true;
+  std::vector<std::string> faces;
+  for (Step &s : steps) {
+    if (s.kind != Step::Kind::Moves || (s.moves.empty() && !s.cycle))
+      continue;
+    const Placement place = placementOf(s.setup);
+    const Vec3 tool = place.turn.transpose() * Vec3::UnitZ();  // towards the spindle, in workpiece coordinates
+    auto where = [&](const std::string &why) {
+      if (!problem)
+        problem = Problem{s.exec, why};
+      ok = false;
+    };
+    // The joints that put the tool tip at q (in the step's frame) with the
+    // tool along the face's normal; the program's point is their x, y, z
+    // less the work offset.
+    auto toProgram = [&](const Vec3 &q) -> std::optional<Vec3> {
+      const Vec3 pw = place.turn.transpose() * (q - place.at);
+      const runtime::InverseResult r = kinematics->inverse({pw + workOffset, tool}, &near);
+      if (!r.joints) {
+        where("the machine cannot turn face " + faceName(tool) + " to the tool: " + r.why);
+        return std::nullopt;
+      }
+      if (r.outsideTravel) {
+        std::string axes;
+        for (size_t k = 0; k < machine.axes.size(); ++k) {
+          const double v = (*r.joints)[static_cast<Eigen::Index>(k)];
+          if (v < machine.axes[k].travelMin - 1e-9 || v > machine.axes[k].travelMax + 1e-9)
+            axes += (axes.empty() ? "" : ", ") + upper(machine.axes[k].name) + formatShortest(v);
+        }
+        where("face " + faceName(tool) + " turned to the tool puts the point " +
+              formatTuple({pw.x(), pw.y(), pw.z()}, 4) + " of the workpiece outside the machine's travel (" + axes +
+              ") with the workpiece's origin at " + formatTuple({workOffset.x(), workOffset.y(), workOffset.z()}, 3));
+        return std::nullopt;
+      }
+      near = *r.joints;
+      return Vec3(near.head<3>()) - workOffset;
+    };
+    const Vec3 probe = s.moves.empty() ? Vec3(s.cycle->at.x(), s.cycle->at.y(), s.cycle->surfaceZ) : s.moves.front().to;
+    const std::optional<Vec3> probed = toProgram(probe);
+    if (!probed)
+      continue;
+    // Heights along the tool shift by one amount for the whole face (the
+    // turn holds the tool along z): what the cycles and planes need.
+    const double dz = probed->z() - probe.z();
+    bool changed = !turned;
+    for (size_t k : rotary)
+      changed = changed || std::abs((*turned)[static_cast<Eigen::Index>(k)] - near[static_cast<Eigen::Index>(k)]) > 1e-9;
+    if (changed || first) {
+      Index index;
+      index.retractZ = retractZ;
+      index.face = faceName(tool);
+      std::string text = "face " + index.face + ":";
+      for (size_t k : rotary) {
+        index.axes.emplace_back(upper(machine.axes[k].name), near[static_cast<Eigen::Index>(k)]);
+        text += " " + upper(machine.axes[k].name) + formatShortest(near[static_cast<Eigen::Index>(k)]);
+      }
+      s.index = std::move(index);
+      if (std::find(faces.begin(), faces.end(), text) == faces.end())
+        faces.push_back(text);
+      turned = near;
+    }
+    first = false;
+    s.workOffset = s.workOffset == 1 ? 1 : 0;
+    const bool level = std::abs(dz) < 1e-12 && place.turn.isIdentity(1e-12);
+    for (Move &m : s.moves) {
+      if (m.kind == Move::Kind::Arc && !(m.plane == geom::ArcPlane::xy()) && !level) {
+        where("an arc in a plane other than XY on face " + faceName(tool) +
+              " turned to the tool: not written yet (the turn keeps only the XY plane)");
+        break;
+      }
+      const std::optional<Vec3> from = toProgram(m.from), to = toProgram(m.to);
+      if (!from || !to)
+        break;
+      if (m.kind == Move::Kind::Arc) {
+        const std::optional<Vec3> centre = toProgram(Vec3(m.centre.x(), m.centre.y(), m.from.z()));
+        if (!centre)
+          break;
+        m.centre = centre->head<2>();
+      }
+      m.from = *from;
+      m.to = *to;
+    }
+    if (s.cycle) {
+      const std::optional<Vec3> at = toProgram(Vec3(s.cycle->at.x(), s.cycle->at.y(), s.cycle->surfaceZ));
+      if (at) {
+        s.cycle->at = at->head<2>();
+        for (double *z : {&s.cycle->initialZ, &s.cycle->retractZ, &s.cycle->surfaceZ, &s.cycle->depthZ})
+          *z += dz;
+        for (double &z : s.cycle->pecks)
+          z += dz;
+      }
+    }
+    s.secplane += dz;
+  }
+  if (!ok) {
+    const std::string what = "the machine's rotary table does not turn every face to the tool (" +
+                             (problem->exec ? "workingstep " + problem->exec->symbol + ": " : std::string()) +
+                             problem->why + "): the program stops for the operator to re-clamp for each face instead";
+    if (problem->exec)
+      diags.warning(problem->exec->origin.loc, what).entity(problem->exec->origin.entityId);
+    else
+      diags.warning(SourceLoc{}, what);
+    return true;
+  }
+  p.steps = std::move(steps);
+  p.clampings.clear();
+  p.indexing.push_back("the program turns the rotary axes to bring each face to the tool (3+2), one work offset "
+                       "for all: the workpiece's origin at X" +
+                       formatShortest(workOffset.x()) + " Y" + formatShortest(workOffset.y()) + " Z" +
+                       formatShortest(workOffset.z()) + " in machine coordinates with every axis at 0; before each "
+                       "turn the tool goes up to Z" + formatShortest(retractZ) + " (G53)");
+  for (const std::string &f : faces)
+    p.indexing.push_back(f);
+  return true;
+}
+
+} // namespace stepnc::backends
