@@ -70,15 +70,16 @@ public:
 
 private:
   /// A program that re-clamps for features on other faces, for a machine
-  /// with a rotary table: the rotary axes turn each face to the tool
+  /// with a rotary table (table-table, head-table): the rotary axes turn each face to the tool
   /// (Indexing.h) where the target writes it, with the workpiece's place on
   /// the table given; elsewhere the re-clamps stay, and a warning says why.
   bool index(Program &program, const ir::Module &module, const EmitOptions &options, DiagnosticEngine &diags) const {
     if (program.clampings.empty() || !options.machine ||
-        options.machine->kinematics.chain != runtime::Chain::TableTable)
+        (options.machine->kinematics.chain != runtime::Chain::TableTable &&
+         options.machine->kinematics.chain != runtime::Chain::HeadTable))
       return true;
     if (!descriptor().rotaryIndexing) {
-      diags.warning(SourceLoc{}, descriptor().name + " does not turn a rotary table to each face yet (rs274 does): "
+      diags.warning(SourceLoc{}, descriptor().name + " does not turn the rotary axes to each face yet (rs274 does): "
                                  "the program stops for the operator to re-clamp the workpiece for each face");
       return true;
     }
@@ -96,7 +97,7 @@ private:
           .entity(at ? at->origin.entityId : 0);
       return false;
     }
-    return indexClampings(program, module, *options.machine, *options.workOffset, diags);
+    return indexClampings(program, module, *options.machine, *options.workOffset, descriptor().arcPlanes, diags);
   }
 
   /// Positions printed in steps coarser than half the contour tolerance

@@ -52,7 +52,7 @@ std::string upper(std::string s) {
 } // namespace
 
 bool indexClampings(Program &p, const ir::Module &, const runtime::Machine &machine, const Vec3 &workOffset,
-                    DiagnosticEngine &diags) {
+                    bool arcPlanes, DiagnosticEngine &diags) {
   if (p.clampings.empty())
     return true;
   std::string error;
@@ -80,12 +80,21 @@ bool indexClampings(Program &p, const ir::Module &, const runtime::Machine &mach
       double reach = 0;
       for (size_t k = 0; k + 1 < table.size(); ++k)
         reach += (table[k + 1]->pivotMm - table[k]->pivotMm).norm();
-      double corner = 0;
+      double corner = 0, top = -1e300;
       for (int c = 0; c < 8; ++c) {
-        const Vec3 q((c & 1) ? hi.x() : lo.x(), (c & 2) ? hi.y() : lo.y(), (c & 4) ? hi.z() : lo.z());
-        corner = std::max(corner, (q + workOffset - table.back()->pivotMm).norm());
+        const Vec3 q = Vec3((c & 1) ? hi.x() : lo.x(), (c & 2) ? hi.y() : lo.y(), (c & 4) ? hi.z() : lo.z()) +
+                       workOffset;
+        corner = std::max(corner, (q - table.back()->pivotMm).norm());
+        if (table.size() == 1) {
+          // About one axis a point circles its foot on the axis: no higher
+          // than the foot plus its distance times the axis's lean from z.
+          const Vec3 d = table.front()->direction.normalized(), rel = q - table.front()->pivotMm;
+          const Vec3 foot = table.front()->pivotMm + d * rel.dot(d);
+          top = std::max(top, foot.z() + (q - foot).norm() * d.cross(Vec3::UnitZ()).norm());
+        }
       }
-      const double top = table.front()->pivotMm.z() + reach + corner;
+      if (table.size() > 1)
+        top = table.front()->pivotMm.z() + reach + corner;
       if (top >= retractZ) {
         diags.error(SourceLoc{}, "the workpiece turning on the machine's table may reach up to z " +
                                      formatFixed(top, 3) + " mm, above the top of z travel " +
@@ -179,26 +188,77 @@ bool indexClampings(Program &p, const ir::Module &, const runtime::Machine &mach
     }
     first = false;
     s.workOffset = s.workOffset == 1 ? 1 : 0;
-    const bool level = std::abs(dz) < 1e-12 && place.turn.isIdentity(1e-12);
-    for (Move &m : s.moves) {
-      if (m.kind == Move::Kind::Arc && !(m.plane == geom::ArcPlane::xy()) && !level) {
-        where("an arc in a plane other than XY on face " + faceName(tool) +
-              " turned to the tool: not written yet (the turn keeps only the XY plane)");
-        break;
-      }
+    // For the whole face the map from its frame to the program's is a turn
+    // and a shift: where it takes the face's axes.
+    const std::optional<Vec3> origin = toProgram(probe), alongZ = toProgram(probe + Vec3::UnitZ());
+    if (!origin || !alongZ)
+      continue;
+    const Vec3 toolAxis = (*alongZ - *origin).normalized();  // the tool, in the program's frame
+    const bool upright = (toolAxis - Vec3::UnitZ()).norm() < 1e-9;
+    auto direction = [&](const Vec3 &q, const Vec3 &v) -> std::optional<Vec3> {
+      const std::optional<Vec3> a = toProgram(q), b = toProgram(q + v);
+      if (!a || !b)
+        return std::nullopt;
+      return Vec3((*b - *a).normalized());
+    };
+    std::vector<Move> moves;
+    for (const Move &given : s.moves) {
+      Move m = given;
       const std::optional<Vec3> from = toProgram(m.from), to = toProgram(m.to);
       if (!from || !to)
         break;
+      if (m.alongZOnly && !upright) {
+        // Up along the tool axis is not along z: up along z alone to the top
+        // of z (where the turn left the tool: the rule after a tool change
+        // holds), across there, then down along z to the point over the
+        // face (above its clearance plane all the way, the tool leaning no
+        // more than 90 deg).
+        const double top = retractZ - workOffset.z();
+        m.from = *from;
+        m.to = Vec3(from->x(), from->y(), top);
+        moves.push_back(m);
+        m.alongZOnly = false;
+        m.from = m.to;
+        m.to = Vec3(to->x(), to->y(), top);
+        moves.push_back(m);
+        m.from = m.to;
+        m.to = *to;
+        moves.push_back(m);
+        continue;
+      }
       if (m.kind == Move::Kind::Arc) {
-        const std::optional<Vec3> centre = toProgram(Vec3(m.centre.x(), m.centre.y(), m.from.z()));
-        if (!centre)
+        const Vec3 centre3 = m.plane.world(Vec3(m.centre.x(), m.centre.y(), m.plane.local(m.from).z()));
+        const std::optional<Vec3> centre = toProgram(centre3);
+        const std::optional<Vec3> normal = direction(centre3, m.plane.normalVector());
+        if (!centre || !normal)
           break;
-        m.centre = centre->head<2>();
+        bool positive = true;
+        const std::optional<geom::ArcPlane> plane = geom::ArcPlane::about(*normal, positive);
+        if (plane && (plane->isXY() || arcPlanes)) {
+          m.plane = *plane;
+          m.ccw = positive ? m.ccw : !m.ccw;
+          m.from = *from;
+          m.to = *to;
+          m.centre = plane->local(*centre).head<2>();
+          moves.push_back(m);
+          continue;
+        }
+        // Faces turned to the tool bring their arcs into XY, ZX or YZ (the
+        // turns are quarter turns for the faces lowering makes); an arc in
+        // another plane, or in ZX or YZ for a target without them, is not
+        // written yet.
+        where("an arc on face " + faceName(tool) + " turned to the tool lies in no plane " +
+              (arcPlanes ? std::string("the target writes (XY, ZX, YZ)") : std::string("but XY")));
+        break;
       }
       m.from = *from;
       m.to = *to;
+      moves.push_back(m);
     }
-    if (s.cycle) {
+    s.moves = std::move(moves);
+    if (s.cycle && !upright) {
+      s.cycle.reset();  // a canned cycle drills along z: its moves are written instead
+    } else if (s.cycle) {
       const std::optional<Vec3> at = toProgram(Vec3(s.cycle->at.x(), s.cycle->at.y(), s.cycle->surfaceZ));
       if (at) {
         s.cycle->at = at->head<2>();
@@ -211,7 +271,7 @@ bool indexClampings(Program &p, const ir::Module &, const runtime::Machine &mach
     s.secplane += dz;
   }
   if (!ok) {
-    const std::string what = "the machine's rotary table does not turn every face to the tool (" +
+    const std::string what = "the machine's rotary axes do not turn every face to the tool (" +
                              (problem->exec ? "workingstep " + problem->exec->symbol + ": " : std::string()) +
                              problem->why + "): the program stops for the operator to re-clamp for each face instead";
     if (problem->exec)

@@ -1,7 +1,8 @@
 // 3+2 (indexed) machining: a program whose features lie on several faces of
 // the workpiece, which lowering made a clamping per face (docs/setups.md),
-// written for a machine with two rotary axes turns those axes to bring each
-// face to the tool instead of stopping for the operator to re-clamp. Each
+// written for a machine with two rotary axes (a table-table or head-table
+// chain) turns those axes to bring each face to the tool instead of
+// stopping for the operator to re-clamp. Each
 // step's moves, planned in its face's frame, are written in the frame of the
 // workpiece as clamped once (one work offset), through the machine's inverse
 // kinematics with the rotary axes held for the whole face
@@ -19,11 +20,18 @@ namespace stepnc::backends {
 /// the first clamping's frame (the workpiece's origin at `workOffset`, in
 /// machine coordinates with every axis at 0) and, where the face changes,
 /// the rotary positions (Step::index); the re-clamp stops and their messages
-/// go. Nothing changes when `p` does not re-clamp, nor (with a warning
-/// naming the step and why) when the machine cannot turn some face to the
-/// tool within its travel or a turned face has an arc outside the XY plane:
-/// the re-clamps stay. False (reported) when the kinematics cannot be made.
+/// go. With the tool leaning (a head), canned cycles are written as their
+/// moves and a step's first move up along z goes across at the top of z,
+/// then down. Nothing changes when `p` does not re-clamp, nor (with a
+/// warning naming the step and why) when the machine cannot turn some face
+/// to the tool within its travel or an arc lands in no plane the target
+/// writes: the re-clamps stay. False (reported) when
+/// the kinematics cannot be made or the workpiece could sweep into the tool
+/// while it turns.
+/// `arcPlanes`: the target writes arcs in the ZX and YZ planes (where a
+/// leaning tool puts a face's arcs); an arc that lands in no plane the
+/// target writes keeps the re-clamps (with the warning).
 bool indexClampings(Program &p, const ir::Module &module, const runtime::Machine &machine, const Vec3 &workOffset,
-                    DiagnosticEngine &diags);
+                    bool arcPlanes, DiagnosticEngine &diags);
 
 } // namespace stepnc::backends

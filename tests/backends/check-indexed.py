@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Checks a 3+2 (indexed) rs274 program on a table-table machine.
+"""Checks a 3+2 (indexed) rs274 program on a table-table or head-table machine.
 
 A part with features on several faces, compiled for a machine whose rotary
 table turns each face to the tool (docs/five-axis.md), is run through
@@ -7,12 +7,14 @@ LinuxCNC's rs274 interpreter with the work offset G54 set where the
 workpiece's origin is (--work-offset). Each canonical move, in machine
 coordinates (its position plus the G54 offset rs274 reports), is taken back
 to the workpiece through the machine's forward kinematics, written here from
-the machine file alone (each table axis's direction and pivot, the outermost
-undone first): the tool tip in workpiece coordinates and the tool's
-direction there. The toolpath IR says where each feed move should be, in
+the machine file alone (the head's axes turning the tip's offset from its
+pivot and the tool, then each table axis's turn undone, the outermost
+first): the tool tip in workpiece coordinates and the tool's direction
+there. The toolpath IR says where each feed move should be, in
 its face's setup frame: taken to the workpiece through the setup's
 workpiece_setup placement. The two are compared move by move (feed moves;
-arcs by their ends and centres) within 0.001 mm, and the tool's direction
+arcs by their ends, centres and the points halfway along them, which tells
+the way round) within 0.001 mm, and the tool's direction
 within 0.001 deg of the face's normal. Every turn of the rotary axes must
 happen with the tool at the top of the machine's z travel.
 
@@ -40,7 +42,7 @@ spec.loader.exec_module(check_rs274)
 TOL_MM = 1e-3
 TOL_DEG = 1e-3
 AXIS_DIRECTIONS = {"a": (1.0, 0.0, 0.0), "b": (0.0, 1.0, 0.0), "c": (0.0, 0.0, 1.0)}
-CANON_RE = re.compile(r"(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED|SET_G5X_OFFSET)\(([^)]*)\)")
+CANON_RE = re.compile(r"(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED|SET_G5X_OFFSET|SELECT_PLANE)\(([^)]*)\)")
 SETUP_RE = re.compile(r"^\s*setup (%\S+)")
 WPS_RE = re.compile(r"^\s*workpiece_setup .*at=\(([^)]*)\)mm axis=\(([^)]*)\) ref=\(([^)]*)\)")
 MOVES_RE = re.compile(r"^\s*moves .*setup=(%\S+)")
@@ -64,30 +66,53 @@ def add(a, b):
     return tuple(x + y for x, y in zip(a, b))
 
 
-class Table:
-    """The table axes of a table-table machine file, outermost first."""
+class Chain:
+    """The rotary axes of a table-table or head-table machine file: the
+    head's (turning the tool about a pivot measured from its tip) and the
+    table's (turning the workpiece about pivots in machine coordinates),
+    each list from the machine's base outwards."""
 
     def __init__(self, path):
         with open(path, "rb") as f:
             data = tomllib.load(f)
         kin = data["kinematics"]
-        if kin.get("type") != "table-table":
-            raise SystemExit("check-indexed: %s is not a table-table machine" % path)
-        self.axes = []
-        for name in kin["table"]:
-            spec_ = data["axes"][name]
-            self.axes.append((name, AXIS_DIRECTIONS[name], tuple(spec_.get("pivot", (0.0, 0.0, 0.0)))))
+        if kin.get("type") not in ("table-table", "head-table"):
+            raise SystemExit("check-indexed: %s is neither a table-table nor a head-table machine" % path)
+
+        def axes(names):
+            return [(n, AXIS_DIRECTIONS[n], tuple(data["axes"][n].get("pivot", (0.0, 0.0, 0.0)))) for n in names]
+        self.head = axes(kin.get("head", []))
+        self.table = axes(kin.get("table", []))
+        self.tool = tuple(kin.get("tool_axis", (0.0, 0.0, 1.0)))
         self.z_top = data["axes"]["z"]["travel"][1]
 
-    def to_workpiece(self, machine_tip, angles, work_offset):
-        """The tool tip and direction in workpiece coordinates for a tip in
-        machine coordinates and the table's angles: its turns undone,
-        outermost first."""
-        tip, k = machine_tip, (0.0, 0.0, 1.0)
-        for name, direction, pivot in self.axes:
+    def to_workpiece(self, joints_xyz, angles, work_offset):
+        """The tool tip and direction in workpiece coordinates for the
+        linear axes' positions (machine coordinates) and the rotary angles:
+        the head turns the tip's offset and the tool (innermost first), then
+        the table's turns are undone (outermost first)."""
+        offset, k = (0.0, 0.0, 0.0), self.tool
+        for name, direction, pivot in reversed(self.head):
+            offset = add(pivot, rotate(sub(offset, pivot), direction, angles[name]))
+            k = rotate(k, direction, angles[name])
+        tip = add(joints_xyz, offset)
+        for name, direction, pivot in self.table:
             tip = add(pivot, rotate(sub(tip, pivot), direction, -angles[name]))
             k = rotate(k, direction, -angles[name])
         return sub(tip, work_offset), k
+
+
+def arc_middle(start, end, centre, ccw, sweep, plane):
+    """The point halfway along an arc (plane coordinates in, world out): its
+    start turned half its sweep about the centre, the normal coordinate
+    halfway (a helix)."""
+    s, e = toolpath_ir.local(start, plane), toolpath_ir.local(end, plane)
+    cx, cy = centre
+    half = (sweep / 2) * (1 if ccw else -1)
+    dx, dy = s[0] - cx, s[1] - cy
+    x = cx + dx * math.cos(half) - dy * math.sin(half)
+    y = cy + dx * math.sin(half) + dy * math.cos(half)
+    return toolpath_ir.world((x, y, (s[2] + e[2]) / 2), plane)
 
 
 def read_setups(ir_path):
@@ -135,6 +160,7 @@ def ir_feed_moves(ir_path, setups):
             if mv["plane"] != "xy":
                 raise SystemExit("check-indexed: an arc outside the XY plane (IR line %d)" % mv["line"])
             entry["centre"] = back((mv["centre"][0], mv["centre"][1], mv["start"][2]))
+            entry["middle"] = back(arc_middle(mv["start"], mv["to"], mv["centre"], mv["ccw"], mv["sweep"], "xy"))
         out.append(entry)
     return out
 
@@ -146,18 +172,28 @@ def canon_feed_moves(canon_path, table, work_offset):
     offset = (0.0, 0.0, 0.0)
     angles = {"a": 0.0, "b": 0.0, "c": 0.0}
     z = None
+    plane = "xy"
+    at = (0.0, 0.0, 0.0)  # where the tool is, program coordinates
     with open(canon_path) as f:
         for n, line in enumerate(f, 1):
             m = CANON_RE.search(line)
             if not m:
                 continue
+            if m.group(1) == "SELECT_PLANE":
+                plane = check_rs274.CANON_PLANES[m.group(2).strip()]
+                continue
             args = [float(a) for a in m.group(2).split(",")]
             if m.group(1) == "SET_G5X_OFFSET":
                 offset = tuple(args[1:4])
                 continue
+            middle = None
             if m.group(1) == "ARC_FEED":
-                e1, e2, c1, c2, _turn, e3, a, b, c = args[:9]
-                to, centre = (e1, e2, e3), (c1, c2, e3)
+                # The plane's first and second axes, then its normal.
+                e1, e2, c1, c2, turn, e3, a, b, c = args[:9]
+                to, centre = toolpath_ir.world((e1, e2, e3), plane), toolpath_ir.world((c1, c2, e3), plane)
+                sweep = toolpath_ir.arc_sweep(toolpath_ir.local(at, plane), (e1, e2), (c1, c2), turn > 0) + \
+                    2 * math.pi * (abs(int(turn)) - 1)
+                middle = arc_middle(at, to, (c1, c2), turn > 0, sweep, plane)
             else:
                 to, centre = tuple(args[:3]), None
                 a, b, c = args[3:6]
@@ -169,12 +205,14 @@ def canon_feed_moves(canon_path, table, work_offset):
                                     "of its travel %g: %s" % (n, z, table.z_top, line.strip()))
                 angles = new
             z = add(to, offset)[2]
+            at = to
             if m.group(1) == "STRAIGHT_TRAVERSE":
                 continue
             tip, k = table.to_workpiece(add(to, offset), angles, work_offset)
             entry = {"to": tip, "axis": k, "text": "canon line %d: %s" % (n, line.strip())}
             if centre:
                 entry["centre"] = table.to_workpiece(add(centre, offset), angles, work_offset)[0]
+                entry["middle"] = table.to_workpiece(add(middle, offset), angles, work_offset)[0]
             out.append(entry)
     return out, problems
 
@@ -183,11 +221,11 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--program", required=True)
     ap.add_argument("--ir", required=True)
-    ap.add_argument("--machine", required=True, help="the machine's TOML file")
+    ap.add_argument("--machine", required=True, help="the machine's TOML file (table-table or head-table)")
     ap.add_argument("--work-offset", required=True)
     args = ap.parse_args()
     work_offset = tuple(float(v) for v in args.work_offset.split(","))
-    table = Table(args.machine)
+    table = Chain(args.machine)
     with tempfile.TemporaryDirectory() as work:
         with open(os.path.join(work, "vars.var"), "w") as f:
             f.write("5220 1\n")
@@ -205,7 +243,8 @@ def main():
     for w, g in zip(want, made):
         d = math.dist(w["to"], g["to"])
         if "centre" in w:
-            d = max(d, math.dist(w["centre"], g.get("centre", (math.inf,) * 3)))
+            d = max(d, math.dist(w["centre"], g.get("centre", (math.inf,) * 3)),
+                    math.dist(w["middle"], g.get("middle", (math.inf,) * 3)))
         cosang = max(-1.0, min(1.0, sum(x * y for x, y in zip(w["normal"], g["axis"]))))
         deg = math.degrees(math.acos(cosang))
         worst_mm, worst_deg = max(worst_mm, d), max(worst_deg, deg)
@@ -217,7 +256,7 @@ def main():
         for p in problems[:5]:
             print("FAIL: " + p)
         return 1
-    print("ok: %d feed moves on %d faces match through the table's kinematics (largest %.4f mm, %.4f deg)" %
+    print("ok: %d feed moves on %d faces match through the machine's kinematics (largest %.4f mm, %.4f deg)" %
           (len(want), len({w["normal"] for w in want}), worst_mm, worst_deg))
     return 0
 

@@ -461,9 +461,10 @@ void registerCompile(CLI::App &app, std::function<void(int)> setResult) {
   cmd->add_option("--machine", opts->machines,
                   "Machine to plan the motion on, for --target=native and --emit=motion-ir: a TOML\n"
                   "file (docs/machine-model.md) or a shipped machine (hsc-3axis, conventional-3axis,\n"
-                  "table-table-5axis, lathe-2axis: a lathe program planned in its ZX plane);\n"
-                  "feed adaptation also keeps feeds within its dynamics and spindle; a deposition\n"
-                  "program writes its [deposition] codes. Given more than once (a multi-process\n"
+                  "table-table-5axis, head-table-5axis, lathe-2axis: a lathe program planned in its ZX\n"
+                  "plane); feed adaptation also keeps feeds within its dynamics and spindle; a deposition\n"
+                  "program writes its [deposition] codes; with --work-offset a 5-axis machine turns each\n"
+                  "face to the tool (docs/five-axis.md). Given more than once (a multi-process\n"
                   "workplan), each setup or workingstep runs on the first that does its process and\n"
                   "a program is written per phase (docs/additive.md)")
       ->allow_extra_args(false);
