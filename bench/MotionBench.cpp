@@ -4,12 +4,19 @@
 //    tangent arcs and sharper corners mixed in), in moves per second;
 //  - BM_Simulate: the reference player sampling a trajectory of about one
 //    hour at 1 kHz, with every check on; the time per run is the time to
-//    simulate that hour.
+//    simulate that hour;
+//  - BM_Inverse: the inverse kinematics of the shipped 5-axis machines
+//    (table-table, head-table) on 100,000 poses along a 5-axis path (the
+//    tool tilting and turning smoothly), each from the joints before: what
+//    writing and planning 5-axis moves costs per move in joint solving.
 #include "bench/DensePath.h"
+#include "runtime/Kinematics.h"
 #include "runtime/Planner.h"
 #include "runtime/Player.h"
 
 #include <benchmark/benchmark.h>
+
+#include <cmath>
 
 using namespace stepnc;
 using namespace stepnc::runtime;
@@ -17,12 +24,14 @@ using stepnc::bench::densePath;
 
 namespace {
 
-Machine hsc() {
+Machine shipped(const std::string &name) {
   std::unique_ptr<SourceFile> file;
   DiagnosticCollector collector;
   DiagnosticEngine diags(collector);
-  return *loadMachine("hsc-3axis", file, diags);
+  return *loadMachine(name, file, diags);
 }
+
+Machine hsc() { return shipped("hsc-3axis"); }
 
 void BM_Plan(benchmark::State &state) {
   const Machine m = hsc();
@@ -54,6 +63,57 @@ void BM_Simulate(benchmark::State &state) {
   state.SetItemsProcessed(state.iterations() * int64_t(r.samples));
 }
 BENCHMARK(BM_Simulate)->Unit(benchmark::kMillisecond);
+
+/// Poses along a 5-axis path over a 100 x 80 mm field, the tool leaning up
+/// to 60 deg from +z and turning round it (a swarf-like sweep), about a
+/// point `centre` of the workpiece.
+std::vector<ToolPose> fiveAxisPoses(int count, const Eigen::Vector3d &centre) {
+  std::vector<ToolPose> poses;
+  poses.reserve(size_t(count));
+  for (int i = 0; i < count; ++i) {
+    const double t = double(i) / count;
+    const double lean = (10 + 50 * (0.5 + 0.5 * std::sin(6.283185307179586 * 7 * t))) * 0.017453292519943295;
+    const double turn = 6.283185307179586 * 3 * t;
+    ToolPose p;
+    p.tipMm = centre + Eigen::Vector3d(50 * std::sin(6.283185307179586 * 5 * t), 40 * std::cos(6.283185307179586 * 4 * t),
+                                       -10 * t);
+    p.axis = Eigen::Vector3d(std::sin(lean) * std::cos(turn), std::sin(lean) * std::sin(turn), std::cos(lean));
+    poses.push_back(p);
+  }
+  return poses;
+}
+
+void inverseBench(benchmark::State &state, const std::string &machine, const Eigen::Vector3d &centre) {
+  const Machine m = shipped(machine);
+  std::string error;
+  const std::unique_ptr<Kinematics> k = makeKinematics(m, error);
+  const std::vector<ToolPose> poses = fiveAxisPoses(int(state.range(0)), centre);
+  size_t solved = 0;
+  for (auto _ : state) {
+    Joints near = Joints::Zero(Eigen::Index(k->jointCount()));
+    solved = 0;
+    for (const ToolPose &p : poses) {
+      const InverseResult r = k->inverse(p, &near);
+      if (r.joints) {
+        near = *r.joints;
+        ++solved;
+      }
+    }
+    benchmark::DoNotOptimize(near);
+  }
+  state.SetItemsProcessed(state.iterations() * int64_t(poses.size()));
+  state.counters["solved"] = double(solved);
+}
+
+void BM_InverseTableTable(benchmark::State &state) {
+  inverseBench(state, "table-table-5axis", Eigen::Vector3d(250, 225, -200));
+}
+BENCHMARK(BM_InverseTableTable)->Arg(100000)->Unit(benchmark::kMillisecond);
+
+void BM_InverseHeadTable(benchmark::State &state) {
+  inverseBench(state, "head-table-5axis", Eigen::Vector3d(300, 250, -250));
+}
+BENCHMARK(BM_InverseHeadTable)->Arg(100000)->Unit(benchmark::kMillisecond);
 
 } // namespace
 
