@@ -256,10 +256,10 @@ int compileSource(const CompileOptions &opts, const std::string &emit, std::uniq
   // Several machines: feeds are bounded by the first that mills.
   if (opts.machines.size() > 1)
     for (const std::string &name : opts.machines) {
-      std::unique_ptr<SourceFile> file;
+      std::unique_ptr<SourceFile> machineFile;
       DiagnosticCollector quiet;
       DiagnosticEngine quietDiags(quiet);
-      if (auto m = runtime::loadMachine(name, file, quietDiags);
+      if (auto m = runtime::loadMachine(name, machineFile, quietDiags);
           m && std::find(m->processes.begin(), m->processes.end(), "milling") != m->processes.end()) {
         toolpath.machine = name;
         break;

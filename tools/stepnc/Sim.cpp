@@ -113,8 +113,7 @@ std::unique_ptr<ir::Module> loadProgram(const SimCommandOptions &opts, std::uniq
 /// for), the powder or wire fed meanwhile, and the beads laid (their length,
 /// and as strips of the bead pitch by the layer thickness their volume, and
 /// mass where the technology gives the density). Empty without deposition.
-std::string depositionReport(const ir::Module &module, const ir::ProgramPath &program,
-                             const runtime::Trajectory &trajectory) {
+std::string depositionReport(const ir::ProgramPath &program, const runtime::Trajectory &trajectory) {
   // Per move of the program: its step's technology when the energy is on.
   std::vector<const ir::Node *> onWith(program.owners.size(), nullptr);
   std::vector<bool> deposits(program.owners.size(), false);
@@ -250,8 +249,8 @@ int runLatheSim(const SimCommandOptions &opts, const runtime::Machine &machine, 
     return kExitDiagnostics;
   }
   const ir::LatheTimeReport report = ir::timeLatheProgram(*module, machine);
-  if (const int rc = writeText(opts.output, ir::formatLatheReport(report, machine)); rc != kExitOk)
-    return rc;
+  if (const int written = writeText(opts.output, ir::formatLatheReport(report, machine)); written != kExitOk)
+    return written;
   return report.violations.empty() ? kExitOk : kExitDiagnostics;
 }
 
@@ -359,7 +358,7 @@ int runSim(const SimCommandOptions &opts) {
   };
   std::string text = runtime::formatReport(report, *trajectory, *machine, nameMove);
   if (module && program)
-    text += depositionReport(*module, *program, *trajectory);
+    text += depositionReport(*program, *trajectory);
   if (!opts.samples.empty() && !samplesOut.commit(error)) {
     printToolError(error);
     return kExitUsage;
