@@ -481,8 +481,9 @@ void registerCompile(CLI::App &app, std::function<void(int)> setResult) {
                 "refusing them (check-limits, docs/diagnostics.md)");
   cmd->add_option("--work-offset", opts->workOffset,
                   "Where the workpiece's origin is on --machine: X,Y,Z in mm, machine coordinates with every\n"
-                  "axis at 0. A machine with a rotary table then turns each face of a part with features on\n"
-                  "several faces to the tool (3+2) instead of stopping to re-clamp (docs/five-axis.md)");
+                  "axis at 0. A 5-axis machine (table-table, head-table) then turns each face of a part with\n"
+                  "features on several faces to the tool (3+2) instead of stopping to re-clamp\n"
+                  "(docs/five-axis.md)");
   cmd->add_flag("--allow-feed-increase", opts->allowFeedIncrease,
                 "Let feed adaptation raise feeds above the programmed ones where the cut allows");
   cmd->add_option("--tool-table", opts->toolTable,
