@@ -127,24 +127,31 @@ bool indexClampings(Program &p, const ir::Module &, const runtime::Machine &mach
   std::optional<runtime::Joints> turned;  // the rotary axes' positions in force
   bool ok = true, first = true;
   std::vector<std::string> faces;
-  for (Step &s : steps) {
-    if (s.kind != Step::Kind::Moves || (s.moves.empty() && !s.cycle))
-      continue;
+  size_t clampingListed = 0;  // where the clamping in force starts in `faces`
+  // One step turned to the tool with the workpiece clamped as `base`
+  // places it; false (with why) when the machine cannot.
+  auto turnStep = [&](Step &s, const Placement &base, const std::string &baseFace,
+                      std::optional<Problem> &failure) -> bool {
     const Placement place = placementOf(s.setup);
-    const Vec3 tool = place.turn.transpose() * Vec3::UnitZ();  // towards the spindle, in workpiece coordinates
+    // The face's normal as the clamping holds the workpiece, and the name
+    // of the face in the workpiece.
+    const Vec3 tool = base.turn * (place.turn.transpose() * Vec3::UnitZ());
+    const std::string face = faceName(place.turn.transpose() * Vec3::UnitZ());
+    bool good = true;
     auto where = [&](const std::string &why) {
-      if (!problem)
-        problem = Problem{s.exec, why};
-      ok = false;
+      if (!failure)
+        failure = Problem{s.exec, why};
+      good = false;
     };
     // The joints that put the tool tip at q (in the step's frame) with the
     // tool along the face's normal; the program's point is their x, y, z
     // less the work offset.
     auto toProgram = [&](const Vec3 &q) -> std::optional<Vec3> {
       const Vec3 pw = place.turn.transpose() * (q - place.at);
-      const runtime::InverseResult r = kinematics->inverse({pw + workOffset, tool}, &near);
+      const Vec3 clamped = base.at + base.turn * pw;
+      const runtime::InverseResult r = kinematics->inverse({clamped + workOffset, tool}, &near);
       if (!r.joints) {
-        where("the machine cannot turn face " + faceName(tool) + " to the tool: " + r.why);
+        where("the machine cannot turn face " + face + " to the tool: " + r.why);
         return std::nullopt;
       }
       if (r.outsideTravel) {
@@ -154,7 +161,8 @@ bool indexClampings(Program &p, const ir::Module &, const runtime::Machine &mach
           if (v < machine.axes[k].travelMin - 1e-9 || v > machine.axes[k].travelMax + 1e-9)
             axes += (axes.empty() ? "" : ", ") + upper(machine.axes[k].name) + formatShortest(v);
         }
-        where("face " + faceName(tool) + " turned to the tool puts the point " +
+        where("face " + face + " turned to the tool" + (baseFace == "+Z" ? "" : " (" + baseFace + " up)") +
+              " puts the point " +
               formatTuple({pw.x(), pw.y(), pw.z()}, 4) + " of the workpiece outside the machine's travel (" + axes +
               ") with the workpiece's origin at " + formatTuple({workOffset.x(), workOffset.y(), workOffset.z()}, 3));
         return std::nullopt;
@@ -165,7 +173,7 @@ bool indexClampings(Program &p, const ir::Module &, const runtime::Machine &mach
     const Vec3 probe = s.moves.empty() ? Vec3(s.cycle->at.x(), s.cycle->at.y(), s.cycle->surfaceZ) : s.moves.front().to;
     const std::optional<Vec3> probed = toProgram(probe);
     if (!probed)
-      continue;
+      return false;
     // Heights along the tool shift by one amount for the whole face (the
     // turn holds the tool along z): what the cycles and planes need.
     const double dz = probed->z() - probe.z();
@@ -175,14 +183,15 @@ bool indexClampings(Program &p, const ir::Module &, const runtime::Machine &mach
     if (changed || first) {
       Index index;
       index.retractZ = retractZ;
-      index.face = faceName(tool);
-      std::string text = "face " + index.face + ":";
+      index.face = face;
+      std::string text = "face " + face + (baseFace == "+Z" ? "" : " (clamped " + baseFace + " up)") + ":";
       for (size_t k : rotary) {
         index.axes.emplace_back(upper(machine.axes[k].name), near[static_cast<Eigen::Index>(k)]);
         text += " " + upper(machine.axes[k].name) + formatShortest(near[static_cast<Eigen::Index>(k)]);
       }
       s.index = std::move(index);
-      if (std::find(faces.begin(), faces.end(), text) == faces.end())
+      // Listed once per clamping.
+      if (std::find(faces.begin() + static_cast<long>(clampingListed), faces.end(), text) == faces.end())
         faces.push_back(text);
       turned = near;
     }
@@ -192,7 +201,7 @@ bool indexClampings(Program &p, const ir::Module &, const runtime::Machine &mach
     // and a shift: where it takes the face's axes.
     const std::optional<Vec3> origin = toProgram(probe), alongZ = toProgram(probe + Vec3::UnitZ());
     if (!origin || !alongZ)
-      continue;
+      return false;
     const Vec3 toolAxis = (*alongZ - *origin).normalized();  // the tool, in the program's frame
     const bool upright = (toolAxis - Vec3::UnitZ()).norm() < 1e-9;
     auto direction = [&](const Vec3 &q, const Vec3 &v) -> std::optional<Vec3> {
@@ -247,7 +256,7 @@ bool indexClampings(Program &p, const ir::Module &, const runtime::Machine &mach
         // turns are quarter turns for the faces lowering makes); an arc in
         // another plane, or in ZX or YZ for a target without them, is not
         // written yet.
-        where("an arc on face " + faceName(tool) + " turned to the tool lies in no plane " +
+        where("an arc on face " + face + " turned to the tool lies in no plane " +
               (arcPlanes ? std::string("the target writes (XY, ZX, YZ)") : std::string("but XY")));
         break;
       }
@@ -269,7 +278,75 @@ bool indexClampings(Program &p, const ir::Module &, const runtime::Machine &mach
       }
     }
     s.secplane += dz;
+    return good;
+  };
+
+  // Each step under the clamping in force; a face the machine cannot turn
+  // to the tool so is re-clamped face up (its own setup: the tool along z),
+  // the operator stopped with the table back at 0, and the faces after it
+  // turned from that clamping while they can be.
+  Placement base;
+  std::string baseFace = "+Z";
+  int reclamps = 0;
+  std::vector<Step> out;
+  for (Step &s : steps) {
+    if (s.kind != Step::Kind::Moves || (s.moves.empty() && !s.cycle)) {
+      out.push_back(std::move(s));
+      continue;
+    }
+    Step attempt = s;
+    const runtime::Joints nearBefore = near;
+    std::optional<Problem> failure;
+    if (turnStep(attempt, base, baseFace, failure)) {
+      out.push_back(std::move(attempt));
+      continue;
+    }
+    // Re-clamped with this face up, the table back at 0 for the operator.
+    near = nearBefore;
+    for (size_t k : rotary)
+      near[static_cast<Eigen::Index>(k)] = 0;
+    turned.reset();  // the step states the turn again after the stop
+    const Placement own = placementOf(s.setup);
+    const std::string face = faceName(own.turn.transpose() * Vec3::UnitZ());
+    attempt = s;
+    std::optional<Problem> again;
+    const size_t listed = faces.size();
+    clampingListed = listed;
+    if (face == baseFace || !turnStep(attempt, own, face, again)) {
+      problem = failure ? failure : again;
+      ok = false;
+      break;
+    }
+    ++reclamps;
+    Step message;
+    message.kind = Step::Kind::Message;
+    message.exec = s.exec;
+    std::string instruction = s.setup ? s.setup->text("instruction").value_or("") : "";
+    if (const size_t colon = instruction.find(": "); instruction.starts_with("work offset") && colon != std::string::npos)
+      instruction = instruction.substr(colon + 2);
+    if (const size_t corner = instruction.find("; the raw block's lowest corner"); corner != std::string::npos)
+      instruction = instruction.substr(0, corner);
+    message.label = (instruction.empty() ? "re-clamp the workpiece with its " + face + " face up" : instruction) +
+                    "; the raw block's lowest corner where it was (G54 unchanged)";
+    Step stop;
+    stop.kind = Step::Kind::Stop;
+    stop.exec = s.exec;
+    stop.reclamp = true;
+    // The table back at 0 for the operator.
+    Index home;
+    home.retractZ = retractZ;
+    home.face = "load";
+    for (size_t k : rotary)
+      home.axes.emplace_back(upper(machine.axes[k].name), 0.0);
+    stop.index = std::move(home);
+    faces.insert(faces.begin() + static_cast<long>(listed), "re-clamped with its " + face + " face up:");
+    out.push_back(std::move(message));
+    out.push_back(std::move(stop));
+    out.push_back(std::move(attempt));
+    base = own;
+    baseFace = face;
   }
+  steps = std::move(out);
   if (!ok) {
     const std::string what = "the machine's rotary axes do not turn every face to the tool (" +
                              (problem->exec ? "workingstep " + problem->exec->symbol + ": " : std::string()) +
@@ -282,11 +359,14 @@ bool indexClampings(Program &p, const ir::Module &, const runtime::Machine &mach
   }
   p.steps = std::move(steps);
   p.clampings.clear();
-  p.indexing.push_back("the program turns the rotary axes to bring each face to the tool (3+2), one work offset "
-                       "for all: the workpiece's origin at X" +
-                       formatShortest(workOffset.x()) + " Y" + formatShortest(workOffset.y()) + " Z" +
-                       formatShortest(workOffset.z()) + " in machine coordinates with every axis at 0; before each "
-                       "turn the tool goes up to Z" + formatShortest(retractZ) + " (G53)");
+  p.indexing.push_back("the program turns the rotary axes to bring each face to the tool (3+2)" +
+                       (reclamps > 0 ? ", re-clamping " + std::to_string(reclamps) +
+                                           (reclamps == 1 ? " time" : " times") + " for faces it cannot turn there"
+                                     : std::string()));
+  p.indexing.push_back("one work offset for all: the workpiece's origin at X" + formatShortest(workOffset.x()) + " Y" +
+                       formatShortest(workOffset.y()) + " Z" + formatShortest(workOffset.z()) +
+                       " in machine coordinates with every axis at 0; before each turn the tool goes up to Z" +
+                       formatShortest(retractZ) + " (G53)");
   for (const std::string &f : faces)
     p.indexing.push_back(f);
   return true;

@@ -39,6 +39,17 @@ std::vector<std::string> headerLines(const Program &p, const EmitOptions &o, con
   return lines;
 }
 
+void IsoEmitter::turn(const Index &index) {
+  // The tool up out of the way (machine coordinates), then the turn.
+  out_.block("G53 G0 Z" + num(index.retractZ));
+  std::string words = "G0";
+  for (const auto &[axis, deg] : index.axes)
+    words += " " + axis + num(deg);
+  out_.block(words);
+  for (const char *w : {"G", "X", "Y", "Z"})
+    modal_.forget(w);
+}
+
 std::optional<std::string> IsoEmitter::run(const Program &p) {
   program_ = &p;
   header(p);
@@ -50,6 +61,8 @@ std::optional<std::string> IsoEmitter::run(const Program &p) {
       continue;
     case Step::Kind::Stop:
     case Step::Kind::OptionalStop:
+      if (s.index)
+        turn(*s.index);
       if (s.reclamp)
         beforeReclamp();
       stop(s.kind == Step::Kind::OptionalStop);
@@ -58,16 +71,8 @@ std::optional<std::string> IsoEmitter::run(const Program &p) {
       break;
     }
     out_.block(comment(s.label));
-    if (s.index) {
-      // The tool up out of the way (machine coordinates), then the turn.
-      out_.block("G53 G0 Z" + num(s.index->retractZ));
-      std::string turn = "G0";
-      for (const auto &[axis, deg] : s.index->axes)
-        turn += " " + axis + num(deg);
-      out_.block(turn);
-      for (const char *w : {"G", "X", "Y", "Z"})
-        modal_.forget(w);
-    }
+    if (s.index)
+      turn(*s.index);
     if (s.workOffset > 0) {
       const std::string offset = workOffsetWord(s.workOffset);
       if (offset.empty())

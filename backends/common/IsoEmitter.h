@@ -88,6 +88,9 @@ protected:
 
 private:
   void arc(const Move &m);
+  /// 3+2: the tool up to the top of z in machine coordinates, then the
+  /// rotary axes to the face's angles (Step::index).
+  void turn(const Index &index);
   /// The head's state changes of step `s` with the machine's codes
   /// (EmitOptions::deposition); errors when there are none, or a value is
   /// beyond what the head gives.

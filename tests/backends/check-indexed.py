@@ -16,7 +16,9 @@ workpiece_setup placement. The two are compared move by move (feed moves;
 arcs by their ends, centres and the points halfway along them, which tells
 the way round) within 0.001 mm, and the tool's direction
 within 0.001 deg of the face's normal. Every turn of the rotary axes must
-happen with the tool at the top of the machine's z travel.
+happen with the tool at the top of the machine's z travel. Where the
+program stops for a re-clamp (its message names the face put up), the
+workpiece is taken as that face's setup places it from there on.
 
   check-indexed.py --program P --ir I --machine M.toml --work-offset X,Y,Z
 
@@ -43,7 +45,9 @@ TOL_MM = 1e-3
 TOL_DEG = 1e-3
 AXIS_DIRECTIONS = {"a": (1.0, 0.0, 0.0), "b": (0.0, 1.0, 0.0), "c": (0.0, 0.0, 1.0)}
 CANON_RE = re.compile(r"(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED|SET_G5X_OFFSET|SELECT_PLANE)\(([^)]*)\)")
-SETUP_RE = re.compile(r"^\s*setup (%\S+)")
+MESSAGE_RE = re.compile(r'MESSAGE\("(.*)"\)')
+RECLAMP_RE = re.compile(r"re-clamp the workpiece with its ([+-][XYZ]) face up")
+SETUP_RE = re.compile(r"^\s*setup (%\S+)(?:.*face_up=([+-][xyz]))?")
 WPS_RE = re.compile(r"^\s*workpiece_setup .*at=\(([^)]*)\)mm axis=\(([^)]*)\) ref=\(([^)]*)\)")
 MOVES_RE = re.compile(r"^\s*moves .*setup=(%\S+)")
 
@@ -115,21 +119,41 @@ def arc_middle(start, end, centre, ccw, sweep, plane):
     return toolpath_ir.world((x, y, (s[2] + e[2]) / 2), plane)
 
 
+IDENTITY = ((0.0, 0.0, 0.0), (0.0, 0.0, 1.0), (1.0, 0.0, 0.0))
+
+
 def read_setups(ir_path):
-    """Each setup's placement of the workpiece: (at, z axis, x axis)."""
-    setups, current = {}, None
+    """Each setup's placement of the workpiece, (at, z axis, x axis), and
+    the placement of each face's setup by the face ("+X"; "+Z": as first
+    clamped)."""
+    setups, faces, current = {}, {"+Z": IDENTITY}, None
     with open(ir_path) as f:
         for line in f:
             m = SETUP_RE.match(line)
             if m:
-                current = m.group(1)
+                current = (m.group(1), m.group(2))
                 continue
             m = WPS_RE.match(line)
             if m and current:
                 vec = [tuple(float(v) for v in g.split(",")) for g in m.groups()]
-                setups[current] = vec
+                setups[current[0]] = vec
+                if current[1]:
+                    faces[current[1].upper()] = vec
                 current = None
-    return setups
+    return setups, faces
+
+
+def placed_back(placement, q):
+    """The workpiece point a setup's placement puts at q."""
+    at, zax, xax = placement
+    yax = (zax[1] * xax[2] - zax[2] * xax[1], zax[2] * xax[0] - zax[0] * xax[2], zax[0] * xax[1] - zax[1] * xax[0])
+    d = sub(q, at)
+    return tuple(sum(d[k] * ax[k] for k in range(3)) for ax in (xax, yax, zax))
+
+
+def turned_back(placement, v):
+    """A direction in the setup's frame taken back to the workpiece."""
+    return placed_back((( 0.0, 0.0, 0.0), placement[1], placement[2]), v)
 
 
 def ir_feed_moves(ir_path, setups):
@@ -165,10 +189,16 @@ def ir_feed_moves(ir_path, setups):
     return out
 
 
-def canon_feed_moves(canon_path, table, work_offset):
+def canon_feed_moves(canon_path, table, work_offset, faces):
     """The canonical feed moves in workpiece coordinates, with the tool's
-    direction; and the problems of turns made below the top of z."""
+    direction; and the problems of turns made below the top of z. A
+    re-clamp message (`re-clamp the workpiece with its -Z face up`) places
+    the workpiece as that face's setup does from there on."""
     out, problems = [], []
+    clamping = IDENTITY
+
+    def back(tip, k):
+        return placed_back(clamping, tip), turned_back(clamping, k)
     offset = (0.0, 0.0, 0.0)
     angles = {"a": 0.0, "b": 0.0, "c": 0.0}
     z = None
@@ -176,6 +206,14 @@ def canon_feed_moves(canon_path, table, work_offset):
     at = (0.0, 0.0, 0.0)  # where the tool is, program coordinates
     with open(canon_path) as f:
         for n, line in enumerate(f, 1):
+            msg = MESSAGE_RE.search(line)
+            if msg and RECLAMP_RE.search(msg.group(1)):
+                face = RECLAMP_RE.search(msg.group(1)).group(1)
+                if face not in faces:
+                    problems.append("canon line %d: a re-clamp with face %s up, which no setup has" % (n, face))
+                else:
+                    clamping = faces[face]
+                continue
             m = CANON_RE.search(line)
             if not m:
                 continue
@@ -208,11 +246,11 @@ def canon_feed_moves(canon_path, table, work_offset):
             at = to
             if m.group(1) == "STRAIGHT_TRAVERSE":
                 continue
-            tip, k = table.to_workpiece(add(to, offset), angles, work_offset)
+            tip, k = back(*table.to_workpiece(add(to, offset), angles, work_offset))
             entry = {"to": tip, "axis": k, "text": "canon line %d: %s" % (n, line.strip())}
             if centre:
-                entry["centre"] = table.to_workpiece(add(centre, offset), angles, work_offset)[0]
-                entry["middle"] = table.to_workpiece(add(middle, offset), angles, work_offset)[0]
+                entry["centre"] = back(*table.to_workpiece(add(centre, offset), angles, work_offset))[0]
+                entry["middle"] = back(*table.to_workpiece(add(middle, offset), angles, work_offset))[0]
             out.append(entry)
     return out, problems
 
@@ -235,8 +273,9 @@ def main():
         if not canon:
             print("FAIL: " + why)
             return 1
-        made, problems = canon_feed_moves(canon, table, work_offset)
-    want = ir_feed_moves(args.ir, read_setups(args.ir))
+        setups, faces = read_setups(args.ir)
+        made, problems = canon_feed_moves(canon, table, work_offset, faces)
+    want = ir_feed_moves(args.ir, setups)
     if len(made) != len(want):
         problems.append("%d feed moves in the program, %d in the IR" % (len(made), len(want)))
     worst_mm, worst_deg = 0.0, 0.0
