@@ -70,13 +70,14 @@ public:
 
 private:
   /// A program that re-clamps for features on other faces, for a machine
-  /// with a rotary table (table-table, head-table): the rotary axes turn each face to the tool
+  /// with two rotary axes (table-table, head-table, head-head): they turn each face to the tool
   /// (Indexing.h) where the target writes it, with the workpiece's place on
   /// the table given; elsewhere the re-clamps stay, and a warning says why.
   bool index(Program &program, const ir::Module &module, const EmitOptions &options, DiagnosticEngine &diags) const {
     if (program.clampings.empty() || !options.machine ||
         (options.machine->kinematics.chain != runtime::Chain::TableTable &&
-         options.machine->kinematics.chain != runtime::Chain::HeadTable))
+         options.machine->kinematics.chain != runtime::Chain::HeadTable &&
+         options.machine->kinematics.chain != runtime::Chain::HeadHead))
       return true;
     if (!descriptor().rotaryIndexing) {
       diags.warning(SourceLoc{}, descriptor().name + " does not turn the rotary axes to each face yet (rs274 does): "

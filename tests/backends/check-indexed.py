@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Checks a 3+2 (indexed) rs274 program on a table-table or head-table machine.
+"""Checks a 3+2 (indexed) rs274 program on a 5-axis machine (table-table,
+head-table, head-head).
 
 A part with features on several faces, compiled for a machine whose rotary
 table turns each face to the tool (docs/five-axis.md), is run through
@@ -71,7 +72,7 @@ def add(a, b):
 
 
 class Chain:
-    """The rotary axes of a table-table or head-table machine file: the
+    """The rotary axes of a table-table, head-table or head-head machine file: the
     head's (turning the tool about a pivot measured from its tip) and the
     table's (turning the workpiece about pivots in machine coordinates),
     each list from the machine's base outwards."""
@@ -80,8 +81,8 @@ class Chain:
         with open(path, "rb") as f:
             data = tomllib.load(f)
         kin = data["kinematics"]
-        if kin.get("type") not in ("table-table", "head-table"):
-            raise SystemExit("check-indexed: %s is neither a table-table nor a head-table machine" % path)
+        if kin.get("type") not in ("table-table", "head-table", "head-head"):
+            raise SystemExit("check-indexed: %s is not a table-table, head-table or head-head machine" % path)
 
         def axes(names):
             return [(n, AXIS_DIRECTIONS[n], tuple(data["axes"][n].get("pivot", (0.0, 0.0, 0.0)))) for n in names]
@@ -259,7 +260,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--program", required=True)
     ap.add_argument("--ir", required=True)
-    ap.add_argument("--machine", required=True, help="the machine's TOML file (table-table or head-table)")
+    ap.add_argument("--machine", required=True, help="the machine's TOML file (table-table, head-table, head-head)")
     ap.add_argument("--work-offset", required=True)
     args = ap.parse_args()
     work_offset = tuple(float(v) for v in args.work_offset.split(","))

@@ -461,12 +461,12 @@ void registerCompile(CLI::App &app, std::function<void(int)> setResult) {
   cmd->add_option("--machine", opts->machines,
                   "Machine to plan the motion on, for --target=native and --emit=motion-ir: a TOML\n"
                   "file (docs/machine-model.md) or a shipped machine (hsc-3axis, conventional-3axis,\n"
-                  "table-table-5axis, head-table-5axis, lathe-2axis: a lathe program planned in its ZX\n"
-                  "plane); feed adaptation also keeps feeds within its dynamics and spindle; a deposition\n"
-                  "program writes its [deposition] codes; with --work-offset a 5-axis machine turns each\n"
-                  "face to the tool (docs/five-axis.md). Given more than once (a multi-process\n"
-                  "workplan), each setup or workingstep runs on the first that does its process and\n"
-                  "a program is written per phase (docs/additive.md)")
+                  "table-table-5axis, head-table-5axis, head-head-5axis, lathe-2axis: a lathe program\n"
+                  "planned in its ZX plane); feed adaptation also keeps feeds within its dynamics and\n"
+                  "spindle; a deposition program writes its [deposition] codes; with --work-offset a\n"
+                  "5-axis machine turns each face to the tool (docs/five-axis.md). Given more than once\n"
+                  "(a multi-process workplan), each setup or workingstep runs on the first that does its\n"
+                  "process and a program is written per phase (docs/additive.md)")
       ->allow_extra_args(false);
   cmd->add_flag("--no-adapt-feed", opts->noAdaptFeed,
                 "Keep the programmed feeds: leave out the adapt-feed pass (docs/feed-adaptation.md)");
@@ -481,9 +481,9 @@ void registerCompile(CLI::App &app, std::function<void(int)> setResult) {
                 "refusing them (check-limits, docs/diagnostics.md)");
   cmd->add_option("--work-offset", opts->workOffset,
                   "Where the workpiece's origin is on --machine: X,Y,Z in mm, machine coordinates with every\n"
-                  "axis at 0. A 5-axis machine (table-table, head-table) then turns each face of a part with\n"
-                  "features on several faces to the tool (3+2) instead of stopping to re-clamp\n"
-                  "(docs/five-axis.md)");
+                  "axis at 0. A 5-axis machine (table-table, head-table, head-head) then turns each face of a\n"
+                  "part with features on several faces to the tool (3+2) instead of stopping to\n"
+                  "re-clamp (docs/five-axis.md)");
   cmd->add_flag("--allow-feed-increase", opts->allowFeedIncrease,
                 "Let feed adaptation raise feeds above the programmed ones where the cut allows");
   cmd->add_option("--tool-table", opts->toolTable,
