@@ -174,8 +174,8 @@ bool indexClampings(Program &p, const ir::Module &, const runtime::Machine &mach
     const std::optional<Vec3> probed = toProgram(probe);
     if (!probed)
       return false;
-    // Heights along the tool shift by one amount for the whole face (the
-    // turn holds the tool along z): what the cycles and planes need.
+    // Heights along the tool shift by one amount for the whole face: what
+    // the security plane and (the tool along z) the cycles need.
     const double dz = probed->z() - probe.z();
     bool changed = !turned;
     for (size_t k : rotary)
@@ -296,11 +296,13 @@ bool indexClampings(Program &p, const ir::Module &, const runtime::Machine &mach
     }
     Step attempt = s;
     const runtime::Joints nearBefore = near;
+    const size_t listedBefore = faces.size();
     std::optional<Problem> failure;
     if (turnStep(attempt, base, baseFace, failure)) {
       out.push_back(std::move(attempt));
       continue;
     }
+    faces.resize(listedBefore);  // what the failed turn listed
     // Re-clamped with this face up, the table back at 0 for the operator.
     near = nearBefore;
     for (size_t k : rotary)
