@@ -286,14 +286,12 @@ double bodyRadius(double radius, double corner, double h) {
   return radius - corner + std::sqrt(std::max(0.0, corner * corner - (corner - h) * (corner - h)));
 }
 
-const Outline &FeatureWalls::Island::shrunk(double e) const {
-  auto it = sections.find(e);
-  if (it != sections.end())
-    return it->second;
-  std::optional<Outline> o = e > 0 ? outline.inset(e) : std::optional<Outline>(outline);
+Outline FeatureWalls::Island::sectionAt(double v) const {
+  const double e = (v - foot) * slope;
   // The reader made sure the outline shrinks to the island's top; a height
   // between keeps its shape.
-  return sections.emplace(e, o ? std::move(*o) : outline).first->second;
+  std::optional<Outline> o = e > 0 ? outline.inset(e) : std::nullopt;
+  return o ? std::move(*o) : outline;
 }
 
 // --- Reading the feature ----------------------------------------------------------
@@ -437,7 +435,7 @@ private:
       std::optional<Outline> o = closedProfile(*boss, *f);
       if (!o)
         return false;
-      FeatureWalls::Island isl{boss->symbol, std::move(*o), f->z, f->z - boss->number("depth").value_or(0), 0, {}, {}};
+      FeatureWalls::Island isl{boss->symbol, std::move(*o), f->z, f->z - boss->number("depth").value_or(0), 0, {}};
       // A slope leans the walls in going up, the outline at the foot
       // (docs/toolpaths.md, "Bosses with a slope").
       if (const double deg = boss->number("slope").value_or(0); deg != 0) {
@@ -582,7 +580,7 @@ private:
     std::optional<Outline> o = closedProfile(feature, f);
     if (!o)
       return false;
-    w.islands_.push_back({feature.symbol, std::move(*o), f.z, f.z - feature.number("depth").value_or(0), 0, {}, {}});
+    w.islands_.push_back({feature.symbol, std::move(*o), f.z, f.z - feature.number("depth").value_or(0), 0, {}});
     return true;
   }
 
@@ -750,7 +748,7 @@ double FeatureWalls::slopedDepth(const Island &i, const Vec2 &p, double radius, 
   // The body's disc at each sampled height against the section there; the
   // sections shrink going up, so heights above the corner meet no more than
   // the corner's top does. The heights and their sections are made once per
-  // tip height (moves at one level share them).
+  // tip height.
   constexpr int kSamples = 48;
   Island::Heights &hs = i.heights;
   if (!(hs.tip == body.tip && hs.lowered == body.lowered && hs.radius == radius && hs.corner == body.corner) ||
@@ -759,18 +757,16 @@ double FeatureWalls::slopedDepth(const Island &i, const Vec2 &p, double radius, 
     const double tip = body.tip - body.lowered, corner = body.corner;
     const double lo = std::max(tip, i.foot), hi = std::min(tip + corner, i.top);
     const int count = hi > lo ? std::clamp(static_cast<int>(std::ceil((hi - lo) / 0.01)), 1, kSamples) : 0;
-    if (i.sections.size() > 4096)
-      i.sections.clear();  // kept bounded; only the table (remade here) points into it
     for (int k = 0; k <= count; ++k) {
       const double v = count > 0 ? lo + (hi - lo) * k / count : lo;
-      hs.at.emplace_back(bodyRadius(radius, corner, v - tip), &i.shrunk((v - i.foot) * i.slope));
+      hs.at.emplace_back(bodyRadius(radius, corner, v - tip), i.sectionAt(v));
     }
   }
   // Coarsely, then every height about the deepest: the depth over the
   // heights is a disc's radius (concave in the height) less its distance to
   // a section moving in at a constant rate (convex), so it has one peak on
   // a wall or at a corner.
-  auto depthAt = [&](size_t k) { return hs.at[k].first + hs.at[k].second->clearance(p); };
+  auto depthAt = [&](size_t k) { return hs.at[k].first + hs.at[k].second.clearance(p); };
   constexpr size_t kCoarse = 4;
   size_t best = 0;
   double depth = -1e300;

@@ -16,7 +16,6 @@
 #include "ir/Program.h"
 #include "ir/geom/MoveWalk.h"
 
-#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -113,15 +112,13 @@ private:
     double top = 0;
     double foot = 0;
     double slope = 0;
-    /// Its section's outline shrunk by e, for the heights sampled (a few
-    /// per level: moves at one level share them); kept bounded by slopedDepth.
-    const Outline &shrunk(double e) const;
-    mutable std::map<double, Outline> sections;
-    /// The heights sampled for the last tip height and body: the body's
-    /// radius there and the section's outline.
+    /// Its section's outline at height v.
+    Outline sectionAt(double v) const;
+    /// The heights sampled for the last tip height and body (moves at one
+    /// level share them): the body's radius there and the section's outline.
     struct Heights {
       double tip = 0, lowered = 0, radius = 0, corner = 0;
-      std::vector<std::pair<double, const Outline *>> at;
+      std::vector<std::pair<double, Outline>> at;
     };
     mutable Heights heights;
   };

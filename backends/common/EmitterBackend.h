@@ -47,7 +47,7 @@ public:
         buildProgram(module, options.toolTable, diags,
                      descriptor().arcPlanes ? ir::OutOfPlaneArcs::Exact : ir::OutOfPlaneArcs::Chords,
                      descriptor().deposition ? ir::Deposition::Take : ir::Deposition::Refuse, descriptor().name);
-    if (!program || !index(*program, module, options, diags))
+    if (!program || !index(*program, options, diags))
       return std::nullopt;
     Emitter emitter(descriptor(), options, diags);
     std::optional<std::string> text = emitter.run(*program);
@@ -73,7 +73,7 @@ private:
   /// with two rotary axes (table-table, head-table, head-head): they turn each face to the tool
   /// (Indexing.h) where the target writes it, with the workpiece's place on
   /// the table given; elsewhere the re-clamps stay, and a warning says why.
-  bool index(Program &program, const ir::Module &module, const EmitOptions &options, DiagnosticEngine &diags) const {
+  bool index(Program &program, const EmitOptions &options, DiagnosticEngine &diags) const {
     if (program.clampings.empty() || !options.machine ||
         (options.machine->kinematics.chain != runtime::Chain::TableTable &&
          options.machine->kinematics.chain != runtime::Chain::HeadTable &&
@@ -98,7 +98,7 @@ private:
           .entity(at ? at->origin.entityId : 0);
       return false;
     }
-    return indexClampings(program, module, *options.machine, *options.workOffset, descriptor().arcPlanes, diags);
+    return indexClampings(program, *options.machine, *options.workOffset, descriptor().arcPlanes, diags);
   }
 
   /// Positions printed in steps coarser than half the contour tolerance

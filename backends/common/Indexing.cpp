@@ -49,10 +49,42 @@ std::string upper(std::string s) {
   return s;
 }
 
+/// How high the raw block can reach while the table turns, in machine
+/// coordinates: with one table axis each corner circles its foot on the
+/// axis (no higher than the foot plus its distance times the axis's lean
+/// from z); with two, the farthest corner from the inner axis's pivot plus
+/// the distance between the pivots, above the outer pivot. None without a
+/// block or a table axis.
+std::optional<double> sweepTop(const Program &p, const runtime::Machine &machine, const Vec3 &workOffset) {
+  std::vector<const runtime::Axis *> table;
+  for (const std::string &name : machine.kinematics.table)
+    for (const runtime::Axis &a : machine.axes)
+      if (a.name == name)
+        table.push_back(&a);
+  if (!p.blank || table.empty())
+    return std::nullopt;
+  const auto &[lo, hi] = *p.blank;
+  double corner = 0, top = -1e300;
+  for (int c = 0; c < 8; ++c) {
+    const Vec3 q =
+        Vec3((c & 1) ? hi.x() : lo.x(), (c & 2) ? hi.y() : lo.y(), (c & 4) ? hi.z() : lo.z()) + workOffset;
+    corner = std::max(corner, (q - table.back()->pivotMm).norm());
+    const Vec3 d = table.front()->direction.normalized(), rel = q - table.front()->pivotMm;
+    const Vec3 foot = table.front()->pivotMm + d * rel.dot(d);
+    top = std::max(top, foot.z() + (q - foot).norm() * d.cross(Vec3::UnitZ()).norm());
+  }
+  if (table.size() == 1)
+    return top;
+  double reach = 0;
+  for (size_t k = 0; k + 1 < table.size(); ++k)
+    reach += (table[k + 1]->pivotMm - table[k]->pivotMm).norm();
+  return table.front()->pivotMm.z() + reach + corner;
+}
+
 } // namespace
 
-bool indexClampings(Program &p, const ir::Module &, const runtime::Machine &machine, const Vec3 &workOffset,
-                    bool arcPlanes, DiagnosticEngine &diags) {
+bool indexClampings(Program &p, const runtime::Machine &machine, const Vec3 &workOffset, bool arcPlanes,
+                    DiagnosticEngine &diags) {
   if (p.clampings.empty())
     return true;
   std::string error;
@@ -66,44 +98,12 @@ bool indexClampings(Program &p, const ir::Module &, const runtime::Machine &mach
     if (machine.axes[k].rotary)
       rotary.push_back(k);
   const double retractZ = machine.axes.at(2).travelMax;
-  // The table turns with the tool at the top of z: whatever the angles, the
-  // workpiece stays within the outermost pivot's distance to the next, and so
-  // on inwards, plus the raw block's farthest corner from the innermost.
-  if (p.blank && !rotary.empty()) {
-    const auto &[lo, hi] = *p.blank;
-    std::vector<const runtime::Axis *> table;
-    for (const std::string &name : machine.kinematics.table)
-      for (const runtime::Axis &a : machine.axes)
-        if (a.name == name)
-          table.push_back(&a);
-    if (!table.empty()) {
-      double reach = 0;
-      for (size_t k = 0; k + 1 < table.size(); ++k)
-        reach += (table[k + 1]->pivotMm - table[k]->pivotMm).norm();
-      double corner = 0, top = -1e300;
-      for (int c = 0; c < 8; ++c) {
-        const Vec3 q = Vec3((c & 1) ? hi.x() : lo.x(), (c & 2) ? hi.y() : lo.y(), (c & 4) ? hi.z() : lo.z()) +
-                       workOffset;
-        corner = std::max(corner, (q - table.back()->pivotMm).norm());
-        if (table.size() == 1) {
-          // About one axis a point circles its foot on the axis: no higher
-          // than the foot plus its distance times the axis's lean from z.
-          const Vec3 d = table.front()->direction.normalized(), rel = q - table.front()->pivotMm;
-          const Vec3 foot = table.front()->pivotMm + d * rel.dot(d);
-          top = std::max(top, foot.z() + (q - foot).norm() * d.cross(Vec3::UnitZ()).norm());
-        }
-      }
-      if (table.size() > 1)
-        top = table.front()->pivotMm.z() + reach + corner;
-      if (top >= retractZ) {
-        diags.error(SourceLoc{}, "the workpiece turning on the machine's table may reach up to z " +
-                                     formatFixed(top, 3) + " mm, above the top of z travel " +
-                                     formatShortest(retractZ) + " mm where the tool waits while it turns (its raw "
-                                     "block at --work-offset " +
-                                     formatTuple({workOffset.x(), workOffset.y(), workOffset.z()}, 3) + ")");
-        return false;
-      }
-    }
+  if (const std::optional<double> top = sweepTop(p, machine, workOffset); top && *top >= retractZ) {
+    diags.error(SourceLoc{}, "the workpiece turning on the machine's table may reach up to z " + formatFixed(*top, 3) +
+                                 " mm, above the top of z travel " + formatShortest(retractZ) +
+                                 " mm where the tool waits while it turns (its raw block at --work-offset " +
+                                 formatTuple({workOffset.x(), workOffset.y(), workOffset.z()}, 3) + ")");
+    return false;
   }
 
   // The re-clamp stops go, and the operator's message before each (on a
@@ -125,7 +125,6 @@ bool indexClampings(Program &p, const ir::Module &, const runtime::Machine &mach
   std::optional<Problem> problem;
   runtime::Joints near = runtime::Joints::Zero(static_cast<Eigen::Index>(kinematics->jointCount()));
   std::optional<runtime::Joints> turned;  // the rotary axes' positions in force
-  bool ok = true, first = true;
   std::vector<std::string> faces;
   size_t clampingListed = 0;  // where the clamping in force starts in `faces`
   // One step turned to the tool with the workpiece clamped as `base`
@@ -137,11 +136,9 @@ bool indexClampings(Program &p, const ir::Module &, const runtime::Machine &mach
     // of the face in the workpiece.
     const Vec3 tool = base.turn * (place.turn.transpose() * Vec3::UnitZ());
     const std::string face = faceName(place.turn.transpose() * Vec3::UnitZ());
-    bool good = true;
     auto where = [&](const std::string &why) {
       if (!failure)
         failure = Problem{s.exec, why};
-      good = false;
     };
     // The joints that put the tool tip at q (in the step's frame) with the
     // tool along the face's normal; the program's point is their x, y, z
@@ -180,10 +177,9 @@ bool indexClampings(Program &p, const ir::Module &, const runtime::Machine &mach
     bool changed = !turned;
     for (size_t k : rotary)
       changed = changed || std::abs((*turned)[static_cast<Eigen::Index>(k)] - near[static_cast<Eigen::Index>(k)]) > 1e-9;
-    if (changed || first) {
+    if (changed) {  // the first step too: nothing turned yet
       Index index;
       index.retractZ = retractZ;
-      index.face = face;
       std::string text = "face " + face + (baseFace == "+Z" ? "" : " (clamped " + baseFace + " up)") + ":";
       for (size_t k : rotary) {
         index.axes.emplace_back(upper(machine.axes[k].name), near[static_cast<Eigen::Index>(k)]);
@@ -195,7 +191,6 @@ bool indexClampings(Program &p, const ir::Module &, const runtime::Machine &mach
         faces.push_back(text);
       turned = near;
     }
-    first = false;
     s.workOffset = s.workOffset == 1 ? 1 : 0;
     // For the whole face the map from its frame to the program's is a turn
     // and a shift: where it takes the face's axes.
@@ -278,7 +273,7 @@ bool indexClampings(Program &p, const ir::Module &, const runtime::Machine &mach
       }
     }
     s.secplane += dz;
-    return good;
+    return !failure;
   };
 
   // Each step under the clamping in force; a face the machine cannot turn
@@ -316,7 +311,6 @@ bool indexClampings(Program &p, const ir::Module &, const runtime::Machine &mach
     clampingListed = listed;
     if (face == baseFace || !turnStep(attempt, own, face, again)) {
       problem = failure ? failure : again;
-      ok = false;
       break;
     }
     ++reclamps;
@@ -337,7 +331,6 @@ bool indexClampings(Program &p, const ir::Module &, const runtime::Machine &mach
     // The table back at 0 for the operator.
     Index home;
     home.retractZ = retractZ;
-    home.face = "load";
     for (size_t k : rotary)
       home.axes.emplace_back(upper(machine.axes[k].name), 0.0);
     stop.index = std::move(home);
@@ -348,8 +341,7 @@ bool indexClampings(Program &p, const ir::Module &, const runtime::Machine &mach
     base = own;
     baseFace = face;
   }
-  steps = std::move(out);
-  if (!ok) {
+  if (problem) {
     const std::string what = "the machine's rotary axes do not turn every face to the tool (" +
                              (problem->exec ? "workingstep " + problem->exec->symbol + ": " : std::string()) +
                              problem->why + "): the program stops for the operator to re-clamp for each face instead";
@@ -359,7 +351,7 @@ bool indexClampings(Program &p, const ir::Module &, const runtime::Machine &mach
       diags.warning(SourceLoc{}, what);
     return true;
   }
-  p.steps = std::move(steps);
+  p.steps = std::move(out);
   p.clampings.clear();
   p.indexing.push_back("the program turns the rotary axes to bring each face to the tool (3+2)" +
                        (reclamps > 0 ? ", re-clamping " + std::to_string(reclamps) +

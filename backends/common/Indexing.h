@@ -15,7 +15,7 @@
 
 namespace stepnc::backends {
 
-/// Turns the re-clamps of `p` (built from `module`) into turns of
+/// Turns the re-clamps of `p` into turns of
 /// `machine`'s rotary axes: every step on another face gets its moves in
 /// the first clamping's frame (the workpiece's origin at `workOffset`, in
 /// machine coordinates with every axis at 0) and, where the face changes,
@@ -31,7 +31,7 @@ namespace stepnc::backends {
 /// `arcPlanes`: the target writes arcs in the ZX and YZ planes (where a
 /// leaning tool puts a face's arcs); an arc that lands in no plane the
 /// target writes keeps the re-clamps (with the warning).
-bool indexClampings(Program &p, const ir::Module &module, const runtime::Machine &machine, const Vec3 &workOffset,
-                    bool arcPlanes, DiagnosticEngine &diags);
+bool indexClampings(Program &p, const runtime::Machine &machine, const Vec3 &workOffset, bool arcPlanes,
+                    DiagnosticEngine &diags);
 
 } // namespace stepnc::backends

@@ -104,7 +104,6 @@ std::string whyNotCycle(const TargetDescriptor &d, const HoleCycle &c);
 struct Index {
   std::vector<std::pair<std::string, double>> axes;  ///< name ("A"), deg
   double retractZ = 0;  ///< machine z the tool goes up to first (the top of its travel), mm
-  std::string face;     ///< "+X": the face the turn brings to the tool
 };
 
 struct Step {

@@ -73,6 +73,12 @@ void approach(Emitter &e, const Path2D &path, double z, const Plan &p, const Nod
   e.linear(at(start, z), p.plungeFeed, "plunge");
 }
 
+/// The radius of a tool of `radius` and `corner` at height h (0 .. ) above
+/// its tip: R - rc + sqrt(rc^2 - (rc - h)^2) through its corner, R above.
+double bodyRadius(double radius, double corner, double h) {
+  return h >= corner ? radius : radius - corner + std::sqrt(std::max(0.0, corner * corner - (corner - h) * (corner - h)));
+}
+
 /// How a boss whose walls lean in is sampled for the keep-out area of a tool
 /// whose corner, grown by the side allowance, is `corner` (slopedKeepOut):
 /// heights `step` apart, each section grown by `margin` more than the
@@ -107,7 +113,7 @@ double levelRidge(double slope, double radius, double corner, double dz) {
   constexpr int kBody = 256;
   for (int k = 0; k <= kBody; ++k) {
     const double h = corner * k / kBody;
-    const double body = corner > 0 ? flat + std::sqrt(std::max(0.0, corner * corner - (corner - h) * (corner - h))) : radius;
+    const double body = bodyRadius(radius, corner, h);
     if (-h * slope + body > axis0) {
       axis0 = -h * slope + body;
       contact = h;
@@ -494,10 +500,7 @@ namespace {
 /// radius there plus the margin; the union is the keep-out area.
 Region slopedKeepOut(const ir::IslandShape &isl, double z, const Plan &p) {
   const double a = p.allowanceSide, radius = p.radius + a, corner = ir::cornerRadius(*p.tool) + a, tip = z - a;
-  auto body = [&](double v) {
-    const double h = v - tip;
-    return h >= corner ? radius : radius - corner + std::sqrt(std::max(0.0, corner * corner - (corner - h) * (corner - h)));
-  };
+  auto body = [&](double v) { return bodyRadius(radius, corner, v - tip); };
   const double lo = std::max(tip, isl.foot), hi = std::min(tip + corner, isl.top);
   if (hi <= lo + 1e-9)
     return geom::offset(isl.sectionAt(lo), body(lo));

@@ -190,7 +190,7 @@ def ir_feed_moves(ir_path, setups):
     return out
 
 
-def canon_feed_moves(canon_path, table, work_offset, faces):
+def canon_feed_moves(canon_path, chain, work_offset, faces):
     """The canonical feed moves in workpiece coordinates, with the tool's
     direction; and the problems of turns made below the top of z. A
     re-clamp message (`re-clamp the workpiece with its -Z face up`) places
@@ -239,19 +239,19 @@ def canon_feed_moves(canon_path, table, work_offset, faces):
             new = {"a": a, "b": b, "c": c}
             if new != angles:
                 top = add(to, offset)[2]
-                if z is None or abs(z - table.z_top) > TOL_MM or abs(top - table.z_top) > TOL_MM:
+                if z is None or abs(z - chain.z_top) > TOL_MM or abs(top - chain.z_top) > TOL_MM:
                     problems.append("canon line %d: the table turns with the tool at machine z %s, not at the top "
-                                    "of its travel %g: %s" % (n, z, table.z_top, line.strip()))
+                                    "of its travel %g: %s" % (n, z, chain.z_top, line.strip()))
                 angles = new
             z = add(to, offset)[2]
             at = to
             if m.group(1) == "STRAIGHT_TRAVERSE":
                 continue
-            tip, k = back(*table.to_workpiece(add(to, offset), angles, work_offset))
+            tip, k = back(*chain.to_workpiece(add(to, offset), angles, work_offset))
             entry = {"to": tip, "axis": k, "text": "canon line %d: %s" % (n, line.strip())}
             if centre:
-                entry["centre"] = back(*table.to_workpiece(add(centre, offset), angles, work_offset))[0]
-                entry["middle"] = back(*table.to_workpiece(add(middle, offset), angles, work_offset))[0]
+                entry["centre"] = back(*chain.to_workpiece(add(centre, offset), angles, work_offset))[0]
+                entry["middle"] = back(*chain.to_workpiece(add(middle, offset), angles, work_offset))[0]
             out.append(entry)
     return out, problems
 
@@ -264,7 +264,7 @@ def main():
     ap.add_argument("--work-offset", required=True)
     args = ap.parse_args()
     work_offset = tuple(float(v) for v in args.work_offset.split(","))
-    table = Chain(args.machine)
+    chain = Chain(args.machine)
     with tempfile.TemporaryDirectory() as work:
         with open(os.path.join(work, "vars.var"), "w") as f:
             f.write("5220 1\n")
@@ -275,7 +275,7 @@ def main():
             print("FAIL: " + why)
             return 1
         setups, faces = read_setups(args.ir)
-        made, problems = canon_feed_moves(canon, table, work_offset, faces)
+        made, problems = canon_feed_moves(canon, chain, work_offset, faces)
     want = ir_feed_moves(args.ir, setups)
     if len(made) != len(want):
         problems.append("%d feed moves in the program, %d in the IR" % (len(made), len(want)))
