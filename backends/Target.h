@@ -77,6 +77,10 @@ struct TargetDescriptor {
   /// turns its rotary axes to each face (3+2, positions computed by stepnc,
   /// backends/common/Indexing.h) instead of stopping to re-clamp.
   bool rotaryIndexing = false;
+  /// Steps that tilt the tool (5-axis moves): the target writes them as the
+  /// machine's joint positions with rotary words and inverse-time feeds, for
+  /// a machine without tool-centre-point control (backends/common/FiveAxis.h).
+  bool jointMoves = false;
   /// Reading back a program that deposits: feed moves run with the spindle
   /// off (a deposition head turns nothing).
   bool feedsWithoutSpindle = false;

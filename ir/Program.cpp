@@ -36,7 +36,7 @@ const Node *findIn(const Node &n, std::string_view symbol, const Node **parent) 
 std::string quotedKind(const Node &n) { return "'" + n.kindName() + "'"; }
 
 /// What of `n` itself (not its subtree) a 3-axis milling reader cannot take.
-std::optional<std::string> beyond(const Node &n, ArcPlanes planes, Deposition deposition) {
+std::optional<std::string> beyond(const Node &n, ArcPlanes planes, Deposition deposition, ToolAxes toolAxes) {
   if (n.is(Trait::ControlFlow))
     return "control flow (" + quotedKind(n) + ")";
   const bool deposits = deposition == Deposition::Take;
@@ -45,7 +45,7 @@ std::optional<std::string> beyond(const Node &n, ArcPlanes planes, Deposition de
     return std::string("an operation of another process (") + quotedKind(n) + ")";
   switch (n.kind) {
   case Kind::Moves:
-    if (n.has("axis"))
+    if (n.has("axis") && toolAxes != ToolAxes::Take)
       return std::string("a tool axis");
     if (n.has("x_mode"))
       return std::string("a lathe's X mode");
@@ -57,7 +57,7 @@ std::optional<std::string> beyond(const Node &n, ArcPlanes planes, Deposition de
   case Kind::Rapid:
   case Kind::Linear:
   case Kind::Arc:
-    if (n.has("axis"))
+    if (n.has("axis") && toolAxes != ToolAxes::Take)
       return std::string("a tool axis per move");
     if (n.has("feed_per_rev"))
       return std::string("a feed per revolution");
@@ -76,15 +76,31 @@ std::optional<std::string> beyond(const Node &n, ArcPlanes planes, Deposition de
   return std::nullopt;
 }
 
-std::optional<Beyond> firstBeyond(const Node &n, ArcPlanes planes, OtherProcesses others, Deposition deposition) {
+std::optional<Beyond> firstBeyond(const Node &n, ArcPlanes planes, OtherProcesses others, Deposition deposition,
+                                  ToolAxes toolAxes, const Node *step = nullptr) {
   if (others == OtherProcesses::Skip && (isTurningStep(n) || isAdditiveStep(n)))
     return std::nullopt;
-  if (auto what = beyond(n, planes, deposition))
+  if (toolAxes == ToolAxes::Skip && tiltsTool(n))
+    return std::nullopt;
+  if (n.kind == Kind::Workingstep || n.kind == Kind::RapidMovement)
+    step = &n;
+  if (auto what = beyond(n, planes, deposition, toolAxes)) {
+    // A move the passes made has no place in the file: its step has.
+    if (!n.origin.loc.valid() && step && n.category() != Category::Executable)
+      return Beyond{step, *what};
     return Beyond{&n, *what};
+  }
   for (const Node &c : n.children)
-    if (auto found = firstBeyond(c, planes, others, deposition))
+    if (auto found = firstBeyond(c, planes, others, deposition, toolAxes, step))
       return found;
   return std::nullopt;
+}
+
+/// Whether `n` or a node under it gives a tool axis other than +z.
+bool tilted(const Node &n) {
+  if (auto axis = n.vec("axis"); axis && (*axis - Vec3::UnitZ()).norm() > 1e-9)
+    return true;
+  return std::any_of(n.children.begin(), n.children.end(), [](const Node &c) { return tilted(c); });
 }
 
 } // namespace
@@ -103,18 +119,25 @@ bool isAdditiveStep(const Node &exec) {
   return op && op->is(Trait::Additive);
 }
 
+bool tiltsTool(const Node &exec) {
+  if (exec.kind != Kind::Workingstep && exec.kind != Kind::RapidMovement)
+    return false;
+  const Node *moves = exec.child(Kind::Moves);
+  return moves && tilted(*moves);
+}
+
 const Node *millingMoves(const Node &exec) {
-  return isTurningStep(exec) || isAdditiveStep(exec) ? nullptr : exec.child(Kind::Moves);
+  return isTurningStep(exec) || isAdditiveStep(exec) || tiltsTool(exec) ? nullptr : exec.child(Kind::Moves);
 }
 
 std::optional<Beyond> beyondThreeAxisMilling(const Module &module, ArcPlanes planes, OtherProcesses others,
-                                             Deposition deposition) {
-  return firstBeyond(module.root, planes, others, deposition);
+                                             Deposition deposition, ToolAxes toolAxes) {
+  return firstBeyond(module.root, planes, others, deposition, toolAxes);
 }
 
 bool requireThreeAxisMilling(const Module &module, std::string_view consumer, DiagnosticEngine &diags,
-                             ArcPlanes planes, OtherProcesses others, Deposition deposition) {
-  const std::optional<Beyond> b = beyondThreeAxisMilling(module, planes, others, deposition);
+                             ArcPlanes planes, OtherProcesses others, Deposition deposition, ToolAxes toolAxes) {
+  const std::optional<Beyond> b = beyondThreeAxisMilling(module, planes, others, deposition, toolAxes);
   if (!b)
     return true;
   std::string subject = b->node->kindName();

@@ -78,8 +78,13 @@ bool isTurningStep(const Node &exec);
 /// Additive trait): its moves lay beads with the energy on and off.
 bool isAdditiveStep(const Node &exec);
 
-/// The `moves` of an executable that a milling pass reads: null for a step
-/// without moves and for a turning or deposition step.
+/// Whether `exec` tilts the tool: its `moves`, or one of its moves, has a
+/// tool axis other than +z (a 5-axis step, docs/five-axis.md).
+bool tiltsTool(const Node &exec);
+
+/// The `moves` of an executable that a 3-axis milling pass reads: null for
+/// a step without moves, for a turning or deposition step, and for a step
+/// that tilts the tool (each pass that passes one over says so).
 const Node *millingMoves(const Node &exec);
 
 /// What a consumer of milling programs does with the steps of other
@@ -93,6 +98,11 @@ enum class OtherProcesses : uint8_t { Refuse, Skip };
 /// with the machine's codes; the other process state changes (spindle,
 /// constant surface speed) stay beyond it.
 enum class Deposition : uint8_t { Refuse, Take };
+
+/// Whether a reader of the IR takes steps that tilt the tool (tiltsTool):
+/// refuses them, passes over them whole (a pass that says so, or checks
+/// them its own way), or takes their moves.
+enum class ToolAxes : uint8_t { Refuse, Skip, Take };
 
 /// Which arcs a reader of the IR takes: in the XY plane only, or in any of
 /// the principal planes XY, ZX and YZ (an arc `normal` along x, y or z).
@@ -116,16 +126,19 @@ struct Beyond {
 /// Principal: it walks moves with ir::walkMoves, which gives them as chords,
 /// or writes them itself) is not stopped by them; an arc about any other
 /// axis stops every consumer.
-/// With `others` Skip, turning and deposition workingsteps are passed over whole.
+/// With `others` Skip, turning and deposition workingsteps are passed over
+/// whole; with `toolAxes` Skip, so are steps that tilt the tool, and with
+/// Take their tool axes are no bar.
 std::optional<Beyond> beyondThreeAxisMilling(const Module &module, ArcPlanes planes = ArcPlanes::XYOnly,
                                              OtherProcesses others = OtherProcesses::Refuse,
-                                             Deposition deposition = Deposition::Refuse);
+                                             Deposition deposition = Deposition::Refuse,
+                                             ToolAxes toolAxes = ToolAxes::Refuse);
 
 /// Reports the first construct `consumer` cannot take as an error at its
 /// node ("<consumer> cannot take <what> yet") and returns false; true when
 /// there is none.
 bool requireThreeAxisMilling(const Module &module, std::string_view consumer, DiagnosticEngine &diags,
                              ArcPlanes planes = ArcPlanes::XYOnly, OtherProcesses others = OtherProcesses::Refuse,
-                             Deposition deposition = Deposition::Refuse);
+                             Deposition deposition = Deposition::Refuse, ToolAxes toolAxes = ToolAxes::Refuse);
 
 } // namespace stepnc::ir

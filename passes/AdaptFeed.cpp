@@ -83,7 +83,7 @@ public:
   std::string_view name() const override { return "adapt-feed"; }
 
   PassResult run(ir::Module &module, DiagnosticEngine &diags, PassStats &stats) override {
-    if (!ir::requireThreeAxisMilling(module, name(), diags, ir::ArcPlanes::Principal, ir::OtherProcesses::Skip))
+    if (!takes(module, diags, "its feeds"))
       return {false, false};
     const auto data = start(diags);
     if (!data)
@@ -371,6 +371,10 @@ private:
       peak[t.info[k].move] = std::max(peak[t.info[k].move], t.profiles[k].peak() * 60);
     long long capped = 0;
     for (size_t k = 0; k < program.nodes.size(); ++k) {
+      // A step that tilts the tool moves joints the 3-axis plan does not
+      // see: its feeds stay as programmed (the warning says so).
+      if (program.owners[k] && ir::tiltsTool(*program.owners[k]))
+        continue;
       auto *node = const_cast<ir::Node *>(program.nodes[k]);
       const std::optional<double> feed = node->kind == ir::Kind::Rapid ? std::nullopt : node->number("feed");
       if (!feed || *feed <= 0 || *feed <= peak[k])

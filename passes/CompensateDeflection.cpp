@@ -249,7 +249,7 @@ public:
   std::string_view name() const override { return "compensate-deflection"; }
 
   PassResult run(ir::Module &module, DiagnosticEngine &diags, PassStats &stats) override {
-    if (!ir::requireThreeAxisMilling(module, name(), diags, ir::ArcPlanes::Principal, ir::OtherProcesses::Skip))
+    if (!takes(module, diags, "its moves"))
       return {false, false};
     const auto data = start(diags);
     if (!data)

@@ -101,8 +101,6 @@ public:
   /// of radius 5.0000 mm of %pocket", "the flat end of %slot", "island %boss".
   std::string describe(const WallContact &c) const;
 
-private:
-  enum class Bound : uint8_t { None, Outline, Tube, HalfPlane };
   /// A boss; one whose walls lean in (slope > 0, the tan of the lean) has
   /// `outline` at its foot and, at height v, that outline shrunk by
   /// (v - foot) * slope.
@@ -122,6 +120,16 @@ private:
     };
     mutable Heights heights;
   };
+  /// The islands, as read.
+  const std::vector<Island> &islands() const { return islands_; }
+  /// Whether the feature has walls of its own besides its islands' (a
+  /// pocket's, a slot's, a step's).
+  bool hasOwnWalls() const { return bound_ != Bound::None; }
+  /// The height of the feature's top.
+  double top() const { return top_; }
+
+private:
+  enum class Bound : uint8_t { None, Outline, Tube, HalfPlane };
   /// A slot's flat end: the square past it that the slot does not reach.
   struct FlatEnd {
     geom::Vec2 at = geom::Vec2::Zero(), out = geom::Vec2::UnitX();

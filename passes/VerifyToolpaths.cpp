@@ -43,6 +43,7 @@
 #include "ir/geom/FeatureShape.h"
 #include "ir/geom/MoveWalk.h"
 #include "passes/FeatureWalls.h"
+#include "passes/VerifyFiveAxis.h"
 #include "passes/InProcessStock.h"
 #include "passes/VerifyDeposition.h"
 #include "passes/VerifyTurning.h"
@@ -405,7 +406,7 @@ private:
       if (c.kind == ir::Kind::Workplan)
         visit(c);
       else if ((c.kind == ir::Kind::Workingstep || c.kind == ir::Kind::RapidMovement) && !ir::isTurningStep(c) &&
-               !ir::isAdditiveStep(c))
+               !ir::isAdditiveStep(c) && !ir::tiltsTool(c))  // verifyFiveAxis checks those
         for (ir::Node &m : c.children)
           if (m.kind == ir::Kind::Moves)
             verify(c, m);
@@ -1161,27 +1162,36 @@ public:
   std::string_view name() const override { return "verify-toolpaths"; }
 
   PassResult run(ir::Module &module, DiagnosticEngine &diags, PassStats &stats) override {
-    if (!ir::requireThreeAxisMilling(module, "verify-toolpaths", diags, ir::ArcPlanes::Principal, ir::OtherProcesses::Skip))
+    if (!ir::requireThreeAxisMilling(module, "verify-toolpaths", diags, ir::ArcPlanes::Principal,
+                                     ir::OtherProcesses::Skip, ir::Deposition::Refuse, ir::ToolAxes::Skip))
       return {false, false};
     PassResult milling = ToolpathChecker(module, diags, stats, tolerance_).run();
     const bool turning = verifyTurning(module, diags, stats, tolerance_);
     reports_.clear();
+    tilted_.clear();
     const bool deposition = verifyDeposition(module, diags, stats, std::nullopt, &reports_);
-    return {milling.ok && turning && deposition, milling.changed};
+    const bool fiveAxis = verifyFiveAxis(module, diags, stats, tolerance_, &tilted_);
+    return {milling.ok && turning && deposition && fiveAxis, milling.changed};
   }
 
   std::vector<std::string> report() const override {
-    if (reports_.empty())
-      return {};
-    std::vector<std::string> lines = {"deposition workingstep: layers, bead length, energy-on time at the feed; "
-                                      "largest uncovered gap and overflow (mm)"};
-    lines.insert(lines.end(), reports_.begin(), reports_.end());
+    std::vector<std::string> lines;
+    if (!reports_.empty()) {
+      lines.push_back("deposition workingstep: layers, bead length, energy-on time at the feed; "
+                      "largest uncovered gap and overflow (mm)");
+      lines.insert(lines.end(), reports_.begin(), reports_.end());
+    }
+    if (!tilted_.empty()) {
+      lines.push_back("workingsteps that tilt the tool (5-axis):");
+      lines.insert(lines.end(), tilted_.begin(), tilted_.end());
+    }
     return lines;
   }
 
 private:
   std::optional<double> tolerance_;
   std::vector<std::string> reports_;
+  std::vector<std::string> tilted_;
 };
 
 } // namespace

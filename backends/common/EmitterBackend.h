@@ -8,6 +8,7 @@
 #pragma once
 
 #include "backends/Backend.h"
+#include "backends/common/FiveAxis.h"
 #include "backends/common/LatheEmitter.h"
 #include "backends/common/Indexing.h"
 #include "backends/common/Program.h"
@@ -43,11 +44,15 @@ public:
         return std::nullopt;
       }
     }
+    if (!takesTilts(module, options, diags))
+      return std::nullopt;
     std::optional<Program> program =
         buildProgram(module, options.toolTable, diags,
                      descriptor().arcPlanes ? ir::OutOfPlaneArcs::Exact : ir::OutOfPlaneArcs::Chords,
-                     descriptor().deposition ? ir::Deposition::Take : ir::Deposition::Refuse, descriptor().name);
-    if (!program || !index(*program, options, diags))
+                     descriptor().deposition ? ir::Deposition::Take : ir::Deposition::Refuse, descriptor().name,
+                     descriptor().jointMoves ? ir::ToolAxes::Take : ir::ToolAxes::Refuse);
+    if (!program || !index(*program, options, diags) ||
+        (options.machine && options.workOffset && !jointMoves(*program, *options.machine, *options.workOffset, diags)))
       return std::nullopt;
     Emitter emitter(descriptor(), options, diags);
     std::optional<std::string> text = emitter.run(*program);
@@ -69,6 +74,41 @@ public:
   }
 
 private:
+  /// Steps that tilt the tool need a target that writes joints, a 5-axis
+  /// machine and where the workpiece is on it: said at the first such step
+  /// when one is missing.
+  bool takesTilts(const ir::Module &module, const EmitOptions &options, DiagnosticEngine &diags) const {
+    const std::vector<const ir::Node *> order = ir::programOrder(module);
+    const auto tilted = std::find_if(order.begin(), order.end(), [](const ir::Node *e) { return ir::tiltsTool(*e); });
+    if (tilted == order.end())
+      return true;
+    const ir::Node &at = **tilted;
+    std::string missing;
+    if (!descriptor().jointMoves) {
+      diags.error(at.origin.loc, "workingstep " + at.symbol + " tilts the tool (5-axis): " + descriptor().name +
+                                     " does not write such steps yet (rs274 does, as the machine's joints; "
+                                     "tool-centre-point control, TRAORI or M128, is not done: docs/five-axis.md)")
+          .entity(at.origin.entityId);
+      return false;
+    }
+    if (!options.machine)
+      missing = "a 5-axis machine (--machine=table-table-5axis, head-table-5axis, head-head-5axis or a file of "
+                "one's own)";
+    else if (options.machine->kinematics.chain != runtime::Chain::TableTable &&
+             options.machine->kinematics.chain != runtime::Chain::HeadTable &&
+             options.machine->kinematics.chain != runtime::Chain::HeadHead)
+      missing = "a 5-axis machine (" + options.machine->name + " has no two rotary axes that turn the tool)";
+    else if (!options.workOffset)
+      missing = "where the workpiece's origin is on the machine (--work-offset=X,Y,Z, machine coordinates with "
+                "every axis at 0)";
+    if (missing.empty())
+      return true;
+    diags.error(at.origin.loc, "workingstep " + at.symbol + " tilts the tool (5-axis): " + descriptor().name +
+                                   " writes it as the machine's joints, which needs " + missing)
+        .entity(at.origin.entityId);
+    return false;
+  }
+
   /// A program that re-clamps for features on other faces, for a machine
   /// with two rotary axes (table-table, head-table, head-head): they turn each face to the tool
   /// (Indexing.h) where the target writes it, with the workpiece's place on

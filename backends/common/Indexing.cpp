@@ -43,11 +43,27 @@ std::string faceName(const Vec3 &d) {
   return "(" + formatTuple({d.x(), d.y(), d.z()}, 6) + ")";
 }
 
-std::string upper(std::string s) {
+
+} // namespace
+
+std::string axisAddress(const runtime::Axis &axis) {
+  std::string s = axis.name;
   for (char &c : s)
     c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
   return s;
 }
+
+std::string outsideTravel(const runtime::Machine &machine, const Eigen::VectorXd &joints) {
+  std::string axes;
+  for (size_t k = 0; k < machine.axes.size(); ++k) {
+    const double v = joints[static_cast<Eigen::Index>(k)];
+    if (v < machine.axes[k].travelMin - 1e-9 || v > machine.axes[k].travelMax + 1e-9)
+      axes += (axes.empty() ? "" : ", ") + axisAddress(machine.axes[k]) + formatShortest(v);
+  }
+  return axes;
+}
+
+namespace {
 
 /// How high the raw block can reach while the table turns, in machine
 /// coordinates: with one table axis each corner circles its foot on the
@@ -83,28 +99,37 @@ std::optional<double> sweepTop(const Program &p, const runtime::Machine &machine
 
 } // namespace
 
-bool indexClampings(Program &p, const runtime::Machine &machine, const Vec3 &workOffset, bool arcPlanes,
-                    DiagnosticEngine &diags) {
-  if (p.clampings.empty())
-    return true;
+std::unique_ptr<runtime::Kinematics> turningKinematics(const Program &p, const runtime::Machine &machine,
+                                                       const Vec3 &workOffset, DiagnosticEngine &diags) {
   std::string error;
-  const std::unique_ptr<runtime::Kinematics> kinematics = runtime::makeKinematics(machine, error);
+  std::unique_ptr<runtime::Kinematics> kinematics = runtime::makeKinematics(machine, error);
   if (!kinematics) {
     diags.error(SourceLoc{}, "the machine's kinematics: " + error);
-    return false;
+    return nullptr;
   }
-  std::vector<size_t> rotary;
-  for (size_t k = 0; k < machine.axes.size(); ++k)
-    if (machine.axes[k].rotary)
-      rotary.push_back(k);
   const double retractZ = machine.axes.at(2).travelMax;
   if (const std::optional<double> top = sweepTop(p, machine, workOffset); top && *top >= retractZ) {
     diags.error(SourceLoc{}, "the workpiece turning on the machine's table may reach up to z " + formatFixed(*top, 3) +
                                  " mm, above the top of z travel " + formatShortest(retractZ) +
                                  " mm where the tool waits while it turns (its raw block at --work-offset " +
                                  formatTuple({workOffset.x(), workOffset.y(), workOffset.z()}, 3) + ")");
-    return false;
+    return nullptr;
   }
+  return kinematics;
+}
+
+bool indexClampings(Program &p, const runtime::Machine &machine, const Vec3 &workOffset, bool arcPlanes,
+                    DiagnosticEngine &diags) {
+  if (p.clampings.empty())
+    return true;
+  const std::unique_ptr<runtime::Kinematics> kinematics = turningKinematics(p, machine, workOffset, diags);
+  if (!kinematics)
+    return false;
+  std::vector<size_t> rotary;
+  for (size_t k = 0; k < machine.axes.size(); ++k)
+    if (machine.axes[k].rotary)
+      rotary.push_back(k);
+  const double retractZ = machine.axes.at(2).travelMax;
 
   // The re-clamp stops go, and the operator's message before each (on a
   // copy: a face out of reach keeps the program as it was).
@@ -152,12 +177,7 @@ bool indexClampings(Program &p, const runtime::Machine &machine, const Vec3 &wor
         return std::nullopt;
       }
       if (r.outsideTravel) {
-        std::string axes;
-        for (size_t k = 0; k < machine.axes.size(); ++k) {
-          const double v = (*r.joints)[static_cast<Eigen::Index>(k)];
-          if (v < machine.axes[k].travelMin - 1e-9 || v > machine.axes[k].travelMax + 1e-9)
-            axes += (axes.empty() ? "" : ", ") + upper(machine.axes[k].name) + formatShortest(v);
-        }
+        const std::string axes = outsideTravel(machine, *r.joints);
         where("face " + face + " turned to the tool" + (baseFace == "+Z" ? "" : " (" + baseFace + " up)") +
               " puts the point " +
               formatTuple({pw.x(), pw.y(), pw.z()}, 4) + " of the workpiece outside the machine's travel (" + axes +
@@ -182,8 +202,8 @@ bool indexClampings(Program &p, const runtime::Machine &machine, const Vec3 &wor
       index.retractZ = retractZ;
       std::string text = "face " + face + (baseFace == "+Z" ? "" : " (clamped " + baseFace + " up)") + ":";
       for (size_t k : rotary) {
-        index.axes.emplace_back(upper(machine.axes[k].name), near[static_cast<Eigen::Index>(k)]);
-        text += " " + upper(machine.axes[k].name) + formatShortest(near[static_cast<Eigen::Index>(k)]);
+        index.axes.emplace_back(axisAddress(machine.axes[k]), near[static_cast<Eigen::Index>(k)]);
+        text += " " + axisAddress(machine.axes[k]) + formatShortest(near[static_cast<Eigen::Index>(k)]);
       }
       s.index = std::move(index);
       // Listed once per clamping.
@@ -332,7 +352,7 @@ bool indexClampings(Program &p, const runtime::Machine &machine, const Vec3 &wor
     Index home;
     home.retractZ = retractZ;
     for (size_t k : rotary)
-      home.axes.emplace_back(upper(machine.axes[k].name), 0.0);
+      home.axes.emplace_back(axisAddress(machine.axes[k]), 0.0);
     stop.index = std::move(home);
     faces.insert(faces.begin() + static_cast<long>(listed), "re-clamped with its " + face + " face up:");
     out.push_back(std::move(message));

@@ -10,8 +10,11 @@
 #pragma once
 
 #include "backends/common/Program.h"
+#include "runtime/Kinematics.h"
 #include "runtime/Machine.h"
 #include "support/Diagnostics.h"
+
+#include <memory>
 
 namespace stepnc::backends {
 
@@ -31,6 +34,20 @@ namespace stepnc::backends {
 /// `arcPlanes`: the target writes arcs in the ZX and YZ planes (where a
 /// leaning tool puts a face's arcs); an arc that lands in no plane the
 /// target writes keeps the re-clamps (with the warning).
+/// A machine axis's address in a program: its name in capitals ("A").
+std::string axisAddress(const runtime::Axis &axis);
+
+/// The axes `joints` puts outside their travel, as a program writes them
+/// ("A-130, C400"); "" when none is.
+std::string outsideTravel(const runtime::Machine &machine, const Eigen::VectorXd &joints);
+
+/// The kinematics of `machine` for a program that turns its rotary axes
+/// with the workpiece's origin at `workOffset`; null (reported) when it
+/// cannot be made, or when the raw block of `p` could sweep above the top of
+/// z travel, where the tool waits while the table turns.
+std::unique_ptr<runtime::Kinematics> turningKinematics(const Program &p, const runtime::Machine &machine,
+                                                       const Vec3 &workOffset, DiagnosticEngine &diags);
+
 bool indexClampings(Program &p, const runtime::Machine &machine, const Vec3 &workOffset, bool arcPlanes,
                     DiagnosticEngine &diags);
 

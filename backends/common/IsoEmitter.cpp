@@ -48,6 +48,29 @@ void IsoEmitter::turn(const Index &index) {
   out_.block(words);
   for (const char *w : {"G", "X", "Y", "Z"})
     modal_.forget(w);
+  for (const auto &[axis, deg] : index.axes) {
+    modal_.forget(axis);
+    modal_.change(axis, num(deg));
+  }
+}
+
+std::string IsoEmitter::rotaryWords(const Move &m) {
+  std::string words;
+  for (size_t k = 0; k < m.rotary.size() && k < program_->rotaryAxes.size(); ++k) {
+    const std::string &name = program_->rotaryAxes[k];
+    const std::string v = num(m.rotary[k]);
+    if (modal_.change(name, v))
+      words += " " + name + v;
+  }
+  return words;
+}
+
+void IsoEmitter::feedMode(bool inverseTime) {
+  if (inverseTime == inverseTime_)
+    return;
+  out_.block(inverseTime ? "G93" : "G94");
+  inverseTime_ = inverseTime;
+  modal_.forget("F");  // the controller takes no feed over from the other mode
 }
 
 std::optional<std::string> IsoEmitter::run(const Program &p) {
@@ -123,6 +146,7 @@ std::optional<std::string> IsoEmitter::run(const Program &p) {
       }
     }
     process(s, s.after);
+    feedMode(false);
     if (const std::string g17 = selectPlane(geom::ArcPlane::xy()); !g17.empty())
       out_.block(g17);
   }
@@ -241,6 +265,8 @@ void IsoEmitter::positionFor(const Step &s) {
 }
 
 void IsoEmitter::move(const Move &m) {
+  if (m.turn)
+    turn(*m.turn);
   if (m.kind == Move::Kind::Arc) {
     arc(m);
     return;
@@ -259,11 +285,17 @@ void IsoEmitter::move(const Move &m) {
   }
   const std::string g = m.kind == Move::Kind::Rapid ? "G0" : "G1";
   // Which axes change as printed; a move that prints as no motion is left out.
-  std::string words = axes(m.to);
+  std::string words = axes(m.to) + rotaryWords(m);
+  if (!words.empty() && words.front() == ' ')
+    words.erase(0, 1);
   if (words.empty())
     return;
-  std::string text = modal_.change("G", g) ? g + " " + words : words;
   if (m.kind == Move::Kind::Linear)
+    feedMode(m.inverseTime > 0);
+  std::string text = modal_.change("G", g) ? g + " " + words : words;
+  if (m.kind == Move::Kind::Linear && m.inverseTime > 0)
+    text += " F" + formatNumber(m.inverseTime, {4, false, true});  // every block in G93
+  else if (m.kind == Move::Kind::Linear)
     text += feedWord(m.feed);
   out_.block(text);
 }

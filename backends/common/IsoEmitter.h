@@ -91,6 +91,13 @@ private:
   /// 3+2: the tool up to the top of z in machine coordinates, then the
   /// rotary axes to the face's angles (Step::index).
   void turn(const Index &index);
+  /// The rotary words of a move of a step that tilts the tool, those that
+  /// change (" A-20. C45."), or "".
+  std::string rotaryWords(const Move &m);
+  /// Inverse-time feeds (G93) or feeds per minute (G94), written when they
+  /// change; the feed is written again after.
+  void feedMode(bool inverseTime);
+  bool inverseTime_ = false;
   /// The head's state changes of step `s` with the machine's codes
   /// (EmitOptions::deposition); errors when there are none, or a value is
   /// beyond what the head gives.

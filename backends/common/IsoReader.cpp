@@ -4,6 +4,7 @@
 #include "support/Format.h"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
@@ -32,7 +33,7 @@ const std::set<int> &allowedG(Dialect dialect) {
   static const std::set<int> rs274 = [] {
     std::set<int> s;
     for (int g : {0, 1, 2, 3, 4, 5, 17, 18, 19, 21, 40, 43, 49, 53, 54, 55, 56, 57, 58, 59, 64, 74, 80, 81, 82, 83,
-                  84, 85, 89, 90, 94, 98, 99})
+                  84, 85, 89, 90, 93, 94, 98, 99})
       s.insert(g * 10);
     s.insert({591, 592, 593});
     return s;
@@ -369,12 +370,19 @@ private:
       pos_ = Vec3(kNaN, kNaN, kNaN);
       return;
     }
-    if (seen.count("A") || seen.count("B") || seen.count("C")) {
-      if (!has(0) || std::any_of(seen.begin(), seen.end(), [](const auto &w) {
-            return w.first != "A" && w.first != "B" && w.first != "C";
-          }))
-        r_.problem(n, "rotary axes turned other than alone at rapid (G0 A.. C..)");
+    const bool rotaryWords = seen.count("A") || seen.count("B") || seen.count("C");
+    const bool rotaryAlone = rotaryWords && std::all_of(seen.begin(), seen.end(), [](const auto &w) {
+      return w.first == "A" || w.first == "B" || w.first == "C";
+    });
+    if (rotaryAlone && has(0)) {
+      // A turn (3+2, or before a step that tilts the tool): where the tool
+      // is over the workpiece is not known after it.
+      rotate(seen);
       pos_ = Vec3(kNaN, kNaN, kNaN);
+      return;
+    }
+    if (rotaryWords && !rotaryAlone && !has(0) && !has(1) && motion_ != 0 && motion_ != 1) {
+      r_.problem(n, "rotary axes turned other than alone at rapid (G0 A.. C..) or on a straight move");
       return;
     }
     if (std::count(keywords.begin(), keywords.end(), "MCALL")) {
@@ -391,8 +399,16 @@ private:
       motion_ = kCspline;
     }
 
-    // In the order LinuxCNC executes a block: feed, speed, tool, M6, spindle,
-    // modal codes, length offset, then the motion.
+    // In the order LinuxCNC executes a block: feed mode, feed, speed, tool,
+    // M6, spindle, modal codes, length offset, then the motion. Leaving
+    // inverse time (G94) leaves no feed in force.
+    if (has(93))
+      inverseTime_ = true;
+    if (has(94)) {
+      if (inverseTime_)
+        feed_ = 0;
+      inverseTime_ = false;
+    }
     if (seen.count("F")) {
       if (seen["F"] <= 0)
         r_.problem(n, "a feed F" + formatFixed(seen["F"], 3));
@@ -417,7 +433,7 @@ private:
     if (dialect_ == Dialect::Rs274 && cycleCode_ && seen.count("P"))
       stickyP_ = seen["P"];
     const bool axes = seen.count("X") || seen.count("Y") || seen.count("Z") || seen.count("I") || seen.count("J") ||
-                      seen.count("K") || seen.count("CR") || (seen.count("R") && !has(43));
+                      seen.count("K") || seen.count("CR") || (seen.count("R") && !has(43)) || rotaryWords;
     if (!axes) {
       if (seen.count("TURN") || (seen.count("Q") && !cycleCode_))
         r_.problem(n, "TURN=, K or Q without a move");
@@ -562,19 +578,32 @@ private:
     upFirst_.clear();
   }
 
-  void make(size_t n, Move::Kind kind, const Vec3 &to, bool cycle = false) {
+  void make(size_t n, Move::Kind kind, const Vec3 &to, bool cycle = false, bool rotated = false) {
     ReadMove m;
     m.kind = kind;
     m.from = pos_;
     m.to = to;
     m.feed = kind == Move::Kind::Rapid ? 0 : feed_;
+    m.inverseTime = kind != Move::Kind::Rapid && inverseTime_;
+    m.abc = abc_;
     m.cycle = cycle;
     m.line = n;
     pos_ = to;
     // A move that goes nowhere is none (the emitter leaves such moves out).
-    if (kind != Move::Kind::Arc && m.from.allFinite() && m.to.allFinite() && m.from == m.to)
+    if (kind != Move::Kind::Arc && !rotated && m.from.allFinite() && m.to.allFinite() && m.from == m.to)
       return;
     r_.moves.push_back(m);
+  }
+
+  /// The rotary axes the block's A, B, C words turn; whether any changes.
+  bool rotate(const std::map<std::string, double> &seen) {
+    bool changed = false;
+    for (int k = 0; k < 3; ++k)
+      if (const auto v = seen.find(std::string(1, "ABC"[k])); v != seen.end()) {
+        changed = changed || !(abc_[static_cast<size_t>(k)] == v->second);
+        abc_[static_cast<size_t>(k)] = v->second;
+      }
+    return changed;
   }
 
   void move(size_t n, const std::map<std::string, double> &seen) {
@@ -607,7 +636,11 @@ private:
         r_.problem(n, std::string(bad) + " on a straight move");
         return;
       }
-    make(n, *motion_ == 0 ? Move::Kind::Rapid : Move::Kind::Linear, to);
+    // LinuxCNC refuses a G1 in inverse time without its F.
+    if (*motion_ == 1 && inverseTime_ && !seen.count("F"))
+      r_.problem(n, "a G1 in inverse time (G93) without F");
+    const bool rotated = rotate(seen);
+    make(n, *motion_ == 0 ? Move::Kind::Rapid : Move::Kind::Linear, to, false, rotated);
   }
 
   void spline(size_t n, const std::map<std::string, double> &seen, const Vec3 &to) {
@@ -1066,6 +1099,8 @@ private:
   bool absolute_ = false, metric_ = false;
   std::optional<geom::ArcPlane> plane_;  ///< G17, G18, G19; none before the program selects one
   double feed_ = 0, speed_ = 0;
+  bool inverseTime_ = false;  ///< G93: F is 1 / the block's minutes
+  std::array<double, 3> abc_ = {kNaN, kNaN, kNaN};  ///< A, B, C as last written
   bool spindleOn_ = false;
   std::optional<int> selected_, inSpindle_, offset_, pendingOffset_;
   std::optional<long> lastNumber_;

@@ -135,6 +135,7 @@ private:
     s.coolant = moves->text("coolant").value_or("off");
     s.secplane = moves->number("secplane").value_or(0);
     s.deposits = ir::isAdditiveStep(e);
+    s.tilted = ir::tiltsTool(e);
     // The head's state changes, each before the move that follows it (the
     // walk gives moves in the order of their nodes; a state is no move).
     std::map<const ir::Node *, std::vector<ProcessChange>> changesBefore;
@@ -179,6 +180,8 @@ private:
       mv.plane = m.plane;
       mv.ccw = m.ccw;
       mv.turns = m.turns;
+      mv.fromAxis = m.fromAxis;
+      mv.axis = m.axis;
       if (auto it = changesBefore.find(m.node); it != changesBefore.end()) {
         mv.before = std::move(it->second);
         changesBefore.erase(it);
@@ -408,9 +411,10 @@ std::string whyNotCycle(const TargetDescriptor &d, const HoleCycle &c) {
 }
 
 std::optional<Program> buildProgram(const ir::Module &module, const ToolTable *table, DiagnosticEngine &diags,
-                                    ir::OutOfPlaneArcs arcs, ir::Deposition deposition, std::string_view target) {
+                                    ir::OutOfPlaneArcs arcs, ir::Deposition deposition, std::string_view target,
+                                    ir::ToolAxes toolAxes) {
   if (!ir::requireThreeAxisMilling(module, target, diags, ir::ArcPlanes::Principal, ir::OtherProcesses::Refuse,
-                                   deposition))
+                                   deposition, toolAxes))
     return std::nullopt;
   return Builder(module, table, diags, arcs).build();
 }

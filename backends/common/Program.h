@@ -39,6 +39,13 @@ struct ProcessChange {
   std::optional<double> wire;    ///< mm/min
 };
 
+/// 3+2 machining (backends/common/Indexing.h): the rotary axes' positions
+/// a step's face needs, reached before it with the tool up out of the way.
+struct Index {
+  std::vector<std::pair<std::string, double>> axes;  ///< name ("A"), deg
+  double retractZ = 0;  ///< machine z the tool goes up to first (the top of its travel), mm
+};
+
 struct Move {
   /// Dwell: the tool waits where it is for `dwell` seconds.
   enum class Kind { Rapid, Linear, Arc, Dwell } kind = Kind::Rapid;
@@ -62,6 +69,18 @@ struct Move {
   const ir::Node *node = nullptr;
   /// Deposition: the head's state changes made before the move, in order.
   std::vector<ProcessChange> before;
+  /// The tool axis at the move's start and end, in the frame of the step's
+  /// setup (the toolpath IR's; +z on a 3-axis step).
+  Vec3 fromAxis = Vec3::UnitZ();
+  Vec3 axis = Vec3::UnitZ();
+  /// A step that tilts the tool, written as the machine's joints
+  /// (backends/common/FiveAxis.h): the rotary axes' angles at the move's
+  /// end (deg, in Program::rotaryAxes order), the feed in inverse time
+  /// (1/min: the block takes 1/F minutes; G93), and a turn of the rotary
+  /// axes made before the move with the tool up at the top of z.
+  std::vector<double> rotary;
+  double inverseTime = 0;
+  std::optional<Index> turn;
 
   /// A rapid that takes the tool to where a step starts: the clearance
   /// move and the moves the IR marks `position`.
@@ -99,12 +118,6 @@ struct HoleCycle {
 /// emitter may still find that its cycle does not make the planned moves.
 std::string whyNotCycle(const TargetDescriptor &d, const HoleCycle &c);
 
-/// 3+2 machining (backends/common/Indexing.h): the rotary axes' positions
-/// a step's face needs, reached before it with the tool up out of the way.
-struct Index {
-  std::vector<std::pair<std::string, double>> axes;  ///< name ("A"), deg
-  double retractZ = 0;  ///< machine z the tool goes up to first (the top of its travel), mm
-};
 
 struct Step {
   enum class Kind { Moves, Message, Stop, OptionalStop } kind = Kind::Moves;
@@ -138,6 +151,9 @@ struct Step {
   std::vector<ProcessChange> after;
   /// A deposition step (its moves lay beads with the head's energy on).
   bool deposits = false;
+  /// A step that tilts the tool (ir::tiltsTool): its moves carry their tool
+  /// axes, and once written as joints (FiveAxis.h) their rotary angles.
+  bool tilted = false;
   std::optional<HoleCycle> cycle;
 };
 
@@ -153,8 +169,12 @@ struct Program {
   /// first clamping's first.
   std::vector<std::pair<int, std::string>> clampings;
   /// A program that turns the rotary axes to each face instead
-  /// (Indexing.h): what the header says of it, line by line.
+  /// (Indexing.h), or moves them with the tool (FiveAxis.h): what the
+  /// header says of it, line by line.
   std::vector<std::string> indexing;
+  /// The rotary axes the moves of steps that tilt the tool give angles for
+  /// ("A", "C"), once written as joints.
+  std::vector<std::string> rotaryAxes;
 };
 
 /// How high a step starts when where the tool is cannot be relied on (after
@@ -169,9 +189,12 @@ double clearanceHeight(const Step &s);
 /// chords.
 /// `deposition`: the target writes deposition steps (Move::before,
 /// Step::after); else they are refused.
+/// `toolAxes`: Take builds steps that tilt the tool too (Step::tilted, each
+/// move's axes), for a target that writes them; else they are refused.
 std::optional<Program> buildProgram(const ir::Module &module, const ToolTable *table, DiagnosticEngine &diags,
                                     ir::OutOfPlaneArcs arcs = ir::OutOfPlaneArcs::Chords,
                                     ir::Deposition deposition = ir::Deposition::Refuse,
-                                    std::string_view target = "the G-code targets");
+                                    std::string_view target = "the G-code targets",
+                                    ir::ToolAxes toolAxes = ir::ToolAxes::Refuse);
 
 } // namespace stepnc::backends

@@ -33,6 +33,16 @@ constexpr double kSweepTol = std::numbers::pi / 2;
 constexpr int kArcSamples = 8;
 /// Dwells are written in seconds with 3 decimals.
 constexpr double kDwellTolS = 0.0005 + 1e-9;
+/// 1/min: inverse-time feeds are written with 4 decimals.
+constexpr double kInverseTimeTol = 0.00005 + 1e-9;
+
+/// The angles a turn of the rotary axes goes to, in its order.
+std::vector<double> anglesOf(const Index &turn) {
+  std::vector<double> out;
+  for (const auto &a : turn.axes)
+    out.push_back(a.second);
+  return out;
+}
 /// Points along a spline piece at which its distance to the chord is measured.
 constexpr int kSplineSamples = 16;
 
@@ -44,6 +54,9 @@ double positionTol(const TargetDescriptor &d) { return std::max(1e-3, unitOf(d))
 double arcPathTol(const TargetDescriptor &d) { return std::max(kArcPathTolMm, kArcPathUnits * unitOf(d)); }
 
 double feedTol(const TargetDescriptor &d) { return 0.5 * std::pow(10.0, -d.feedDecimals) + 1e-6; }
+
+/// How far a printed rotary angle (deg) may be from the planned one.
+double angleTol(const TargetDescriptor &d) { return 0.5 * unitOf(d) + 1e-9; }
 
 std::string point(const Vec3 &p) {
   auto c = [](double v) { return std::isfinite(v) ? formatFixed(v, 4) : std::string("?"); };
@@ -164,6 +177,8 @@ private:
         if (!samePlace(read[b2 - 1]->to, planned[a2 - 1]->to, posTol_))
           return fail(i, read[b2 - 1]->line, "the rapids end at " + point(read[b2 - 1]->to) + ", the plan's at " +
                                                  point(planned[a2 - 1]->to));
+        if (!sameRotary(i, *planned[a2 - 1], *read[b2 - 1]))
+          return false;
         a = a2;
         b = b2;
         continue;
@@ -239,8 +254,30 @@ private:
     if (!samePlace(w.to, m.to, posTol_))
       return fail(i, w.line, "a " + std::string(kindName(w.kind)) + " to " + point(w.to) + " where the plan has a " +
                                  describe(m));
+    if (m.inverseTime > 0 || w.inverseTime) {
+      if (!w.inverseTime || !(m.inverseTime > 0) || !(std::abs(w.feed - m.inverseTime) <= kInverseTimeTol))
+        return fail(i, w.line, (w.inverseTime ? "an inverse-time feed of " + formatFixed(w.feed, 4) + "/min"
+                                              : "a feed of " + formatFixed(w.feed, 3) + " mm/min") +
+                                   " where the plan has " +
+                                   (m.inverseTime > 0 ? "an inverse-time feed of " + formatFixed(m.inverseTime, 4) +
+                                                            "/min"
+                                                      : "a feed of " + formatFixed(m.feed, 3) + " mm/min"));
+      return sameRotary(i, m, w);
+    }
     if (!(std::abs(w.feed - m.feed) <= feedTol(d_)))
       return fail(i, w.line, "a feed of " + formatFixed(w.feed, 3) + " mm/min where the plan has a " + describe(m));
+    return sameRotary(i, m, w);
+  }
+
+  /// The rotary axes where a move of a step that tilts the tool leaves them.
+  bool sameRotary(size_t i, const Move &m, const ReadMove &w) {
+    for (size_t k = 0; k < m.rotary.size() && k < p_.rotaryAxes.size(); ++k) {
+      const size_t axis = static_cast<size_t>(p_.rotaryAxes[k].front() - 'A');
+      if (axis < 3 && !(std::abs(w.abc[axis] - m.rotary[k]) <= angleTol(d_)))
+        return fail(i, w.line, p_.rotaryAxes[k] + (std::isfinite(w.abc[axis]) ? formatFixed(w.abc[axis], 4)
+                                                                                : std::string(" not written")) +
+                                   " where the plan has " + p_.rotaryAxes[k] + formatFixed(m.rotary[k], 4));
+    }
     return true;
   }
 
@@ -369,6 +406,13 @@ std::vector<std::vector<Move>> expectedMoves(const Program &p, const TargetDescr
   // a tool change until a move sets them.
   const double nan = std::nan("");
   Vec3 at(nan, nan, nan);
+  std::vector<double> turned;  // the rotary angles as printed
+  auto printedAngles = [&](const std::vector<double> &v) {
+    std::vector<double> out;
+    for (double a : v)
+      out.push_back(roundTo(a, d.coordDecimals));
+    return out;
+  };
   auto printed = [&](const Vec3 &v) {
     return Vec3(roundTo(v.x(), d.coordDecimals), roundTo(v.y(), d.coordDecimals), roundTo(v.z(), d.coordDecimals));
   };
@@ -376,6 +420,8 @@ std::vector<std::vector<Move>> expectedMoves(const Program &p, const TargetDescr
     const Step &s = p.steps[i];
     if (s.toolChange || s.workOffset > 0)
       at = Vec3(nan, nan, nan);
+    if (s.index)
+      turned = printedAngles(anglesOf(*s.index));
     for (Move m : s.moves) {
       const Vec3 to = printed(m.to);
       if (m.alongZOnly) {
@@ -385,7 +431,12 @@ std::vector<std::vector<Move>> expectedMoves(const Program &p, const TargetDescr
       }
       if (m.kind == Move::Kind::Arc && arcPrintsClosed(m.fromInPlane(), m.toInPlane(), m.sweep(), d.coordDecimals))
         m.kind = Move::Kind::Linear;
-      if ((m.kind == Move::Kind::Rapid || m.kind == Move::Kind::Linear) && to == at)
+      if (m.turn)
+        turned = printedAngles(anglesOf(*m.turn));
+      const bool rotates = !m.rotary.empty() && printedAngles(m.rotary) != turned;
+      if (!m.rotary.empty())
+        turned = printedAngles(m.rotary);
+      if ((m.kind == Move::Kind::Rapid || m.kind == Move::Kind::Linear) && to == at && !rotates)
         continue;  // prints as no motion
       out[i].push_back(m);
       if (m.kind != Move::Kind::Dwell)

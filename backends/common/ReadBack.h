@@ -13,6 +13,8 @@
 #include "geom/ArcPlane.h"
 #include "support/Diagnostics.h"
 
+#include <array>
+#include <cmath>
 #include <cstddef>
 #include <optional>
 #include <string>
@@ -31,7 +33,11 @@ struct ReadMove {
   bool ccw = false;                        ///< arcs
   geom::ArcPlane plane = geom::ArcPlane::xy();  ///< arcs: G17, G18 or G19 in force
   double sweep = 0;  ///< arcs: the whole angle turned, radians (> 0), full turns included
-  double feed = 0;   ///< mm/min, feed moves (the modal feed in force)
+  double feed = 0;   ///< mm/min, feed moves (the modal feed in force); 1/min in inverse time
+  bool inverseTime = false;  ///< a feed move in inverse time (G93)
+  /// The rotary axes A, B, C after the move, as the program last wrote them
+  /// (NaN: never written).
+  std::array<double, 3> abc = {std::nan(""), std::nan(""), std::nan("")};
   double dwell = 0;  ///< dwells, s
   /// A piece of a spline the controller draws through its end points (G5,
   /// CSPLINE): compared by its end. With a Bézier form, its inner control

@@ -37,6 +37,7 @@ TargetDescriptor rs274Descriptor() {
   d.latheCompensation = true;  // G41/G42 with the tool table's radius and orientation
   d.deposition = true;         // the machine's codes (M62-M68 on LinuxCNC)
   d.rotaryIndexing = true;     // G53 G0 Z up, G0 A.. C.. (docs/five-axis.md)
+  d.jointMoves = true;         // G93 G1 X.. Y.. Z.. A.. C.. F.. (docs/five-axis.md)
   return d;
 }
 

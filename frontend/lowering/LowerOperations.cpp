@@ -511,6 +511,8 @@ std::optional<Node> Lowerer::operation(const Instance &op) {
   };
   length("retract_plane", "retract_plane");
   position("start_point", "start_point");
+  if (Instance direction = op.ref("its_tool_direction"))
+    toolDirection(direction, n);
   length("overcut", "overcut_length");
   length("axial_depth", "axial_cutting_depth");
   length("radial_depth", "radial_cutting_depth");
@@ -617,6 +619,56 @@ std::optional<Node> Lowerer::operation(const Instance &op) {
   return n;
 }
 
+void Lowerer::toolDirection(const Instance &d, Node &n) {
+  if (d.isA("three_axes_tilted_tool")) {
+    n.set("tool_direction", Value::word("tilted"));
+    if (auto axis = direction(d.ref("its_tool_direction")))
+      n.set("tilted_axis", Value::direction(*axis));
+    else
+      missing(d, "its_tool_direction");
+  } else if (d.isA("five_axes_var_tilt_yaw")) {
+    n.set("tool_direction", Value::word("varying"));
+  } else if (d.isA("five_axes_const_tilt_yaw")) {
+    n.set("tool_direction", Value::word("constant"));
+    copyAngle(n, "tilt", d, "tilt_angle");
+    copyAngle(n, "yaw", d, "yaw_angle");
+    if (!n.has("tilt"))
+      missing(d, "tilt_angle");
+    if (!n.has("yaw"))
+      missing(d, "yaw_angle");
+  } else {
+    unsupported(d, "tool direction");
+  }
+}
+
+void Lowerer::toolAxes(const Instance &tp, const Instance &axes, Node &basic) {
+  // ISO 14649-11: its_toolaxis has the parameter range of basiccurve. Read
+  // as the generators of such files write it: a polyline beside the
+  // basiccurve's, each point, taken as a vector from the origin, the tool
+  // axis at the basiccurve's point of the same index.
+  if (basic.kind != ir::Kind::Polyline || !axes.isA("polyline")) {
+    unsupported(tp, "a tool axis curve that is not a polyline beside a polyline basiccurve");
+    return;
+  }
+  const std::vector<Instance> points = axes.refs("points");
+  if (points.size() != basic.children.size()) {
+    missing(tp, "its_toolaxis",
+            "has " + std::to_string(points.size()) + " points and basiccurve " +
+                std::to_string(basic.children.size()) + ": each point of the path needs its tool axis");
+    return;
+  }
+  for (size_t i = 0; i < points.size(); ++i) {
+    const std::optional<Vec3> v = point(points[i]);
+    if (!v)
+      continue;  // reported by point()
+    if (!(v->norm() > 1e-9)) {
+      missing(points[i], "coordinates", "is (0, 0, 0): a tool axis is a direction");
+      continue;
+    }
+    basic.children[i].set("axis", Value::direction(v->normalized()));
+  }
+}
+
 void Lowerer::toolpaths(const Instance &list, Node &parent) {
   for (const Instance &tp : list.refs("its_list")) {
     const bool feedstop = tp.isA("feedstop");
@@ -651,12 +703,15 @@ void Lowerer::toolpaths(const Instance &list, Node &parent) {
       n.add(technology(*this, tech));
     if (Instance mf = tp.ref("its_machine_functions"))
       n.add(machineFunctions(mf));
-    if (tp.ref("its_toolaxis") || tp.ref("surface_normal"))
-      unsupported(tp, "tool axis or surface normal curves (5-axis)");
-    if (auto c = curve(tp.ref("basiccurve")))
+    if (tp.ref("surface_normal"))
+      unsupported(tp, "surface normal curves");
+    if (auto c = curve(tp.ref("basiccurve"))) {
+      if (Instance axes = tp.ref("its_toolaxis"))
+        toolAxes(tp, axes, *c);
       n.add(std::move(*c));
-    else
+    } else {
       missing(tp, "basiccurve");
+    }
     parent.add(std::move(n));
   }
 }

@@ -228,6 +228,13 @@ public:
   void turningToolBody(const Instance &body, Node &n);
   /// Adds the toolpaths of a toolpath_list as children of `parent`.
   void toolpaths(const Instance &list, Node &parent);
+  /// An operation's its_tool_direction into `n` (tool_direction and its
+  /// direction or angles).
+  void toolDirection(const Instance &d, Node &n);
+  /// Sets `axis` on each point of a toolpath's polyline `basic` from its
+  /// tool axis curve `axes` (ISO 14649-11 its_toolaxis, a polyline of
+  /// directions beside it); reports what does not fit.
+  void toolAxes(const Instance &tp, const Instance &axes, Node &basic);
 
   // --- additive (LowerAdditive.cpp) -----------------------------------------
   /// An added feature (am_feature) into `n`; false after reporting.

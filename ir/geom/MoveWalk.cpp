@@ -170,12 +170,21 @@ ir::Vec3 Move::pointAt(double s) const {
 
 namespace {
 
-void walk(const ir::Node &parent, const ir::Node *cycle, std::optional<ir::Vec3> &at, PathKind path,
-          OutOfPlaneArcs arcs, std::vector<Move> &out) {
+/// Where a walk is: the tool's position (when known) and axis, and the
+/// axis the moves without one of their own have.
+struct WalkState {
+  std::optional<ir::Vec3> at;
+  ir::Vec3 axis = ir::Vec3::UnitZ();
+  ir::Vec3 movesAxis = ir::Vec3::UnitZ();
+};
+
+void walk(const ir::Node &parent, const ir::Node *cycle, WalkState &state, PathKind path, OutOfPlaneArcs arcs,
+          std::vector<Move> &out) {
+  std::optional<ir::Vec3> &at = state.at;
   for (const ir::Node &n : parent.children) {
     switch (n.kind) {
     case ir::Kind::Cycle:
-      walk(n, &n, at, path, arcs, out);
+      walk(n, &n, state, path, arcs, out);
       continue;
     case ir::Kind::Rapid:
     case ir::Kind::Linear:
@@ -188,9 +197,12 @@ void walk(const ir::Node &parent, const ir::Node *cycle, std::optional<ir::Vec3>
     Move m = readMove(n, path);
     m.cycle = cycle;
     m.from = at;
+    m.fromAxis = state.axis;
+    m.axis = m.kind == MoveKind::Dwell ? state.axis : n.vec("axis").value_or(state.movesAxis);
     if (m.kind == MoveKind::Dwell)
       m.to = at.value_or(ir::Vec3::Zero());
     at = m.to;
+    state.axis = m.axis;
     if (m.kind == MoveKind::Arc && !m.plane.isXY() && m.from && arcs == OutOfPlaneArcs::Chords) {
       const std::vector<ir::Vec3> points = m.chordPoints(kOutOfPlaneArcChord);
       for (size_t k = 1; k < points.size(); ++k) {
@@ -199,6 +211,8 @@ void walk(const ir::Node &parent, const ir::Node *cycle, std::optional<ir::Vec3>
         line.chord = true;
         line.from = points[k - 1];
         line.to = points[k];
+        line.fromAxis = turnAxis(m.fromAxis, m.axis, double(k - 1) / double(points.size() - 1));
+        line.axis = turnAxis(m.fromAxis, m.axis, double(k) / double(points.size() - 1));
         line.center = ir::Vec3::Zero();
         line.turns = 0;
         out.push_back(std::move(line));
@@ -214,9 +228,26 @@ void walk(const ir::Node &parent, const ir::Node *cycle, std::optional<ir::Vec3>
 std::vector<Move> walkMoves(const ir::Node &moves, std::optional<ir::Vec3> start, PathKind path,
                             OutOfPlaneArcs arcs) {
   std::vector<Move> out;
-  std::optional<ir::Vec3> at = start;
-  walk(moves, nullptr, at, path, arcs, out);
+  WalkState state;
+  state.at = start;
+  state.movesAxis = moves.vec("axis").value_or(ir::Vec3::UnitZ());
+  state.axis = state.movesAxis;
+  walk(moves, nullptr, state, path, arcs, out);
   return out;
+}
+
+ir::Vec3 turnAxis(const ir::Vec3 &u, const ir::Vec3 &w, double t) {
+  const double c = std::clamp(u.dot(w), -1.0, 1.0);
+  const double angle = std::acos(c);
+  if (angle < 1e-12 || angle > std::numbers::pi - 1e-9)
+    return t >= 1 && angle < 1e-12 ? w : u;
+  const double s = std::sin(angle);
+  return (std::sin((1 - t) * angle) / s) * u + (std::sin(t * angle) / s) * w;
+}
+
+double angleBetween(const ir::Vec3 &u, const ir::Vec3 &w) {
+  // atan2 of the cross and dot products: exact for small angles too.
+  return std::atan2(u.cross(w).norm(), u.dot(w)) * 180 / std::numbers::pi;
 }
 
 std::vector<std::pair<Move, bool>> walkWithEnergy(const ir::Node &moves) {

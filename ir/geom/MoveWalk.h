@@ -39,6 +39,11 @@ struct Move {
   std::string role;                    ///< "position", "cut", ... (default: position for rapids, cut otherwise)
   double dwell = 0;                    ///< dwells: s
   const ir::Node *cycle = nullptr;     ///< the canned cycle the move belongs to, if any
+  /// The tool axis at the move's end (its own `axis`, else that of `moves`,
+  /// else +z; a dwell keeps the one it finds) and at its start (where the
+  /// move before left it); between them it turns evenly (turnAxis).
+  ir::Vec3 axis = ir::Vec3::UnitZ();
+  ir::Vec3 fromAxis = ir::Vec3::UnitZ();
 
   /// True for a move that cuts at a feed (a line or an arc).
   bool isFeed() const { return kind == MoveKind::Linear || kind == MoveKind::Arc; }
@@ -56,6 +61,15 @@ struct Move {
   /// mm of it (a helix's height spread over them); a line's two ends.
   std::vector<ir::Vec3> chordPoints(double tolerance) const;
 };
+
+/// The tool axis a fraction t (0..1) of the way through a move whose axis
+/// goes from u to w (unit vectors): turning evenly in the plane of the two,
+/// the toolpath IR's rule for 5-axis moves (docs/ir.md). u and w opposite
+/// have no such plane: u is kept up to the end.
+ir::Vec3 turnAxis(const ir::Vec3 &u, const ir::Vec3 &w, double t);
+
+/// The angle between two unit vectors, degrees.
+double angleBetween(const ir::Vec3 &u, const ir::Vec3 &w);
 
 /// How far the chords that stand for an arc out of the XY plane may be from
 /// it (mm): the chord tolerance of B-splines (ir/geom/Curves.h).

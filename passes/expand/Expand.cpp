@@ -284,6 +284,14 @@ private:
                              " has no expansion in stepnc");
       return;
     }
+    // A tool direction (5-axis) is taken by 2.5D milling (flank milling
+    // of side finishing) and by explicit toolpaths (whose points give their
+    // own tool axes); no other family tilts the tool.
+    if (op->has("tool_direction") && sel.key != ir::Kind::Strategy && sel.key != ir::Kind::Toolpath) {
+      x_.report(ws, *op, "a tool direction (ISO 14649-11 its_tool_direction) is not supported by " +
+                             std::string(family->name) + ": stepnc tilts the tool for flank milling only");
+      return;
+    }
     Node moves = makeMoves(ws, tool->symbol, p.spindle, coolant(*op), setup);
     const double retract = retractPlane(ws, *op);
     // Axial approaches start the retract plane above the feature's top, never

@@ -212,6 +212,11 @@ void expandRapidMovement(Expander &x, Node &rm, const std::string &setup);
 bool expandHoleMaking(Expander &x, const Step &step);
 /// Milling2D.cpp: levels, the strategy's paths at each, approaches and links.
 bool expandMilling2D(Expander &x, const Step &step);
+/// FlankMilling.cpp: a side finishing operation whose tool direction varies
+/// (ISO 14649-11 five_axes_var_tilt_yaw): the walls of the bosses on a planar
+/// face, each in one pass with the side of a flat end mill along its
+/// rulings (moves with a tool axis). Other tool directions are refused.
+bool expandFlankMilling(Expander &x, const Step &step);
 /// SlotLevels.cpp: a slot with slanted or curved walls, level by level from
 /// the top down, each level cut as a slot with vertical walls as wide as the
 /// tool fits at that height (2.5D milling hands such slots over).

@@ -14,6 +14,7 @@
 // ISO 14649 interpreter does, wherever that is safe.
 #include "passes/expand/Expand.h"
 
+#include "ir/geom/MoveWalk.h"
 #include "passes/InProcessStock.h"
 #include "support/Format.h"
 
@@ -101,10 +102,123 @@ void explicitPiece(const ir::PlaneFrame &f, const ir::CurvePiece &c, const Expli
     run.decided.push_back({before, !kind.rapid, toolpath.origin});
 }
 
+/// The least z part of the tool axis a path may start with: reached down
+/// its axis from the security plane, the tool leans 80 deg at most.
+constexpr double kMinApproachCos = 0.17364817766693033;  // cos 80 deg
+
+/// Whether any toolpath of `op` gives its tool axes (ISO 14649-11 its_toolaxis:
+/// `axis` on the points of its polyline).
+bool givesToolAxes(const Node &op) {
+  for (const Node *tp : op.childrenOf(ir::Kind::Toolpath))
+    for (const Node &curve : tp->children)
+      if (curve.kind == ir::Kind::Polyline)
+        for (const Node &point : curve.children)
+          if (point.has("axis"))
+            return true;
+  return false;
+}
+
+/// The toolpaths of an operation that gives tool axes (5-axis): each point
+/// with its axis (a polyline without axes, or a point without one: +z),
+/// reached from the security plane down the tool axis of its first point
+/// and left up the axis of its last; no path is joined to another or settled
+/// on the stock (the verifier checks the step's rapids). False after an error.
+bool expandTiltedToolpaths(Expander &x, const Step &step) {
+  const Node &ws = step.ws, &op = step.op;
+  const ir::PlaneFrame &f = *step.frame;
+  const Plan &p = step.plan;
+  Node &moves = step.moves;
+  const double secplane = moves.number("secplane").value_or(0);
+  std::optional<Vec3> at;
+  Vec3 axis = Vec3::UnitZ();
+  auto add = [&](Node m, const Vec3 &to, const Vec3 &a) {
+    m.set("axis", ir::Value::direction(a));
+    moves.add(std::move(m));
+    at = to;
+    axis = a;
+  };
+  auto upTo = [](const Vec3 &from, const Vec3 &a, double z) { return Vec3(from + a * ((z - from.z()) / a.z())); };
+  auto leave = [&]() {
+    if (at && at->z() < secplane - 1e-9)
+      add(Emitter::rapidNode(upTo(*at, axis, secplane), "retract"), upTo(*at, axis, secplane), axis);
+  };
+  for (const Node *tp : op.childrenOf(ir::Kind::Toolpath)) {
+    const Node *tech = tp->child(ir::Kind::Technology);
+    const double feed = tech && tech->number("feed") ? *tech->number("feed") : p.feed;
+    const ExplicitKind kind = explicitKind(*tp);
+    if (tp->has("dwell")) {
+      if (at) {
+        Node dwell(ir::Kind::Dwell);
+        dwell.set("time", ir::Value::time(*tp->number("dwell")));
+        moves.add(std::move(dwell));
+      }
+      continue;
+    }
+    for (const Node &curve : tp->children) {
+      if (curve.category() != ir::Category::Curve)
+        continue;
+      if (curve.kind != ir::Kind::Polyline) {
+        x.report(ws, *tp, "its explicit toolpaths give tool axes: every curve of the operation must be a polyline "
+                          "(this one is a " + curve.kindName() + ")");
+        return false;
+      }
+      std::vector<std::pair<Vec3, Vec3>> poses;
+      for (const Node &point : curve.children) {
+        const Vec3 q = point.vec("at").value_or(Vec3::Zero());
+        const Vec3 a = point.vec("axis").value_or(Vec3::UnitZ());
+        const geom::Vec2 axy = f.mapDir(a.head<2>());
+        poses.emplace_back(ir::Vec3(f.map(q.head<2>()).x(), f.map(q.head<2>()).y(), f.z + q.z()),
+                           Vec3(axy.x(), axy.y(), a.z()).normalized());
+      }
+      if (tp->flag("reversed").value_or(false))
+        std::reverse(poses.begin(), poses.end());
+      if (poses.empty())
+        continue;
+      const auto &[start, startAxis] = poses.front();
+      const bool joined = at && (*at - start).norm() <= 1e-6 && ir::angleBetween(axis, startAxis) <= 1e-6;
+      if (!joined) {
+        // Reached down the start's axis from the security plane.
+        if (startAxis.z() < kMinApproachCos) {
+          x.report(ws, *tp, "its toolpath starts with the tool axis " +
+                                formatTuple({startAxis.x(), startAxis.y(), startAxis.z()}, 6) + ", " +
+                                formatFixed(std::acos(std::clamp(startAxis.z(), -1.0, 1.0)) * 180 / kPi, 3) +
+                                " deg from z: stepnc reaches a path's start down its tool axis from the security "
+                                "plane, which needs a tool leaning 80 deg or less");
+          return false;
+        }
+        leave();
+        add(Emitter::rapidNode(upTo(start, startAxis, secplane), "position"), upTo(start, startAxis, secplane),
+            startAxis);
+        const double clearance = std::max(start.z(), std::min(p.clearanceZ, secplane));
+        if (kind.rapid || clearance <= start.z() + 1e-9) {
+          add(Emitter::rapidNode(start, "approach"), start, startAxis);
+        } else {
+          add(Emitter::rapidNode(upTo(start, startAxis, clearance), "approach"), upTo(start, startAxis, clearance),
+              startAxis);
+          add(Emitter::linearNode(start, p.plungeFeed, "plunge"), start, startAxis);
+        }
+      }
+      for (size_t k = 1; k < poses.size(); ++k) {
+        const auto &[q, a] = poses[k];
+        if ((q - *at).norm() <= 1e-9 && ir::angleBetween(a, axis) <= 1e-9)
+          continue;
+        add(kind.rapid ? Emitter::rapidNode(q, kind.role) : Emitter::linearNode(q, feed, kind.role), q, a);
+      }
+    }
+  }
+  leave();
+  return true;
+}
+
 } // namespace
 
 bool expandExplicitToolpaths(Expander &x, const Step &step) {
   const Node &ws = step.ws, &op = step.op;
+  if (givesToolAxes(op))
+    return expandTiltedToolpaths(x, step);
+  if (const std::optional<std::string> direction = op.text("tool_direction"))
+    x.assumed(ws, op, "its tool direction (" + *direction + ") is not followed: its toolpaths give no tool axes "
+                      "(its_toolaxis), so the tool stays along z");
   const ir::PlaneFrame &frame = *step.frame;
   const Plan &p = step.plan;
   Emitter e(step.moves, step.moves.number("secplane").value_or(0));

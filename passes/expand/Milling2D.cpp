@@ -347,6 +347,8 @@ void cutLevel(Emitter &e, const Step &step, const ir::FeatureShape &s, const Pla
 }
 
 bool expandMilling2D(Expander &x, const Step &step) {
+  if (step.op.has("tool_direction"))
+    return expandFlankMilling(x, step);
   const ir::FeatureShape &s = *step.shape;
   if (s.section)
     return expandSlotLevels(x, step);

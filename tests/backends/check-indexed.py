@@ -256,6 +256,16 @@ def canon_feed_moves(canon_path, chain, work_offset, faces):
     return out, problems
 
 
+def run_with_offset(program, work, work_offset):
+    """rs274's canonical moves of the program with G54 set to the work offset
+    (mm; rs274's variables file is in inches): (canon path, None) or (None, why)."""
+    with open(os.path.join(work, "vars.var"), "w") as f:
+        f.write("5220 1\n")
+        for k, v in enumerate(work_offset):
+            f.write("%d %.9f\n" % (5221 + k, v / 25.4))
+    return check_rs274.run_rs274(program, work)
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--program", required=True)
@@ -266,11 +276,7 @@ def main():
     work_offset = tuple(float(v) for v in args.work_offset.split(","))
     chain = Chain(args.machine)
     with tempfile.TemporaryDirectory() as work:
-        with open(os.path.join(work, "vars.var"), "w") as f:
-            f.write("5220 1\n")
-            for k, v in enumerate(work_offset):
-                f.write("%d %.9f\n" % (5221 + k, v / 25.4))
-        canon, why = check_rs274.run_rs274(args.program, work)
+        canon, why = run_with_offset(args.program, work, work_offset)
         if not canon:
             print("FAIL: " + why)
             return 1

@@ -61,7 +61,8 @@ def read_moves(path):
     with per_rev set), line (in the file) and text; arcs also
     plane ('xy', 'zx', 'yz'), centre (in the plane's coordinates: x, y in XY),
     ccw (seen from the plane's normal), turns, radius and sweep (radians,
-    full turns included); dwells their time (s), where the tool is."""
+    full turns included); dwells their time (s), where the tool is. A move
+    that gives its tool axis (5-axis) has it as axis."""
     out = []
     pos = (0.0, 0.0, 0.0)
     # A deposition head's state: energy on or off, its power, powder, wire.
@@ -89,6 +90,8 @@ def read_moves(path):
             move = {"kind": m.group(1), "start": pos, "to": point(attrs["to"]), "line": n, "text": code.strip()}
             if head:
                 move["head"] = dict(head)
+            if "axis" in attrs:
+                move["axis"] = point(attrs["axis"])
             if "feed" in attrs:
                 move["feed"] = float(attrs["feed"].replace("mm/min", ""))
             elif "feed_per_rev" in attrs:

@@ -198,3 +198,33 @@ TEST_CASE("arcs in the ZX and YZ planes: exact and as chords", "[movewalk]") {
     along += s.length();
   CHECK(along == Approx(10));
 }
+
+TEST_CASE("tool axes: each move's start and end axis, turning evenly between", "[movewalk][five-axis]") {
+  Node moves(ir::Kind::Moves);
+  moves.set("axis", Value::direction(Vec3::UnitZ()));
+  rapid(moves, Vec3(0, 0, 50));
+  const Vec3 tilted = Vec3(std::sin(kPi / 6), 0, std::cos(kPi / 6));  // 30 deg towards +x
+  linear(moves, Vec3(10, 0, 0)).set("axis", Value::direction(tilted));
+  moves.add(Node(ir::Kind::Dwell)).set("time", Value::time(1));
+  linear(moves, Vec3(20, 0, 0));  // no axis of its own: the one `moves` gives
+  const std::vector<Move> walked = walkMoves(moves);
+  REQUIRE(walked.size() == 4);
+  CHECK(walked[0].fromAxis == Vec3::UnitZ());
+  CHECK(walked[1].fromAxis == Vec3::UnitZ());
+  CHECK(walked[1].axis == tilted);
+  CHECK(walked[2].axis == tilted);  // a dwell keeps the axis it finds
+  CHECK(walked[3].fromAxis == tilted);
+  CHECK(walked[3].axis == Vec3::UnitZ());
+
+  // Evenly: a third of the way, a third of the angle, in the plane of the two.
+  const Vec3 third = turnAxis(Vec3::UnitZ(), tilted, 1.0 / 3);
+  CHECK(third.norm() == Approx(1).epsilon(1e-12));
+  CHECK(angleBetween(Vec3::UnitZ(), third) == Approx(10).epsilon(1e-9));
+  CHECK(third.y() == Approx(0).margin(1e-15));
+  CHECK(turnAxis(Vec3::UnitZ(), tilted, 0) == Vec3::UnitZ());
+  CHECK((turnAxis(Vec3::UnitZ(), tilted, 1) - tilted).norm() < 1e-15);
+  // Opposite axes have no plane: the start is kept up to the end.
+  CHECK(turnAxis(Vec3::UnitZ(), -Vec3::UnitZ(), 0.5) == Vec3::UnitZ());
+  // Small angles stay exact (atan2, not acos).
+  CHECK(angleBetween(Vec3::UnitZ(), Vec3(1e-9, 0, 1).normalized()) == Approx(1e-9 * 180 / kPi).epsilon(1e-6));
+}
