@@ -1,5 +1,7 @@
 #include "driver/Pipeline.h"
 
+#include <algorithm>
+
 #include "driver/ExitCode.h"
 #include "passes/PassManager.h"
 #include "support/Format.h"
@@ -38,10 +40,17 @@ std::string toolpathPipeline(const ToolpathPipelineOptions &options) {
   return text + "verify-toolpaths";
 }
 
-std::string planMotionPipeline(const std::string &machine, std::optional<double> tolerance) {
+std::string planMotionPipeline(const std::string &machine, std::optional<double> tolerance,
+                               const std::string &workOffset) {
   std::string text = "plan-motion<machine=" + machine;
   if (tolerance)
     text += ",tolerance=" + formatShortest(*tolerance);
+  if (!workOffset.empty()) {
+    // The pipeline separates options by commas: the point's by colons.
+    std::string point = workOffset;
+    std::replace(point.begin(), point.end(), ',', ':');
+    text += ",work-offset=" + point;
+  }
   return text + ">";
 }
 

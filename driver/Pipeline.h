@@ -30,7 +30,10 @@ struct ToolpathPipelineOptions {
 std::string toolpathPipeline(const ToolpathPipelineOptions &options);
 
 /// The plan-motion pass for a machine (file or shipped name) and tolerance.
-std::string planMotionPipeline(const std::string &machine, std::optional<double> tolerance);
+/// `workOffset`: "X,Y,Z" mm where the workpiece's origin is on a 5-axis
+/// machine (steps that tilt the tool are planned on its joints); empty: none.
+std::string planMotionPipeline(const std::string &machine, std::optional<double> tolerance,
+                               const std::string &workOffset = "");
 
 struct PipelineRun {
   bool verifyEach = false;

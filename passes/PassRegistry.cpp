@@ -55,6 +55,8 @@ TypeText typeText(OptionType type) {
     return {"true|false", "true or false"};
   case OptionType::File:
     return {"<file>", "a file path"};
+  case OptionType::Point:
+    return {"<x:y:z>", "three numbers in mm separated by ':', such as 200:195:-250"};
   case OptionType::Machine: {
     std::string names;
     for (const std::string &n : runtime::shippedMachineNames())
@@ -96,9 +98,32 @@ std::optional<PassOptions::Value> convert(OptionType type, std::string_view text
     if (text.empty())
       return std::nullopt;
     return std::string(text);
+  case OptionType::Point:
+    if (!parsePoint(text))
+      return std::nullopt;
+    return std::string(text);
   }
   return std::nullopt;
 }
+
+} // namespace
+
+std::optional<std::array<double, 3>> parsePoint(std::string_view text) {
+  std::array<double, 3> out{};
+  for (size_t k = 0; k < 3; ++k) {
+    const size_t end = k < 2 ? text.find(':') : text.size();
+    if (end == std::string_view::npos)
+      return std::nullopt;
+    const std::optional<double> v = numberWithUnit(text.substr(0, end), "mm");
+    if (!v)
+      return std::nullopt;
+    out[k] = *v;
+    text.remove_prefix(std::min(text.size(), end + 1));
+  }
+  return out;
+}
+
+namespace {
 
 bool isNameChar(char c) { return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '-' || c == '_'; }
 
@@ -130,7 +155,7 @@ std::string describePass(const PassInfo &info) {
 std::string describeOptionTypes() {
   std::string text = "option values:\n";
   for (OptionType type : {OptionType::Length, OptionType::Angle, OptionType::Bool, OptionType::File,
-                          OptionType::Machine}) {
+                          OptionType::Machine, OptionType::Point}) {
     const TypeText t = typeText(type);
     text += "    " + std::string(t.placeholder) + ": " + t.expects + '\n';
   }

@@ -7,6 +7,7 @@
 #include "passes/Pass.h"
 
 #include <memory>
+#include <array>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -22,7 +23,11 @@ enum class OptionType {
   Bool,    ///< "true" or "false"; a flag
   File,    ///< a file path, not empty; text
   Machine, ///< a machine description (TOML file) or a shipped machine's name, not empty; text
+  Point,   ///< three numbers in mm separated by ':' ("200:195:-250"; commas separate options); text
 };
+
+/// A Point option's text as (x, y, z); nullopt when it is not three finite numbers.
+std::optional<std::array<double, 3>> parsePoint(std::string_view text);
 
 /// What an option is when a pipeline does not give it.
 struct OptionDefault {

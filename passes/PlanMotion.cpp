@@ -4,8 +4,14 @@
 #include "ir/motion/MotionIR.h"
 #include "ir/Program.h"
 #include "passes/Pass.h"
+#include "passes/PassRegistry.h"
+#include "runtime/Kinematics.h"
 #include "runtime/Machine.h"
 #include "support/Format.h"
+
+#include <algorithm>
+#include <array>
+#include <memory>
 
 namespace stepnc::passes {
 
@@ -13,8 +19,8 @@ namespace {
 
 class PlanMotionPass final : public Pass {
 public:
-  PlanMotionPass(std::string machinePath, std::optional<double> tolerance)
-      : machinePath_(std::move(machinePath)), tolerance_(tolerance) {}
+  PlanMotionPass(std::string machinePath, std::optional<double> tolerance, std::optional<std::array<double, 3>> offset)
+      : machinePath_(std::move(machinePath)), tolerance_(tolerance), workOffset_(offset) {}
 
   std::string_view name() const override { return "plan-motion"; }
 
@@ -25,10 +31,39 @@ public:
       return {false, false};
     if (machine->kinematics.chain == runtime::Chain::Lathe)
       return runLathe(module, *machine, diags, stats);
+    // Steps that tilt the tool are planned on the joints of a 5-axis
+    // machine, told where the workpiece sits on it.
+    std::unique_ptr<runtime::Kinematics> kinematics;
+    const bool fiveAxis = machine->kinematics.chain == runtime::Chain::TableTable ||
+                          machine->kinematics.chain == runtime::Chain::HeadTable ||
+                          machine->kinematics.chain == runtime::Chain::HeadHead;
+    const std::vector<const ir::Node *> order = ir::programOrder(module);
+    const auto tilted = std::find_if(order.begin(), order.end(), [](const ir::Node *e) { return ir::tiltsTool(*e); });
+    if (tilted != order.end()) {
+      const ir::Node &at = **tilted;
+      const std::string needs = !fiveAxis ? "a 5-axis machine (" + machine->name + " has no two rotary axes that turn "
+                                                                                   "the tool)"
+                                : !workOffset_ ? "where the workpiece's origin is on the machine (--work-offset, or "
+                                                 "plan-motion<work-offset=X:Y:Z>)"
+                                               : "";
+      if (!needs.empty()) {
+        diags.error(at.origin.loc, "workingstep " + at.symbol + " tilts the tool: plan-motion plans it on the "
+                                                                "machine's joints, which needs " + needs)
+            .entity(at.origin.entityId);
+        return {false, false};
+      }
+      std::string error;
+      kinematics = runtime::makeKinematics(*machine, error);
+      if (!kinematics) {
+        diags.error({}, "plan-motion: the machine's kinematics: " + error);
+        return {false, false};
+      }
+    }
     // Deposition steps are planned as any 3-axis moves (the head's state
     // changes take no time); the native format refuses them.
     if (!ir::requireThreeAxisMilling(module, "plan-motion", diags, ir::ArcPlanes::Principal,
-                                     ir::OtherProcesses::Refuse, ir::Deposition::Take))
+                                     ir::OtherProcesses::Refuse, ir::Deposition::Take,
+                                     kinematics ? ir::ToolAxes::Take : ir::ToolAxes::Refuse))
       return {false, false};
     // The planner moves x, y and z: a generic chain is refused rather than
     // planned with its axes taken for x, y, z.
@@ -48,6 +83,10 @@ public:
     runtime::PlanOptions options;
     if (tolerance_)
       options.tolerance = *tolerance_;
+    if (kinematics) {
+      options.kinematics = kinematics.get();
+      options.workOffset = runtime::Vec3((*workOffset_)[0], (*workOffset_)[1], (*workOffset_)[2]);
+    }
     const runtime::Trajectory trajectory = runtime::plan(program.path, *machine, options);
     ir::attachMotion(module, program, trajectory);
     count(program, trajectory, stats);
@@ -98,12 +137,16 @@ private:
   std::string machinePath_;
   std::unique_ptr<SourceFile> machineFile_;
   std::optional<double> tolerance_;
+  std::optional<std::array<double, 3>> workOffset_;
 };
 
 } // namespace
 
 std::unique_ptr<Pass> createPlanMotionPass(const PassOptions &options) {
-  return std::make_unique<PlanMotionPass>(options.text("machine"), options.number("tolerance"));
+  std::optional<std::array<double, 3>> offset;
+  if (options.has("work-offset"))
+    offset = parsePoint(options.text("work-offset"));
+  return std::make_unique<PlanMotionPass>(options.text("machine"), options.number("tolerance"), offset);
 }
 
 } // namespace stepnc::passes

@@ -28,16 +28,22 @@ namespace {
 /// z x y) and each segment's spindle. A trajectory is written in the lowest
 /// version that holds it, so players of an older version go on reading what
 /// they can play: a mill's without dwells as version 1, with them as 2, a
-/// lathe's as 3.
-constexpr int kVersion = 3;
+/// lathe's as 3, one that tilts the tool (5-axis: each segment's tool axes
+/// and the axis that capped it) as 4.
+constexpr int kVersion = 4;
+constexpr int kVersionWithToolAxes = 4;
+constexpr int kVersionWithSpindle = 3;
 constexpr int kVersionWithDwells = 2;
 constexpr int kVersionWithoutDwells = 1;
 constexpr std::string_view kMagic = "STEPNC-MOTION";
 
 /// The version a trajectory needs.
 int versionFor(const Trajectory &t) {
+  for (const Segment &seg : t.segments)
+    if (seg.tilted())
+      return kVersionWithToolAxes;
   if (t.frame == Frame::Zxy)
-    return kVersion;
+    return kVersionWithSpindle;
   for (size_t i = 0; i < t.segments.size(); ++i)
     if (t.segments[i].kind == SegmentKind::Dwell || t.info[i].stop == StopReason::Dwell)
       return kVersionWithDwells;
@@ -106,8 +112,9 @@ std::string writeNative(const Trajectory &trajectory, const std::string &source)
   out += "cycle_time " + number(t.cycleTime) + '\n';
   out += "tolerance " + number(t.tolerance) + '\n';
   const bool lathe = t.frame == Frame::Zxy;
-  if (lathe)
-    out += "axes z x y\n";
+  const int version = versionFor(t);
+  if (version >= kVersionWithSpindle)
+    out += lathe ? "axes z x y\n" : "axes x y z\n";
   out += "start";
   appendPoint(out, t.start);
   out += '\n';
@@ -158,10 +165,16 @@ std::string writeNative(const Trajectory &trajectory, const std::string &source)
     out += " phases " + std::to_string(prof.phases.size());
     for (const Phase &ph : prof.phases)
       appendNumbers(out, {ph.duration, ph.jerk});
-    if (lathe) {
+    if (version >= kVersionWithSpindle) {
       out += " spindle";
       appendNumbers(out, {info.spindle0, info.spindle1});
       out += info.sync ? " sync index" : " sync none";
+    }
+    if (version >= kVersionWithToolAxes) {
+      out += " tool";
+      appendNumbers(out, {seg.axis0.x(), seg.axis0.y(), seg.axis0.z(), seg.axis1.x(), seg.axis1.y(), seg.axis1.z()});
+      out += " limited_axis ";
+      out += info.axis >= 0 && size_t(info.axis) < t.axisNames.size() ? t.axisNames[size_t(info.axis)] : "none";
     }
     out += '\n';
   }
@@ -496,7 +509,7 @@ bool Reader::header(Trajectory &t) {
   if (line("tolerance"))
     t.tolerance = nonNegative("the tolerance");
   endOfLine("the tolerance");
-  if (version_ >= kVersion) {
+  if (version_ >= kVersionWithSpindle) {
     // Which machine axes the three coordinates are: a mill's x y z, a lathe's z x y.
     if (line("axes")) {
       const Word *a = word("the first axis"), *b = word("the second axis"), *c = word("the third axis");
@@ -635,7 +648,8 @@ void Reader::segment(Trajectory &t, bool first) {
     prof.phases[k].duration = nonNegative("a phase's duration");
     prof.phases[k].jerk = real("a phase's jerk");
   }
-  if (version_ >= kVersion) {
+  Vec3 axis0 = Vec3::UnitZ(), axis1 = Vec3::UnitZ();
+  if (version_ >= kVersionWithSpindle) {
     // The spindle: its speed at both ends; a thread pass keeps it.
     keyword("spindle");
     info.spindle0 = real("the spindle speed at the start");
@@ -650,7 +664,27 @@ void Reader::segment(Trajectory &t, bool first) {
                                                       kRelTolerance * std::abs(info.spindle0)))
       fail(spindleAt, "a segment synchronised with the spindle (a thread pass) needs it turning at one speed, not " +
                           number(info.spindle0) + " to " + number(info.spindle1) + " rev/min");
-    endOfLine("the synchronisation");
+    if (version_ >= kVersionWithToolAxes) {
+      // The tool axis at the segment's start and end (unit vectors), and
+      // the machine axis whose limit capped its speed (none: no axis's).
+      keyword("tool");
+      const uint64_t toolAt = last_;
+      axis0 = point("the tool axis at the start");
+      axis1 = point("the tool axis at the end");
+      if (ok_ && !(std::abs(axis0.norm() - 1) <= kRelTolerance && std::abs(axis1.norm() - 1) <= kRelTolerance))
+        fail(toolAt, "the tool axes are unit vectors, not of lengths " + number(axis0.norm()) + " and " +
+                         number(axis1.norm()));
+      keyword("limited_axis");
+      if (const Word *w = word("the limiting axis (a name, or none)"); w && w->text != "none") {
+        auto it = std::find(t.axisNames.begin(), t.axisNames.end(), std::string(w->text));
+        if (it == t.axisNames.end())
+          it = t.axisNames.insert(t.axisNames.end(), std::string(w->text));
+        info.axis = static_cast<int8_t>(it - t.axisNames.begin());
+      }
+      endOfLine("the limiting axis");
+    } else {
+      endOfLine("the synchronisation");
+    }
   } else {
     endOfLine("the last phase");
   }
@@ -732,6 +766,8 @@ void Reader::segment(Trajectory &t, bool first) {
   }
   v1_ = prof.v1();
   a1_ = prof.a1();
+  seg.axis0 = axis0.normalized();
+  seg.axis1 = axis1.normalized();
   t.segments.push_back(seg);
   t.profiles.push_back(prof);
   t.info.push_back(info);

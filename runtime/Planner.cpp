@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <limits>
 #include <numbers>
+#include <optional>
 
 #if defined(__linux__)
 #include <sys/mman.h>
@@ -26,6 +27,12 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kCurveAccel = 0.8;
 constexpr double kCurveJerk = 0.6;
 constexpr double kCouplingJerk = 0.2;
+/// Joint units per mm (and per mm^2): a jump of a joint's rate at a junction
+/// below this is the finite differences' noise, not a kink.
+constexpr double kJointKink = 1e-6;
+/// mm or deg: joints that must move further than this with the tip still
+/// turn first (a dwell); less is the inverse kinematics' rounding.
+constexpr double kJointTurn = 1e-6;
 
 /// Turning more than this (radians) is a reversal: the tool stops.
 constexpr double kReversal = 179.0 * std::numbers::pi / 180.0;
@@ -91,6 +98,8 @@ struct Piece {
     s.startAngle = startAngle;
     s.sweep = sweep;
     s.ccw = ccw;
+    s.axis0 = move == 0 ? input.startAxis : input.moves[move - 1].axis;
+    s.axis1 = input.moves[move].axis;
   }
 };
 
@@ -451,6 +460,13 @@ public:
       axes_[k] = {ax.velocity / 60, ax.acceleration, ax.jerk, kCurveAccel * ax.acceleration, kCurveJerk * ax.jerk,
                   kCouplingJerk * ax.jerk};
     }
+    // The rotary joints after x, y, z, in their order (AxisDemand::rotary1).
+    for (size_t k = 3; k < machine.axes.size() && rotaryCount_ < rotary_.size(); ++k) {
+      const Axis &ax = machine.axes[k];
+      rotaryIndex_[rotaryCount_] = static_cast<int8_t>(k);
+      rotary_[rotaryCount_++] = {ax.velocity / 60, ax.acceleration, ax.jerk, kCurveAccel * ax.acceleration,
+                                 kCurveJerk * ax.jerk, kCouplingJerk * ax.jerk};
+    }
   }
 
   /// The speed cap and the path acceleration and jerk for a segment whose
@@ -458,47 +474,54 @@ public:
   void limitsFor(const AxisDemand &d, double feed, SegmentInfo &info) const {
     double v = kInf;
     SpeedLimit by = SpeedLimit::Feed;
-    auto cap = [&](double value, SpeedLimit why) {
+    int8_t limiting = -1;
+    auto cap = [&](double value, SpeedLimit why, int8_t axis = -1) {
       if (value < v) {
         v = value;
         by = why;
+        limiting = axis;
       }
     };
     if (feed > 0) {
       cap(feed, SpeedLimit::Feed);
       cap(maxFeed_, SpeedLimit::MachineFeed);
     }
-    for (size_t k = 0; k < count_; ++k) {
-      const AxisBudget &ax = axes_[k];
-      if (d.r1[k] > 0)
-        cap(ax.velocity / d.r1[k], SpeedLimit::AxisVelocity);
-      if (d.r2[k] > 0)
-        cap(std::sqrt(ax.curveAccel / d.r2[k]), SpeedLimit::Acceleration);
-      if (d.r3[k] > 0) {
+    // Each joint's demand with its budget: x, y, z, then the rotary joints.
+    auto each = [&](auto &&visit) {
+      for (size_t k = 0; k < count_; ++k)
+        visit(axes_[k], d.r1[Eigen::Index(k)], d.r2[Eigen::Index(k)], d.r3[Eigen::Index(k)], static_cast<int8_t>(k));
+      for (size_t k = 0; k < rotaryCount_; ++k)
+        visit(rotary_[k], d.rotary1[k], d.rotary2[k], d.rotary3[k], rotaryIndex_[k]);
+    };
+    each([&](const AxisBudget &ax, double r1, double r2, double r3, int8_t axis) {
+      if (r1 > 0)
+        cap(ax.velocity / r1, SpeedLimit::AxisVelocity, axis);
+      if (r2 > 0)
+        cap(std::sqrt(ax.curveAccel / r2), SpeedLimit::Acceleration, axis);
+      if (r3 > 0) {
         // The cube root only where it may be the lower: above (1 + 1e-12) v^3
         // its root exceeds v by far more than cbrt's and the cube's rounding.
-        const double jerkRoom = ax.curveJerk / d.r3[k];
+        const double jerkRoom = ax.curveJerk / r3;
         if (!(jerkRoom > v * v * v * (1 + 1e-12)))
-          cap(std::cbrt(jerkRoom), SpeedLimit::Jerk);
+          cap(std::cbrt(jerkRoom), SpeedLimit::Jerk, axis);
       }
-    }
+    });
     double a = kInf, jerk = kInf;
-    for (size_t k = 0; k < count_; ++k) {
-      const AxisBudget &ax = axes_[k];
-      if (d.r1[k] <= 0)
-        continue;
-      double ak = (ax.acceleration - v * v * d.r2[k]) / d.r1[k];
-      if (d.r2[k] > 0 && v > 0)
-        ak = std::min(ak, ax.couplingJerk / (3 * v * d.r2[k]));
+    each([&](const AxisBudget &ax, double r1, double r2, double, int8_t) {
+      if (r1 <= 0)
+        return;
+      double ak = (ax.acceleration - v * v * r2) / r1;
+      if (r2 > 0 && v > 0)
+        ak = std::min(ak, ax.couplingJerk / (3 * v * r2));
       a = std::min(a, ak);
-    }
-    for (size_t k = 0; k < count_; ++k) {
-      const AxisBudget &ax = axes_[k];
-      if (d.r1[k] > 0)
-        jerk = std::min(jerk, (ax.jerk - v * v * v * d.r3[k] - 3 * v * a * d.r2[k]) / d.r1[k]);
-    }
+    });
+    each([&](const AxisBudget &ax, double r1, double r2, double r3, int8_t) {
+      if (r1 > 0)
+        jerk = std::min(jerk, (ax.jerk - v * v * v * r3 - 3 * v * a * r2) / r1);
+    });
     info.limits = {v, a, jerk};
     info.limitedBy = by;
+    info.axis = limiting;
   }
 
 private:
@@ -512,8 +535,82 @@ private:
   };
   size_t count_;
   std::array<AxisBudget, 3> axes_{};
+  /// The rotary joints (deg, deg/s, ...) and their index in Machine::axes.
+  size_t rotaryCount_ = 0;
+  std::array<AxisBudget, 3> rotary_{};
+  std::array<int8_t, 3> rotaryIndex_{};
   double maxFeed_ = kInf;  ///< mm/s, the controller's max_feed
 };
+
+/// The demand a segment that tilts the tool makes of the machine's joints:
+/// the joints at points along it (each solution the nearest the one before,
+/// starting from `near`, which is left at the segment's end), and their
+/// first three derivatives with respect to the tip's path by finite
+/// differences, with a margin. Points: every 2 deg the axis turns and at
+/// least 4 pieces. False (d unchanged) where a point is out of reach: the
+/// backends and the verifier refuse such a path before it is planned.
+/// The joints' first and second derivatives with respect to the tip's path
+/// at a segment's two ends (joint units per mm, per mm^2).
+struct JointEnds {
+  Joints d1Start, d1End, d2Start, d2End;
+};
+
+bool jointDemand(const Segment &seg, const Kinematics &kin, const Vec3 &offset, Joints &near, AxisDemand &d,
+                 JointEnds &ends) {
+  constexpr double kMargin = 1.25;  // what 16 or more pieces of differences may miss of a peak
+  const double turned = std::acos(std::clamp(seg.axis0.dot(seg.axis1), -1.0, 1.0)) * 180 / std::numbers::pi;
+  const int n = std::clamp(static_cast<int>(std::ceil(turned / 0.5)), 16, 64);
+  const double h = seg.length / n;
+  if (!(h > 0))
+    return false;
+  std::array<Joints, 65> q;
+  Joints at = near;
+  for (int i = 0; i <= n; ++i) {
+    const double s = seg.length * i / n;
+    const InverseResult r = kin.inverse({seg.at(s).p + offset, seg.axisAt(s)}, &at);
+    if (!r.joints)
+      return false;
+    at = *r.joints;
+    q[static_cast<size_t>(i)] = at;
+  }
+  near = at;
+  ends.d1Start = (q[1] - q[0]) / h;
+  ends.d1End = (q[size_t(n)] - q[size_t(n - 1)]) / h;
+  // The second derivatives near the ends: their largest over the segment
+  // (below), a bound for what finite differences see at the ends.
+  AxisDemand out;
+  size_t rotary = 0;
+  for (Eigen::Index k = 0; k < near.size(); ++k) {
+    double r1 = 0, r2 = 0, r3 = 0;
+    for (int i = 0; i < n; ++i)
+      r1 = std::max(r1, std::abs(q[size_t(i + 1)][k] - q[size_t(i)][k]) / h);
+    for (int i = 1; i < n; ++i)
+      r2 = std::max(r2, std::abs(q[size_t(i + 1)][k] - 2 * q[size_t(i)][k] + q[size_t(i - 1)][k]) / (h * h));
+    for (int i = 1; i + 1 < n; ++i)
+      r3 = std::max(r3, std::abs(q[size_t(i + 2)][k] - 3 * q[size_t(i + 1)][k] + 3 * q[size_t(i)][k] -
+                                 q[size_t(i - 1)][k]) /
+                            (h * h * h));
+    if (k < 3) {
+      out.r1[k] = kMargin * r1;
+      out.r2[k] = kMargin * r2;
+      out.r3[k] = kMargin * r3;
+    } else if (rotary < out.rotary1.size()) {
+      out.rotary1[rotary] = kMargin * r1;
+      out.rotary2[rotary] = kMargin * r2;
+      out.rotary3[rotary] = kMargin * r3;
+      ++rotary;
+    }
+  }
+  // The joints' curvature cannot be less than the path's own (the tip's
+  // path is what the linear joints carry, turned).
+  out.r2 = out.r2.cwiseMax(d.r2);
+  out.r3 = out.r3.cwiseMax(d.r3);
+  d = out;
+  ends.d2Start = ends.d2End = Joints::Zero(near.size());
+  for (Eigen::Index k = 0; k < near.size(); ++k)
+    ends.d2Start[k] = ends.d2End[k] = k < 3 ? d.r2[k] : d.rotary2[size_t(std::min<Eigen::Index>(k - 3, 2))];
+  return true;
+}
 
 /// The curvature vector of the circle through the vertex between lines a and
 /// b and the vertices before and after it; zero when either is not a line.
@@ -628,6 +725,8 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   out.tolerance = tolerance;
   out.cycleTime = machine.cycleTime;
   out.start = input.start;
+  for (const Axis &a : machine.axes)
+    out.axisNames.push_back(a.name);
 
   // 1. One piece per move with any length; dwells stop the tool between
   // pieces.
@@ -683,13 +782,139 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   lengths.reserve(count);
   // d is the last segment's demand().
   const SpeedBudget budget(machine);
-  auto push = [&](double feed, uint32_t move, uint32_t next, StopReason stop, const AxisDemand &d) {
-    lengths.push_back(out.segments.back().length);
+  // 5-axis: where the joints are, for the next segment that tilts the tool;
+  // the joints' derivatives at the end of the segment before; and the speed
+  // each junction may be passed at (joints' rates that jump there).
+  Joints joints;
+  std::optional<JointEnds> lastEnds;
+  bool lastTilted = false;
+  std::vector<double> junctionCap;
+  if (options.kinematics) {
+    joints = Joints::Zero(static_cast<Eigen::Index>(options.kinematics->jointCount()));
+    junctionCap.reserve(count);
+  }
+  // Each dwell segment's wait, in the order of the segments.
+  std::vector<double> dwellTimes;
+  // A segment that tilts the tool and starts where the tool lies along a
+  // rotary axis (upright, after a step that does not tilt it, or where its
+  // axis passes that way): the free axis is set from where the tool axis
+  // goes (the other solutions would swing it as the tool leaves), and the
+  // joints that must move to get there turn first, the tip at rest: a
+  // dwell as long as the slowest of them takes, from rest to rest within
+  // its limits (the tool stops there).
+  auto turnFirst = [&](StopReason &stop, uint32_t move, bool fromMiddle) {
+    Segment &seg = out.segments.back();
+    const Kinematics &kin = *options.kinematics;
+    const Vec3 offset = options.workOffset;
+    // At a rapid that turns the tool, the rotary axes start again from the
+    // solution nearest the middle of their travel (0), as the G-code
+    // targets turn them (docs/five-axis.md): the path after has the most
+    // travel either way.
+    Joints near = joints;
+    if (fromMiddle)
+      for (size_t k = 3; k < machine.axes.size() && Eigen::Index(k) < near.size(); ++k)
+        if (machine.axes[k].rotary)
+          near[Eigen::Index(k)] = 0;
+    InverseResult at = kin.inverse({seg.start + offset, seg.axis0}, &near);
+    if (!at.joints)
+      return;
+    if (at.singular && seg.length > 0) {
+      const double ahead = std::min(seg.length, 1e-3);
+      const InverseResult next = kin.inverse({seg.at(ahead).p + offset, seg.axisAt(ahead)}, &joints);
+      if (next.joints)
+        at = kin.inverse({seg.start + offset, seg.axis0}, &*next.joints);
+      if (!at.joints)
+        return;
+    }
+    // Joints that agree within what the inverse kinematics' rounding leaves
+    // need no turn.
+    double wait = 0;
+    for (size_t k = 0; k < machine.axes.size() && Eigen::Index(k) < joints.size(); ++k) {
+      const double move = std::abs((*at.joints)[Eigen::Index(k)] - joints[Eigen::Index(k)]);
+      const Axis &axis = machine.axes[k];
+      if (move > kJointTurn)
+        wait = std::max(wait, planProfile(0, 0, move, {axis.velocity / 60, axis.acceleration, axis.jerk}).duration());
+    }
+    joints = *at.joints;
+    if (!(wait > 0))
+      return;
+    Segment moved = std::move(seg);
+    out.segments.pop_back();
+    Segment turn = Segment::dwell(moved.start);
+    turn.axis0 = turn.axis1 = moved.axis0;
+    out.segments.push_back(std::move(turn));
+    lengths.push_back(0);
+    SegmentInfo &info = out.info.emplace_back();
+    info.stop = StopReason::Dwell;
+    info.move = info.nextMove = move;
+    junctionCap.push_back(kInf);
+    dwellTimes.push_back(wait);
+    out.segments.push_back(std::move(moved));
+    stop = StopReason::Dwell;
+  };
+  auto push = [&](double feed, uint32_t move, uint32_t next, StopReason stop, const AxisDemand &given) {
+    if (options.kinematics && out.segments.back().tilted()) {
+      const Segment &here = out.segments.back();
+      turnFirst(stop, move, feed == 0 && here.kind == SegmentKind::Line && here.axis0 != here.axis1);
+    }
+    const Segment &seg = out.segments.back();
+    lengths.push_back(seg.length);
     SegmentInfo &info = out.info.emplace_back();
     info.feed = feed;
     info.move = move;
     info.nextMove = next;
     info.stop = stop;
+    AxisDemand d = given;
+    if (!options.kinematics) {
+      budget.limitsFor(d, feed, info);
+      return;
+    }
+    // The joints' rates at the segment's ends: by the inverse kinematics on
+    // a segment that tilts the tool, else the tip's own (the rotary axes
+    // still; the tool upright keeps them at 0).
+    std::optional<JointEnds> ends;
+    const bool tilted = seg.tilted();
+    if (tilted) {
+      JointEnds e;
+      if (jointDemand(seg, *options.kinematics, options.workOffset, joints, d, e))
+        ends = e;
+    } else if (seg.kind != SegmentKind::Dwell && seg.length > 0) {
+      JointEnds e;
+      const Eigen::Index count = joints.size();
+      e.d1Start = e.d1End = e.d2Start = e.d2End = Joints::Zero(count);
+      const PathPoint a = seg.at(0), b = seg.at(seg.length);
+      e.d1Start.head<3>() = a.r1;
+      e.d1End.head<3>() = b.r1;
+      e.d2Start.head<3>() = d.r2;
+      e.d2End.head<3>() = d.r2;
+      ends = e;
+    }
+    // A junction next to a segment that tilts the tool, where the joints'
+    // rates jump (the axis turning at another rate on either side): what a
+    // jump of velocity or acceleration within one cycle would cost in jerk
+    // bounds the speed there (in practice the tool stops for an orientation
+    // that turns at a new rate; smoothing it is not done yet).
+    double cap = kInf;
+    if (stop == StopReason::None && ends && lastEnds && (tilted || lastTilted)) {
+      const double cycle = machine.cycleTime > 0 ? machine.cycleTime : 0.001;
+      for (Eigen::Index k = 0; k < joints.size() && size_t(k) < machine.axes.size(); ++k) {
+        const double jk = machine.axes[size_t(k)].jerk;
+        // The rates' jump; the second derivatives' by their bounds on the
+        // two sides (what finite differences give at an end is not sharp).
+        const double dv = std::abs(ends->d1Start[k] - lastEnds->d1End[k]);
+        const double da = std::abs(ends->d2Start[k]) + std::abs(lastEnds->d2End[k]);
+        // Half of each to the velocity's jump and to the acceleration's,
+        // and half again for the ends' rates, which the differences over a
+        // piece of the segment see less sharp than they are.
+        if (dv > kJointKink)
+          cap = std::min(cap, 0.25 * jk * cycle * cycle / dv);
+        if (da > kJointKink)
+          cap = std::min(cap, std::sqrt(0.25 * jk * cycle / da));
+      }
+    }
+    junctionCap.push_back(cap);
+    lastEnds = ends;
+    lastTilted = tilted;
     budget.limitsFor(d, feed, info);
   };
   StopReason stop = StopReason::Start;
@@ -706,6 +931,9 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
       info.nextMove = d.move;
       info.stop = StopReason::Dwell;
       stop = StopReason::Dwell;
+      dwellTimes.push_back(d.timeS);
+      if (options.kinematics)
+        junctionCap.push_back(kInf);
     }
   };
   {
@@ -727,12 +955,16 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
             feed = std::max(prev.feed, p.feed);
           AxisDemand demand;
           out.segments.push_back(Segment::blend(blendBetween(prev, before, p, here), demand));
+          out.segments.back().axis0 = before.axisAt(before.length - prev.cutEnd);
+          out.segments.back().axis1 = here.axisAt(p.cutStart);
           push(feed, prev.move, p.move, stop, demand);
           stop = StopReason::None;
         }
       }
       if (p.keepsMiddle()) {
         out.segments.push_back(here.part(p.cutStart, here.length - p.cutEnd));
+        out.segments.back().axis0 = here.axisAt(p.cutStart);
+        out.segments.back().axis1 = here.axisAt(here.length - p.cutEnd);
         push(p.feed, p.move, p.move, stop, out.segments.back().demand());
         stop = StopReason::None;
       }
@@ -767,8 +999,10 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
     r.length = lengths[k];
     r.limits = out.info[k].limits;
     double highest = r.limits.v;
+    auto junctionFree = [&](size_t j) { return junctionCap.empty() || junctionCap[j] == kInf; };
     if (isShort(k)) {
-      while (r.last + 1 < n && out.info[r.last + 1].stop == StopReason::None && isShort(r.last + 1)) {
+      while (r.last + 1 < n && out.info[r.last + 1].stop == StopReason::None && isShort(r.last + 1) &&
+             junctionFree(r.last + 1)) {
         const PathLimits &l = out.info[r.last + 1].limits;
         if (std::min(r.limits.v, l.v) < kRunCapSpread * std::max(highest, l.v))
           break;
@@ -785,8 +1019,11 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   // 5. Speeds where runs meet: caps, then backward and forward look-ahead.
   const size_t m = runs.size();
   std::vector<double> vj(m + 1, 0.0);
-  for (size_t r = 1; r < m; ++r)
+  for (size_t r = 1; r < m; ++r) {
     vj[r] = runs[r].fromRest ? 0 : std::min(runs[r - 1].limits.v, runs[r].limits.v);
+    if (!junctionCap.empty())
+      vj[r] = std::min(vj[r], junctionCap[runs[r].first]);
+  }
   // A run's far end bounds its near end by the speed reachable from it over
   // the run (reachableSpeed), which binds only where the change between the
   // two does not fit in the run's length: where it fits (or the near end is
@@ -809,7 +1046,7 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   for (size_t r = 0; r < m; ++r) {
     const Run &run = runs[r];
     if (lengths[run.first] == 0) {  // only dwells have no length (moves of none make no piece)
-      out.profiles.push_back(dwellProfile(dwells[dwellAt++].timeS));
+      out.profiles.push_back(dwellProfile(dwellTimes[dwellAt++]));
       continue;
     }
     const Profile whole = planProfile(vj[r], vj[r + 1], run.length, run.limits);

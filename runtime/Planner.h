@@ -20,12 +20,20 @@
 //  5. Profiles. Each run gets its fastest seven-phase profile between those
 //     speeds, with zero acceleration at both ends.
 //
+// A path that tilts the tool (5-axis, PlanOptions::kinematics) is planned on
+// the tool tip's path, as a controller with tool-centre-point control runs
+// it, with step 2's caps taken from every joint: the joints at points along
+// each segment (inverse kinematics), their derivatives with respect to the
+// tip's path by finite differences; the joint whose limit is lowest is
+// recorded (SegmentInfo::axis).
+//
 // A dwell stops the tool: the move before it ends at rest, the move after
 // it starts from rest, and between them a dwell segment (SegmentKind::Dwell,
 // stop reason Dwell, as the segment after it) holds the tool at the point
 // for the dwell's time.
 #pragma once
 
+#include "runtime/Kinematics.h"
 #include "runtime/Machine.h"
 #include "runtime/Trajectory.h"
 
@@ -45,10 +53,14 @@ struct PathMove {
   double feed = 0;             ///< mm/min; 0 = rapid (the axes' speed)
   bool stopBefore = false;     ///< the tool is at rest before this move
   double dwellS = 0;           ///< dwells: s the tool waits
+  /// The tool axis at the move's end (5-axis; the tip's path is `to`'s):
+  /// it turns evenly from the one before along the move.
+  Vec3 axis = Vec3::UnitZ();
 };
 
 struct PathInput {
   Vec3 start = Vec3::Zero();  ///< where the tool is, at rest
+  Vec3 startAxis = Vec3::UnitZ();
   std::vector<PathMove> moves;
 };
 
@@ -56,6 +68,12 @@ struct PlanOptions {
   /// mm; blends stay this close to the programmed path (default: the
   /// machine's path tolerance).
   double tolerance = 0;
+  /// A 5-axis machine's kinematics and where the workpiece's origin is on
+  /// it (machine coordinates with every axis at 0): the segments that tilt
+  /// the tool are capped by every joint's limits, the joints found by the
+  /// inverse kinematics along them. Without it the path is the axes'.
+  const Kinematics *kinematics = nullptr;
+  Vec3 workOffset = Vec3::Zero();
 };
 
 /// Plans the moves on the machine. Moves of zero length and dwells of no

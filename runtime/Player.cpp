@@ -42,6 +42,10 @@ constexpr double kTwoPi = 2 * std::numbers::pi;
 /// Relative slack on every limit: the planner may use a limit exactly, and
 /// the derivatives carry rounding.
 constexpr double kSlack = 1e-6;
+/// The joints' dynamics of a segment that tilts the tool come from differences
+/// between samples (one sample period behind the analytic values) and from
+/// the planner's sampled demand: 2 % beyond a limit is a violation.
+constexpr double kJointSlack = 0.02;
 constexpr double kEndPositionTol = 1e-9;       // mm, against the last segment's end
 constexpr double kProgrammedEndTol = 1e-6;     // mm, against the last programmed point
 constexpr double kEndSpeedTol = 1e-9;          // mm/s
@@ -352,7 +356,63 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
         return false;
     return true;
   };
-  auto checkTravelAt = [&](const Vec3 &p, double t, uint32_t sg) {
+  // A segment that tilts the tool moves the machine's joints otherwise than
+  // its tip: their velocity, acceleration and jerk are taken from the joints
+  // at consecutive samples (differences over the sample period), each
+  // against its axis's limits; the tip's own are not the axes'.
+  struct JointSample {
+    double t = 0;
+    Joints q, v, a;
+    bool hasV = false, hasA = false;  ///< v and a are differences of samples, not placeholders
+  };
+  std::vector<JointSample> history;  // the last two samples with joints
+  r.jointMaxVelocity.assign(machine.axes.size(), 0);
+  r.jointMaxAcceleration.assign(machine.axes.size(), 0);
+  r.jointMaxJerk.assign(machine.axes.size(), 0);
+  auto jointDynamics = [&](double t, uint32_t sg, bool tilted) {
+    JointSample now;
+    now.t = t;
+    now.q = joints;
+    now.v = now.a = Joints::Zero(joints.size());
+    Joints jerk = Joints::Zero(joints.size());
+    const bool withV = !history.empty() && t > history.back().t;
+    if (withV)
+      now.v = (now.q - history.back().q) / (t - history.back().t);
+    const bool withA = withV && history.back().hasV;
+    if (withA)
+      now.a = (now.v - history.back().v) / (t - history.back().t);
+    const bool withJ = withA && history.back().hasA;
+    if (withJ)
+      jerk = (now.a - history.back().a) / (t - history.back().t);
+    now.hasV = withV;
+    now.hasA = withA;
+    if (tilted && withV) {
+      r.tiltedSamples++;
+      for (size_t k = 0; k < machine.axes.size(); ++k) {
+        const Eigen::Index i = static_cast<Eigen::Index>(k);
+        const Axis &axis = machine.axes[k];
+        const double v = std::abs(now.v[i]), acc = std::abs(now.a[i]), j = std::abs(jerk[i]);
+        r.jointMaxVelocity[k] = std::max(r.jointMaxVelocity[k], v);
+        if (v > axis.velocity / 60 * (1 + kJointSlack) + 1e-6)
+          violate(ViolationKind::Velocity, static_cast<int>(k), t, sg, v, axis.velocity / 60);
+        if (withA) {
+          r.jointMaxAcceleration[k] = std::max(r.jointMaxAcceleration[k], acc);
+          if (acc > axis.acceleration * (1 + kJointSlack) + 1e-6)
+            violate(ViolationKind::Acceleration, static_cast<int>(k), t, sg, acc, axis.acceleration);
+        }
+        if (withJ) {
+          r.jointMaxJerk[k] = std::max(r.jointMaxJerk[k], j);
+          if (j > axis.jerk * (1 + kJointSlack) + 1e-6)
+            violate(ViolationKind::Jerk, static_cast<int>(k), t, sg, j, axis.jerk);
+        }
+      }
+    }
+    if (history.size() == 2)
+      history.erase(history.begin());
+    history.push_back(std::move(now));
+  };
+  auto checkTravelAt = [&](const Vec3 &p, const Vec3 &toolAxis, bool tilted, double t, uint32_t sg,
+                           const std::optional<ToolPose> &ahead, bool fromMiddle) {
     if (!checkTravel)
       return;
     const Vec3 tip = p + offset;
@@ -364,13 +424,37 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
       haveJoints = true;
       return;
     }
-    const InverseResult ir = kinematics->inverse(ToolPose{tip, Vec3::UnitZ()}, haveJoints ? &joints : nullptr);
+    // The planner's choice at a rapid that turns the tool: the rotary axes
+    // start again from the solution nearest the middle of their travel.
+    Joints near = joints;
+    if (fromMiddle)
+      for (size_t k = 0; k < machine.axes.size(); ++k)
+        if (machine.axes[k].rotary)
+          near[static_cast<Eigen::Index>(k)] = 0;
+    InverseResult ir = kinematics->inverse(ToolPose{tip, toolAxis}, haveJoints ? &near : nullptr);
     if (!ir.joints)
       return;  // not on a chain whose rotary axes can stay at 0 (whyNotThreeAxis says so)
+    if (ir.singular && tilted && ahead) {
+      // The tool along a rotary axis leaves the other free: it is where the
+      // tool axis goes next (as the planner set it).
+      const InverseResult next = kinematics->inverse(*ahead, &*ir.joints);
+      if (next.joints) {
+        const InverseResult again = kinematics->inverse(ToolPose{tip, toolAxis}, &*next.joints);
+        if (again.joints)
+          ir = again;
+      }
+    }
     joints = *ir.joints;
     for (size_t k = 0; k < machine.axes.size(); ++k)
       checkAxis(k, joints[static_cast<Eigen::Index>(k)], t, sg);
     haveJoints = true;
+    // A dwell where the joints turn with the tip still (the planner timed
+    // the turn from the joints' limits): the differences start again after.
+    if (trajectory.segments.size() > sg && trajectory.segments[sg].kind == SegmentKind::Dwell) {
+      history.clear();
+      return;
+    }
+    jointDynamics(t, sg, tilted);
   };
 
   // The segment under the samples, and what is known of it.
@@ -422,6 +506,7 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
     enter(0);
 
   const double lastRegular = duration - 1e-9 * period;
+  size_t lastJointSegment = std::numeric_limits<size_t>::max();  // the segment of the last sample's joints
   Sample s, prev;
   bool havePrev = false;
   for (size_t k = 0;; ++k) {
@@ -458,7 +543,9 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
       s.speed = ps.v;
 
       const uint32_t sg = s.segment;
-      for (int a = 0; a < 3; ++a) {
+      // A segment that tilts the tool: the joints' dynamics are checked
+      // instead (checkTravelAt), not the tip's.
+      for (int a = 0; a < 3 && !trajectory.segments[seg].tilted(); ++a) {
         const double v = std::abs(s.v[a]), acc = std::abs(s.a[a]), j = std::abs(s.j[a]);
         r.maxVelocity[a] = std::max(r.maxVelocity[a], v);
         r.maxAcceleration[a] = std::max(r.maxAcceleration[a], acc);
@@ -523,7 +610,27 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
       }
     }
 
-    checkTravelAt(s.p, s.t, s.segment);
+    {
+      const Segment *here = n > 0 ? &trajectory.segments[seg] : nullptr;
+      const bool tilted = here && here->tilted();
+      const double along = tilted ? trajectory.profiles[seg].at(final ? durations[seg] : t - segStart).s : 0;
+      const Vec3 toolAxis = tilted ? here->axisAt(along) : Vec3::UnitZ();
+      // Where the tool axis goes next: a little further along, or (a dwell)
+      // the next segment's start.
+      std::optional<ToolPose> ahead;
+      if (tilted && here->length > 0) {
+        const double s1 = std::min(here->length, along + 1e-3);
+        ahead = ToolPose{here->at(s1).p + offset, here->axisAt(s1)};
+      } else if (tilted && seg + 1 < n) {
+        const Segment &next = trajectory.segments[seg + 1];
+        const double s1 = std::min(next.length, 1e-3);
+        ahead = ToolPose{next.at(s1).p + offset, next.axisAt(s1)};
+      }
+      const bool turning = tilted && trajectory.info[seg].feed == 0 && here->kind == SegmentKind::Line &&
+                           here->axis0 != here->axis1;
+      checkTravelAt(s.p, toolAxis, tilted, s.t, s.segment, ahead, turning && seg != lastJointSegment);
+      lastJointSegment = seg;
+    }
     if (onSample)
       onSample(s);
     prev = s;
@@ -585,6 +692,11 @@ std::string seconds(double t) { return formatFixed(t, 3) + " s"; }
 std::string perMinute(double mmPerS) { return formatFixed(mmPerS * 60, 1) + " mm/min"; }
 std::string percent(double fraction) { return formatFixed(fraction * 100, 1) + " %"; }
 
+/// "mm", or "deg" for a rotary axis.
+std::string unitOf(const Machine &machine, int axis) {
+  return axis >= 0 && size_t(axis) < machine.axes.size() && machine.axes[size_t(axis)].rotary ? "deg" : "mm";
+}
+
 std::string axisName(const Machine &machine, int axis) {
   if (axis >= 0 && static_cast<size_t>(axis) < machine.axes.size())
     return machine.axes[static_cast<size_t>(axis)].name;
@@ -642,7 +754,13 @@ std::string formatReport(const SimReport &report, const Trajectory &trajectory, 
       for (const SlowSpot &spot : report.slowest)
         out += "  " + name(spot.move) + " (segment " + std::to_string(spot.segment) + "): " + perMinute(spot.speed) +
                " of " + perMinute(spot.feed) + " (" + percent(spot.feed > 0 ? spot.speed / spot.feed : 0) + "), " +
-               reasonText(spot.reason, spot.limitedBy) + "\n";
+               reasonText(spot.reason, spot.limitedBy) +
+               (spot.reason == SlowReason::Cap && spot.segment < trajectory.info.size() &&
+                        trajectory.info[spot.segment].axis >= 0 &&
+                        size_t(trajectory.info[spot.segment].axis) < trajectory.axisNames.size()
+                    ? " (axis " + trajectory.axisNames[size_t(trajectory.info[spot.segment].axis)] + ")"
+                    : std::string()) +
+               "\n";
     }
   } else {
     out += "feed on feed moves: no feed moves\n";
@@ -656,6 +774,22 @@ std::string formatReport(const SimReport &report, const Trajectory &trajectory, 
            of(report.maxVelocity[k] * 60, axis.velocity) + ", |a| " + formatFixed(report.maxAcceleration[k], 1) +
            " mm/s^2" + of(report.maxAcceleration[k], axis.acceleration) + ", |j| " +
            formatFixed(report.maxJerk[k], 1) + " mm/s^3" + of(report.maxJerk[k], axis.jerk) + "\n";
+  }
+  if (report.tiltedSamples > 0) {
+    // Where the tool tilts the axes are the joints (differences of samples).
+    out += "joint peaks where the tool tilts (" + std::to_string(report.tiltedSamples) +
+           " samples; of the limit):\n";
+    for (size_t k = 0; k < machine.axes.size() && k < report.jointMaxVelocity.size(); ++k) {
+      const Axis &axis = machine.axes[k];
+      const std::string unit = unitOf(machine, static_cast<int>(k));
+      auto of = [](double value, double limit) { return limit > 0 ? " (" + percent(value / limit) + ")" : ""; };
+      out += "  " + axis.name + ": |v| " + formatFixed(report.jointMaxVelocity[k] * 60, 1) + " " + unit + "/min" +
+             of(report.jointMaxVelocity[k] * 60, axis.velocity) + ", |a| " +
+             formatFixed(report.jointMaxAcceleration[k], 1) + " " + unit + "/s^2" +
+             of(report.jointMaxAcceleration[k], axis.acceleration) + ", |j| " +
+             formatFixed(report.jointMaxJerk[k], 1) + " " + unit + "/s^3" + of(report.jointMaxJerk[k], axis.jerk) +
+             "\n";
+    }
   }
 
   // Travel: the range each axis covers, against its travel.
@@ -708,15 +842,17 @@ std::string formatReport(const SimReport &report, const Trajectory &trajectory, 
     out += "segment " + std::to_string(v.segment);
     switch (v.kind) {
     case ViolationKind::Velocity:
-      out += ", axis " + axisName(machine, v.axis) + ": velocity " + perMinute(v.value) + " > " + perMinute(v.limit);
+      out += ", axis " + axisName(machine, v.axis) + ": velocity " + formatFixed(v.value * 60, 1) + " " +
+             unitOf(machine, v.axis) + "/min > " + formatFixed(v.limit * 60, 1) + " " + unitOf(machine, v.axis) +
+             "/min";
       break;
     case ViolationKind::Acceleration:
-      out += ", axis " + axisName(machine, v.axis) + ": acceleration " + formatFixed(v.value, 1) + " mm/s^2 > " +
-             formatFixed(v.limit, 1) + " mm/s^2";
+      out += ", axis " + axisName(machine, v.axis) + ": acceleration " + formatFixed(v.value, 1) + " " +
+             unitOf(machine, v.axis) + "/s^2 > " + formatFixed(v.limit, 1) + " " + unitOf(machine, v.axis) + "/s^2";
       break;
     case ViolationKind::Jerk:
-      out += ", axis " + axisName(machine, v.axis) + ": jerk " + formatFixed(v.value, 1) + " mm/s^3 > " +
-             formatFixed(v.limit, 1) + " mm/s^3";
+      out += ", axis " + axisName(machine, v.axis) + ": jerk " + formatFixed(v.value, 1) + " " +
+             unitOf(machine, v.axis) + "/s^3 > " + formatFixed(v.limit, 1) + " " + unitOf(machine, v.axis) + "/s^3";
       break;
     case ViolationKind::Feed:
       out += ": speed " + perMinute(v.value) + " above the programmed feed " + perMinute(v.limit);

@@ -11,11 +11,14 @@
 // Values are the analytic derivatives at the sample times. Each is also
 // checked against its neighbour sample, |a(t+T) - a(t)| <= j_max T, so a jump
 // between samples (a curvature step, a profile that does not join) cannot hide
-// between two samples.
+// between two samples. On a segment that tilts the tool the axes are the
+// joints: their velocity, acceleration and jerk are the differences of the
+// joints (inverse kinematics) between consecutive samples, checked against
+// every axis's limits, rotary ones included.
 //
 // Travel and spindle: each sample's position is mapped through the machine's
-// kinematics (runtime/Kinematics.h; rotary axes at 0, tool along +z) to its
-// axes' positions; on an xyz machine it is the axes' position, compared with
+// kinematics (runtime/Kinematics.h; rotary axes at 0, tool along +z, or on a
+// segment that tilts the tool along its axis there) to its axes' positions; on an xyz machine it is the axes' position, compared with
 // bounds taken once. With the program origin's place on the machine given
 // (SimOptions::workOffsetMm) each is checked against its travel; without
 // it, only that the program's extent on each axis fits the travel somewhere.
@@ -136,6 +139,11 @@ struct SimReport {
   /// program's. Empty when the travel was not checked.
   std::vector<double> axisMin, axisMax;
   std::string travelNotChecked;  ///< why the travel was not checked (empty when it was)
+  /// Segments that tilt the tool (5-axis): the samples on them, and per
+  /// machine axis the largest |v|, |a|, |j| of the joints there (mm or deg,
+  /// per s, s^2, s^3; by differences between samples).
+  size_t tiltedSamples = 0;
+  std::vector<double> jointMaxVelocity, jointMaxAcceleration, jointMaxJerk;
   std::optional<Vec3> workOffsetMm;  ///< as given: positions checked, else extents only
   bool spindleChecked = false;
   double spindleMinRpm = 0, spindleMaxRpm = 0;  ///< over moves with the spindle turning (when checked)

@@ -1,5 +1,7 @@
 #include "runtime/Segment.h"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -329,14 +331,30 @@ Segment Segment::arcTurns(const Vec3 &from, const Vec3 &to, const Vec3 &center, 
   return s;
 }
 
+Vec3 axisBetween(const Vec3 &u, const Vec3 &w, double t) {
+  if (t <= 0 || u == w)
+    return u;
+  if (t >= 1)
+    return w;
+  // The rotation taking u to w, a fraction t of it (a great circle).
+  const Eigen::Quaterniond turn = Eigen::Quaterniond::FromTwoVectors(u, w);
+  return (Eigen::Quaterniond::Identity().slerp(t, turn) * u).normalized();
+}
+
 Segment Segment::part(double s0, double s1) const {
   s0 = std::clamp(s0, 0.0, length);
   s1 = std::clamp(s1, s0, length);
   if (s0 <= 0 && s1 >= length)
     return *this;
-  if (kind == SegmentKind::Line)
-    return line(at(s0).p, at(s1).p);
+  if (kind == SegmentKind::Line) {
+    Segment out = line(at(s0).p, at(s1).p);
+    out.axis0 = axisAt(s0);
+    out.axis1 = axisAt(s1);
+    return out;
+  }
   Segment out = *this;
+  out.axis0 = axisAt(s0);
+  out.axis1 = axisAt(s1);
   if (kind == SegmentKind::Arc) {
     const double rise = sweep > 0 ? (end.z() - start.z()) / sweep : 0;
     const double k = std::sqrt(radius * radius + rise * rise);

@@ -37,7 +37,15 @@ struct AxisDemand {
   Vec3 r1 = Vec3::Zero();
   Vec3 r2 = Vec3::Zero();
   Vec3 r3 = Vec3::Zero();
+  /// On a segment that tilts the tool (5-axis), r1..r3 are the machine's
+  /// linear joints' and these its rotary joints', in Machine::axes order
+  /// after x, y, z: deg per mm of the tip's path, and its derivatives.
+  std::array<double, 3> rotary1{}, rotary2{}, rotary3{};
 };
+
+/// The tool axis a fraction t (0..1) of the way from unit vector u to w:
+/// turning evenly in the plane of the two (the toolpath IR's rule).
+Vec3 axisBetween(const Vec3 &u, const Vec3 &w, double t);
 
 /// A quintic Bezier curve (the blends) in power form: B(u) = sum c[k] u^k.
 struct QuinticCurve {
@@ -75,6 +83,15 @@ struct Segment {
   double startAngle = 0;
   double sweep = 0;
   bool ccw = true;
+
+  // The tool axis (a unit vector from the tip towards the spindle) at the
+  // start and at the end, turning evenly along the segment (axisBetween by
+  // the fraction of its length); +z on a 3-axis path.
+  Vec3 axis0 = Vec3::UnitZ();
+  Vec3 axis1 = Vec3::UnitZ();
+  bool tilted() const { return axis0 != Vec3::UnitZ() || axis1 != Vec3::UnitZ(); }
+  /// The tool axis at arc length s.
+  Vec3 axisAt(double s) const { return length > 0 ? axisBetween(axis0, axis1, std::clamp(s / length, 0.0, 1.0)) : axis1; }
 
   // Blend: a quintic Bezier curve; ctrl[0] = start, ctrl[5] = end.
   std::array<Vec3, 6> ctrl{Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};

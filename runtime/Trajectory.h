@@ -52,6 +52,9 @@ struct SegmentInfo {
   uint32_t move = 0;                    ///< index of the programmed move it follows
   uint32_t nextMove = 0;                ///< blends: the move it joins to (else = move)
   StopReason stop = StopReason::None;   ///< why the segment starts at rest
+  /// Which of the machine's axes (Machine::axes index) set the cap when
+  /// limitedBy is an axis's velocity, acceleration or jerk; -1 otherwise.
+  int8_t axis = -1;
   /// Lathes (Frame::Zxy): the spindle's speed at the segment's start and at
   /// its end, rev/min (negative: turning the other way, M4), changing
   /// linearly with time in between.
@@ -74,6 +77,8 @@ struct Trajectory {
   double cycleTime = 0.001;  ///< s, the machine's interpolation period
   /// Zxy for a lathe, whose segments also carry the spindle (SegmentInfo).
   Frame frame = Frame::Xyz;
+  /// The names of the axes SegmentInfo::axis counts ("x", ..., "c").
+  std::vector<std::string> axisNames;
   Vec3 start = Vec3::Zero();
   std::vector<Segment> segments;
   std::vector<Profile> profiles;  ///< one per segment

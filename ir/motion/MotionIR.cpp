@@ -82,6 +82,7 @@ ProgramPath programPath(const ir::Module &module) {
       pm.ccw = m.ccw;
       pm.turns = m.turns;
       pm.feed = m.isFeed() ? m.feed : 0;
+      pm.axis = m.axis;
       add({pm, e, m.node});
       position = m.to;
     }
@@ -162,6 +163,12 @@ void attachMotion(ir::Module &module, const ProgramPath &program, const runtime:
       s.set("spindle", ir::Value::reals({info.spindle0, info.spindle1}));
       if (info.sync)
         s.set("sync", ir::Value::boolean(true));
+    }
+    if (seg.tilted()) {
+      s.set("axes", ir::Value::reals({seg.axis0.x(), seg.axis0.y(), seg.axis0.z(), seg.axis1.x(), seg.axis1.y(),
+                                      seg.axis1.z()}));
+      if (info.axis >= 0 && size_t(info.axis) < trajectory.axisNames.size())
+        s.set("limited_axis", ir::Value::word(trajectory.axisNames[size_t(info.axis)]));
     }
     motion.add(std::move(s));
   }
@@ -270,6 +277,24 @@ std::optional<runtime::Trajectory> readMotion(const ir::Module &module, Diagnost
         info.spindle0 = (*spindle)[0];
         info.spindle1 = (*spindle)[1];
         info.sync = s.flag("sync").value_or(false);
+      }
+      if (s.has("axes")) {
+        const auto axes = numbersOf(s, "axes", 6);
+        if (!axes)
+          continue;
+        const Vec3 a0((*axes)[0], (*axes)[1], (*axes)[2]), a1((*axes)[3], (*axes)[4], (*axes)[5]);
+        if (!(std::abs(a0.norm() - 1) <= 1e-6 && std::abs(a1.norm() - 1) <= 1e-6)) {
+          fail(s, "a segment's 'axes' are two unit vectors, its tool axis at its start and at its end");
+          continue;
+        }
+        seg.axis0 = a0.normalized();
+        seg.axis1 = a1.normalized();
+      }
+      if (const std::optional<std::string> name = s.text("limited_axis")) {
+        auto it = std::find(out.axisNames.begin(), out.axisNames.end(), *name);
+        if (it == out.axisNames.end())
+          it = out.axisNames.insert(out.axisNames.end(), *name);
+        info.axis = static_cast<int8_t>(it - out.axisNames.begin());
       }
       runtime::Profile prof;
       prof.v0 = s.number("v0").value_or(0);

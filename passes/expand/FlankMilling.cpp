@@ -92,11 +92,13 @@ public:
       return false;
     Emitter e(step_.moves, step_.moves.number("secplane").value_or(0));
     secplane_ = e.secplane();
+    std::optional<Vec2> facing;
     for (const ir::IslandShape &isl : s.islands) {
-      std::optional<std::vector<Pose>> poses = around(isl);
+      std::optional<std::vector<Pose>> poses = around(isl, facing);
       if (!poses)
         return false;
       cut(*poses);
+      facing = Vec2(poses->front().normal.x(), poses->front().normal.y()).normalized();
     }
     return true;
   }
@@ -119,9 +121,12 @@ private:
   }
 
   /// The tool's poses once round island `isl` in the direction that climbs
-  /// (or as the strategy's cut mode says), from the middle of its longest
-  /// side back to it; nullopt after reporting.
-  std::optional<std::vector<Pose>> around(const ir::IslandShape &isl) {
+  /// (or as the strategy's cut mode says), from the middle of a side back to
+  /// it: the side whose wall faces most nearly `facing` (the way the boss
+  /// before ended: the tool between them then turns least, and never
+  /// through upright, where a machine's table or fork would have to swing
+  /// half a turn), else the longest; nullopt after reporting.
+  std::optional<std::vector<Pose>> around(const ir::IslandShape &isl, const std::optional<Vec2> &facing) {
     const Node &ws = step_.ws;
     if (isl.region.loops.size() != 1) {
       x_.report(ws, "flank milling takes a boss whose outline is one loop; " + isl.symbol + " has " +
@@ -150,11 +155,15 @@ private:
     }
     reach_ = p_.radius + p_.allowanceSide;
     foot_ = isl.foot;
-    // Start in the middle of the longest side.
+    // Start in the middle of the side facing the way the boss before ended,
+    // else of the longest.
     size_t first = 0;
-    for (size_t k = 1; k < loop.segs.size(); ++k)
-      if (loop.segs[k].length() > loop.segs[first].length() + 1e-9)
+    auto facingOf = [&](size_t k) { return facing ? outward(loop.segs[k].tangent(0.5)).dot(*facing) : 0.0; };
+    for (size_t k = 1; k < loop.segs.size(); ++k) {
+      const double better = facingOf(k) - facingOf(first);
+      if (better > 1e-9 || (better > -1e-9 && loop.segs[k].length() > loop.segs[first].length() + 1e-9))
         first = k;
+    }
     std::vector<Pose> poses;
     const size_t count = loop.segs.size();
     for (size_t k = 0; k <= count; ++k) {

@@ -273,7 +273,7 @@ int compileSource(const CompileOptions &opts, const std::string &emit, std::uniq
   std::string pipelineText =
       emit != "feature-ir" && opts.passes.empty() ? driver::toolpathPipeline(toolpath) : opts.passes;
   if (opts.passes.empty() && needsMotion)
-    pipelineText += "," + driver::planMotionPipeline(opts.machine, opts.tolerance);
+    pipelineText += "," + driver::planMotionPipeline(opts.machine, opts.tolerance, opts.workOffset);
   std::vector<std::string> reports;
   if (!pipelineText.empty()) {
     driver::PipelineRun run;

@@ -91,7 +91,7 @@ std::unique_ptr<ir::Module> loadProgram(const SimCommandOptions &opts, std::uniq
     passes.push_back(driver::toolpathPipeline(toolpath));
   }
   if (motion && (!hasMotion || opts.tolerance))
-    passes.push_back(driver::planMotionPipeline(machineName, opts.tolerance));
+    passes.push_back(driver::planMotionPipeline(machineName, opts.tolerance, opts.workOffset));
   if (!passes.empty()) {
     std::string pipeline = passes[0];
     for (size_t k = 1; k < passes.size(); ++k)

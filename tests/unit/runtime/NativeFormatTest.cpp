@@ -392,10 +392,10 @@ TEST_CASE("the native text of a small trajectory", "[native]") {
 TEST_CASE("native format mistakes are located", "[native]") {
   REQUIRE(read(kSmall).errors.empty());
   // Another version: refused at the version number.
-  CHECK(error(replaced(kSmall, "STEPNC-MOTION 1", "STEPNC-MOTION 4")) ==
-        "1:15: unsupported native format version 4; this stepnc reads versions 1 to 3");
+  CHECK(error(replaced(kSmall, "STEPNC-MOTION 1", "STEPNC-MOTION 5")) ==
+        "1:15: unsupported native format version 5; this stepnc reads versions 1 to 4");
   const std::string notMotion =
-      ": not a stepnc native motion file: the first line must be 'STEPNC-MOTION N', N the format version (1 to 3)";
+      ": not a stepnc native motion file: the first line must be 'STEPNC-MOTION N', N the format version (1 to 4)";
   CHECK(error("G01 X1\n") == "1:1" + notMotion);
   CHECK(error("\n" + kSmall) == "2:1" + notMotion);
   CHECK(error("") == "1:1" + notMotion);
