@@ -8,7 +8,9 @@
 //  - BM_Inverse: the inverse kinematics of the shipped 5-axis machines
 //    (table-table, head-table) on 100,000 poses along a 5-axis path (the
 //    tool tilting and turning smoothly), each from the joints before: what
-//    writing and planning 5-axis moves costs per move in joint solving.
+//    writing and planning 5-axis moves costs per move in joint solving;
+//  - BM_PlanFiveAxis: BM_Plan's path with the tool tilted along it, planned
+//    on a 5-axis machine's joints.
 #include "bench/DensePath.h"
 #include "runtime/Kinematics.h"
 #include "runtime/Planner.h"
@@ -114,6 +116,37 @@ void BM_InverseHeadTable(benchmark::State &state) {
   inverseBench(state, "head-table-5axis", Eigen::Vector3d(300, 250, -250));
 }
 BENCHMARK(BM_InverseHeadTable)->Arg(100000)->Unit(benchmark::kMillisecond);
+
+/// BM_PlanFiveAxis: the same 100,000-move path as BM_Plan with the tool
+/// tilted along it (leaning 5 to 35 deg and turning round +z), planned on
+/// the shipped table-table machine's joints: the inverse kinematics at
+/// points along every segment and each joint's limits (PlanOptions::
+/// kinematics). Compared per move with BM_Plan (docs/performance.md).
+void BM_PlanFiveAxis(benchmark::State &state) {
+  const Machine m = shipped("table-table-5axis");
+  std::string error;
+  const std::unique_ptr<Kinematics> k = makeKinematics(m, error);
+  PathInput path = densePath(int(state.range(0)), 3000);
+  const size_t n = path.moves.size();
+  for (size_t i = 0; i < n; ++i) {
+    const double t = double(i) / double(n);
+    const double lean = (5 + 30 * (0.5 + 0.5 * std::sin(6.283185307179586 * 7 * t))) * 0.017453292519943295;
+    const double turn = 6.283185307179586 * 3 * t;
+    path.moves[i].axis = Eigen::Vector3d(std::sin(lean) * std::cos(turn), std::sin(lean) * std::sin(turn), std::cos(lean));
+  }
+  PlanOptions options;
+  options.kinematics = k.get();
+  options.workOffset = Eigen::Vector3d(250, 225, -250);
+  size_t segments = 0;
+  for (auto _ : state) {
+    Trajectory t = plan(path, m, options);
+    segments = t.segments.size();
+    benchmark::DoNotOptimize(t);
+  }
+  state.SetItemsProcessed(state.iterations() * int64_t(path.moves.size()));
+  state.counters["segments_out"] = double(segments);
+}
+BENCHMARK(BM_PlanFiveAxis)->Arg(100000)->Unit(benchmark::kMillisecond);
 
 } // namespace
 

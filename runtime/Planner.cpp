@@ -542,24 +542,27 @@ private:
   double maxFeed_ = kInf;  ///< mm/s, the controller's max_feed
 };
 
-/// The demand a segment that tilts the tool makes of the machine's joints:
-/// the joints at points along it (each solution the nearest the one before,
-/// starting from `near`, which is left at the segment's end), and their
-/// first three derivatives with respect to the tip's path by finite
-/// differences, with a margin. Points: every 2 deg the axis turns and at
-/// least 4 pieces. False (d unchanged) where a point is out of reach: the
-/// backends and the verifier refuse such a path before it is planned.
 /// The joints' first and second derivatives with respect to the tip's path
 /// at a segment's two ends (joint units per mm, per mm^2).
 struct JointEnds {
   Joints d1Start, d1End, d2Start, d2End;
 };
 
+/// The demand a segment that tilts the tool makes of the machine's joints:
+/// the joints at points along it (each solution the nearest the one before,
+/// starting from `near`, which is left at the segment's end), and their
+/// first three derivatives with respect to the tip's path by finite
+/// differences, with a margin. Points: every 0.5 deg the axis turns and
+/// every 1 mm of the path, at least 8 pieces (fewer let the player find
+/// jerk 3 % over a limit on the shipped head-head machine). False (d
+/// unchanged) where a point is out of reach: the backends and the verifier
+/// refuse such a path before it is planned.
+
 bool jointDemand(const Segment &seg, const Kinematics &kin, const Vec3 &offset, Joints &near, AxisDemand &d,
                  JointEnds &ends) {
   constexpr double kMargin = 1.25;  // what 16 or more pieces of differences may miss of a peak
   const double turned = std::acos(std::clamp(seg.axis0.dot(seg.axis1), -1.0, 1.0)) * 180 / std::numbers::pi;
-  const int n = std::clamp(static_cast<int>(std::ceil(turned / 0.5)), 16, 64);
+  const int n = std::clamp(static_cast<int>(std::ceil(std::max(turned / 0.5, seg.length / 1.0))), 8, 64);
   const double h = seg.length / n;
   if (!(h > 0))
     return false;
