@@ -81,6 +81,12 @@ struct TargetDescriptor {
   /// machine's joint positions with rotary words and inverse-time feeds, for
   /// a machine without tool-centre-point control (backends/common/FiveAxis.h).
   bool jointMoves = false;
+  /// Steps that tilt the tool written with the controller's tool-centre-
+  /// point control: the words that turn it on and off ("TRAORI",
+  /// "TRAFOOF"), X Y Z the tool tip in the workpiece and the rotary axes'
+  /// angles on each move, feeds along the tip's path (FiveAxis.h,
+  /// tcpMoves). Empty: the target has none.
+  std::string tcpOn, tcpOff;
   /// Reading back a program that deposits: feed moves run with the spindle
   /// off (a deposition head turns nothing).
   bool feedsWithoutSpindle = false;

@@ -50,9 +50,15 @@ public:
         buildProgram(module, options.toolTable, diags,
                      descriptor().arcPlanes ? ir::OutOfPlaneArcs::Exact : ir::OutOfPlaneArcs::Chords,
                      descriptor().deposition ? ir::Deposition::Take : ir::Deposition::Refuse, descriptor().name,
-                     descriptor().jointMoves ? ir::ToolAxes::Take : ir::ToolAxes::Refuse);
-    if (!program || !index(*program, options, diags) ||
-        (options.machine && options.workOffset && !jointMoves(*program, *options.machine, *options.workOffset, diags)))
+                     descriptor().jointMoves || !descriptor().tcpOn.empty() ? ir::ToolAxes::Take
+                                                                            : ir::ToolAxes::Refuse);
+    if (!program || !index(*program, options, diags))
+      return std::nullopt;
+    if (options.machine && descriptor().jointMoves && options.workOffset &&
+        !jointMoves(*program, *options.machine, *options.workOffset, diags))
+      return std::nullopt;
+    if (options.machine && !descriptor().jointMoves && !descriptor().tcpOn.empty() &&
+        !tcpMoves(*program, *options.machine, options.workOffset, diags))
       return std::nullopt;
     Emitter emitter(descriptor(), options, diags);
     std::optional<std::string> text = emitter.run(*program);
@@ -84,13 +90,14 @@ private:
       return true;
     const ir::Node &at = **tilted;
     std::string missing;
-    if (!descriptor().jointMoves) {
+    if (!descriptor().jointMoves && descriptor().tcpOn.empty()) {
       diags.error(at.origin.loc, "workingstep " + at.symbol + " tilts the tool (5-axis): " + descriptor().name +
                                      " does not write such steps yet (rs274 does, as the machine's joints; "
-                                     "tool-centre-point control, TRAORI or M128, is not done: docs/five-axis.md)")
+                                     "siemens-840d with TRAORI: docs/five-axis.md)")
           .entity(at.origin.entityId);
       return false;
     }
+    const bool tcp = !descriptor().jointMoves;
     if (!options.machine)
       missing = "a 5-axis machine (--machine=table-table-5axis, head-table-5axis, head-head-5axis or a file of "
                 "one's own)";
@@ -98,13 +105,15 @@ private:
              options.machine->kinematics.chain != runtime::Chain::HeadTable &&
              options.machine->kinematics.chain != runtime::Chain::HeadHead)
       missing = "a 5-axis machine (" + options.machine->name + " has no two rotary axes that turn the tool)";
-    else if (!options.workOffset)
+    else if (!options.workOffset && !tcp)
       missing = "where the workpiece's origin is on the machine (--work-offset=X,Y,Z, machine coordinates with "
                 "every axis at 0)";
     if (missing.empty())
       return true;
     diags.error(at.origin.loc, "workingstep " + at.symbol + " tilts the tool (5-axis): " + descriptor().name +
-                                   " writes it as the machine's joints, which needs " + missing)
+                                   (tcp ? " writes it with " + descriptor().tcpOn + " and the machine's rotary axes"
+                                        : std::string(" writes it as the machine's joints")) +
+                                   ", which needs " + missing)
         .entity(at.origin.entityId);
     return false;
   }

@@ -34,9 +34,13 @@ bool placedAsIs(const ir::Node *setup) {
 
 class Jointer {
 public:
+  /// `tcp`: for a controller with tool-centre-point control (the tip stays
+  /// the program's point); `checkLinear`: the work offset is known, so the
+  /// linear axes' travel is checked too.
   Jointer(Program &p, const runtime::Machine &machine, const runtime::Kinematics &kinematics, const Vec3 &workOffset,
-          DiagnosticEngine &diags)
-      : p_(p), machine_(machine), kin_(kinematics), offset_(workOffset), diags_(diags) {
+          DiagnosticEngine &diags, bool tcp = false, bool checkLinear = true)
+      : p_(p), machine_(machine), kin_(kinematics), offset_(workOffset), diags_(diags), tcp_(tcp),
+        checkLinear_(checkLinear) {
     for (size_t k = 0; k < machine.axes.size(); ++k)
       if (machine.axes[k].rotary)
         rotary_.push_back(k);
@@ -52,7 +56,9 @@ public:
       if (s.kind != Step::Kind::Moves || s.moves.empty())
         continue;
       if (!s.tilted) {
-        if (turned && !s.index) {
+        // (Under tool-centre-point control each tilted step turns its axes
+        // back to 0 itself, with the transformation still on.)
+        if (turned && !s.index && !tcp_) {
           s.index = turnTo(home());
           for (size_t k : rotary_)
             near_[static_cast<Eigen::Index>(k)] = 0;
@@ -61,12 +67,21 @@ public:
                                         [](const auto &a) { return std::abs(a.second) > 1e-9; });
         continue;
       }
-      if (!step(s))
+      if (!(tcp_ ? tcpStep(s) : step(s)))
         return false;
-      turned = true;
+      turned = !tcp_;  // a TCP step turns its axes back to 0 itself
     }
     for (size_t k : rotary_)
       p_.rotaryAxes.push_back(axisAddress(machine_.axes[k]));
+    if (tcp_) {
+      std::string names;
+      for (const std::string &n : p_.rotaryAxes)
+        names += (names.empty() ? "" : " ") + n;
+      p_.indexing.push_back("the steps that tilt the tool are written with the controller's tool-centre-point "
+                            "control: X Y Z the tool tip in the workpiece, " + names + " the rotary axes of " +
+                            machine_.name + " in deg, feeds along the tip's path");
+      return true;
+    }
     std::string names;
     for (const std::string &n : p_.rotaryAxes)
       names += (names.empty() ? "" : " ") + n;
@@ -117,7 +132,7 @@ private:
       error(s, "the machine cannot put the tool at " + pointText(tip) + " along " + axisText(axis) + ": " + r.why);
       return std::nullopt;
     }
-    if (r.outsideTravel) {
+    if (r.outsideTravel && (checkLinear_ || outsideRotary(*r.joints))) {
       error(s, "the tool at " + pointText(tip) + " along " + axisText(axis) +
                    " needs the machine's axes outside their travel (" + outsideTravel(machine_, *r.joints) +
                    ") with the workpiece's origin at " +
@@ -125,6 +140,115 @@ private:
       return std::nullopt;
     }
     return r.joints;
+  }
+
+  /// Whether a rotary axis of `q` is outside its travel.
+  bool outsideRotary(const runtime::Joints &q) const {
+    for (size_t k : rotary_) {
+      const double v = q[static_cast<Eigen::Index>(k)];
+      if (v < machine_.axes[k].travelMin - 1e-9 || v > machine_.axes[k].travelMax + 1e-9)
+        return true;
+    }
+    return false;
+  }
+
+  /// A step for tool-centre-point control: the tip as the IR has it, the
+  /// rotary angles on every move, moves halved where the angles' straight
+  /// line would turn the tool off the IR's axis; the axes back to 0 after.
+  bool tcpStep(Step &s) {
+    if (!placedAsIs(s.setup)) {
+      error(s, "tilts the tool on another face of the workpiece (setup " + s.setup->symbol +
+                   "), which stepnc does not write yet: give it in the first clamping's frame");
+      return false;
+    }
+    std::vector<Move> out;
+    bool placed = false;
+    Vec3 at = Vec3::Zero();
+    for (const Move &m : s.moves) {
+      if (m.alongZOnly || m.kind == Move::Kind::Dwell) {
+        Move c = m;
+        if (m.kind == Move::Kind::Dwell)
+          c.from = c.to = at;
+        out.push_back(c);
+        at = c.to;
+        continue;
+      }
+      if (m.kind == Move::Kind::Arc) {
+        error(s, "an arc among moves that tilt the tool is not written yet");
+        return false;
+      }
+      const bool turning = !placed || (m.kind == Move::Kind::Rapid && ir::angleBetween(m.fromAxis, m.axis) > 1e-6);
+      const std::optional<runtime::Joints> q = inverse(s, m.to, m.axis, turning ? home() : near_);
+      if (!q)
+        return false;
+      placed = true;
+      if (m.kind == Move::Kind::Rapid) {
+        Move r = m;
+        r.from = at;
+        r.rotary = rotaryOf(*q);
+        out.push_back(r);
+        at = r.to;
+        near_ = *q;
+        continue;
+      }
+      // Halves until the rotary angles' straight line keeps the tool axis
+      // within kJointAxisTolerance of the IR's halfway along each block.
+      struct Piece {
+        double ta, tb;
+        runtime::Joints qa, qb;
+        int depth;
+      };
+      std::vector<Piece> stack{{0, 1, near_, *q, 0}};
+      while (!stack.empty()) {
+        Piece piece = std::move(stack.back());
+        stack.pop_back();
+        const double tm = (piece.ta + piece.tb) / 2;
+        const Vec3 axis = kin_.forward((piece.qa + piece.qb) / 2).axis;
+        const double off = ir::angleBetween(axis, ir::turnAxis(m.fromAxis, m.axis, tm));
+        if (off > kJointAxisTolerance && piece.depth < kMaxHalvings) {
+          const std::optional<runtime::Joints> qm =
+              inverse(s, poseAt(m, tm).first, poseAt(m, tm).second, piece.qa);
+          if (!qm)
+            return false;
+          stack.push_back({tm, piece.tb, *qm, piece.qb, piece.depth + 1});
+          stack.push_back({piece.ta, tm, piece.qa, *qm, piece.depth + 1});
+          continue;
+        }
+        if (off > kJointAxisTolerance) {
+          error(s, "the rotary axes cannot follow the tool axis of the move to " + pointText(m.to) +
+                       " within " + formatShortest(kJointAxisTolerance) + " deg (it passes near a rotary axis)");
+          return false;
+        }
+        Move b = m;
+        b.from = at;
+        b.to = poseAt(m, piece.tb).first;
+        b.rotary = rotaryOf(piece.qb);
+        b.fromAxis = ir::turnAxis(m.fromAxis, m.axis, piece.ta);
+        b.axis = ir::turnAxis(m.fromAxis, m.axis, piece.tb);
+        out.push_back(b);
+        at = b.to;
+      }
+      near_ = *q;
+    }
+    if (placed) {
+      // The rotary axes back to 0 with the tip still, before the transformation
+      // goes off: the steps after run with them at 0.
+      Move back = out.back();
+      back.kind = Move::Kind::Rapid;
+      back.feed = 0;
+      back.inverseTime = 0;
+      back.from = at;
+      back.to = at;
+      back.role = "position";
+      back.fromAxis = back.axis;
+      back.axis = Vec3::UnitZ();
+      back.rotary = rotaryOf(home());
+      back.turn.reset();
+      out.push_back(back);
+      near_ = home();
+    }
+    s.moves = std::move(out);
+    return true;
   }
 
   bool step(Step &s) {
@@ -284,6 +408,8 @@ private:
   double retractZ_ = 0;
   double radius_ = 0;
   runtime::Joints near_;
+  bool tcp_ = false;
+  bool checkLinear_ = true;
 };
 
 } // namespace
@@ -295,6 +421,19 @@ bool jointMoves(Program &p, const runtime::Machine &machine, const Vec3 &workOff
   if (!kinematics)
     return false;
   return Jointer(p, machine, *kinematics, workOffset, diags).run();
+}
+
+bool tcpMoves(Program &p, const runtime::Machine &machine, const std::optional<Vec3> &workOffset,
+              DiagnosticEngine &diags) {
+  if (std::none_of(p.steps.begin(), p.steps.end(), [](const Step &s) { return s.tilted; }))
+    return true;
+  std::string error;
+  const std::unique_ptr<runtime::Kinematics> kinematics = runtime::makeKinematics(machine, error);
+  if (!kinematics) {
+    diags.error(SourceLoc{}, "the machine's kinematics: " + error);
+    return false;
+  }
+  return Jointer(p, machine, *kinematics, workOffset.value_or(Vec3::Zero()), diags, true, workOffset.has_value()).run();
 }
 
 } // namespace stepnc::backends

@@ -25,6 +25,8 @@
 #include "runtime/Machine.h"
 #include "support/Diagnostics.h"
 
+#include <optional>
+
 namespace stepnc::backends {
 
 /// mm and deg the tip and axis may be off the IR's move between two blocks.
@@ -38,5 +40,18 @@ inline constexpr double kJointAxisTolerance = 0.01;
 /// kind not written yet (on another face, with arcs); true and nothing
 /// changed when no step tilts the tool.
 bool jointMoves(Program &p, const runtime::Machine &machine, const Vec3 &workOffset, DiagnosticEngine &diags);
+
+/// Rewrites the steps of `p` that tilt the tool for a controller with
+/// tool-centre-point control (siemens-840d's TRAORI): X Y Z stay the tool
+/// tip in the workpiece, each move gets the rotary axes' angles for its tool
+/// axis (the machine's inverse kinematics, the solution nearest the one
+/// before; at a rapid that turns the tool, nearest the middle of the
+/// travel), and a move whose rotary axes, moving in proportion, would take
+/// the tool axis further than 0.01 deg from the IR's is cut in halves (the
+/// controller keeps the tip on the line). The step ends with the rotary
+/// axes back at 0, the tip still. `workOffset`, when given, also checks the
+/// linear axes' travel. False (reported) as jointMoves.
+bool tcpMoves(Program &p, const runtime::Machine &machine, const std::optional<Vec3> &workOffset,
+              DiagnosticEngine &diags);
 
 } // namespace stepnc::backends

@@ -135,7 +135,12 @@ std::optional<std::string> IsoEmitter::run(const Program &p) {
           .entity(s.exec->origin.entityId);
       continue;
     }
+    bool tcp = false;  // the controller's tool-centre-point control on (a tilted step's)
     for (size_t i = 0; i < s.moves.size();) {
+      if (s.tilted && !tcp && !d_.tcpOn.empty() && !s.moves[i].rotary.empty()) {
+        out_.block(d_.tcpOn);
+        tcp = true;
+      }
       process(s, s.moves[i].before);
       const size_t end = smoothRunEnd(s.moves, i);
       if (end >= i + 2) {
@@ -146,6 +151,8 @@ std::optional<std::string> IsoEmitter::run(const Program &p) {
       }
     }
     process(s, s.after);
+    if (tcp)
+      out_.block(d_.tcpOff);
     feedMode(false);
     if (const std::string g17 = selectPlane(geom::ArcPlane::xy()); !g17.empty())
       out_.block(g17);

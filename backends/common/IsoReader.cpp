@@ -228,7 +228,7 @@ private:
           continue;
         }
         bool matched = false;
-        for (std::string_view k : {"MCALL", "CSPLINE", "BAUTO", "EAUTO"})
+        for (std::string_view k : {"MCALL", "CSPLINE", "BAUTO", "EAUTO", "TRAORI", "TRAFOOF"})
           if (keyword(k)) {
             out.push_back({std::string(k), ""});
             i += k.size();
@@ -268,13 +268,13 @@ private:
     static const std::set<std::string> rs274Words = {"G", "M", "X", "Y", "Z", "I", "J", "K", "P", "Q", "R", "F",
                                                      "S", "T", "H", "A", "B", "C"};
     static const std::set<std::string> siemensWords = {"G", "M", "X", "Y", "Z", "I", "J", "K", "F", "S", "T", "D",
-                                                       "CR", "TURN"};
+                                                       "CR", "TURN", "A", "B", "C"};
     static const std::set<std::string> lengths = {"X", "Y", "Z", "I", "J", "K", "R", "Q", "F", "CR", "A", "B", "C"};
     static const std::set<std::string> wholes = {"M", "S", "T", "D", "H", "TURN"};
     bool ok = true;
     for (Word &w : ws) {
       if (w.address == "MSG" || w.address == "CALL" || w.address == "MCALL" || w.address == "CSPLINE" ||
-          w.address == "BAUTO" || w.address == "EAUTO")
+          w.address == "BAUTO" || w.address == "EAUTO" || w.address == "TRAORI" || w.address == "TRAFOOF")
         continue;
       const auto &allowed = dialect_ == Dialect::Rs274 ? rs274Words : siemensWords;
       if (!allowed.count(w.address)) {
@@ -339,6 +339,17 @@ private:
         ms.push_back(static_cast<int>(w.value));
       } else if (w.address == "CALL") {
         calls.push_back(w.text);
+      } else if (w.address == "TRAORI" || w.address == "TRAFOOF") {
+        // The 840D's transformation on or off: alone in its block; the
+        // rotary words are taken with it on (the tip stays the program's).
+        if (ws->size() != 1)
+          r_.problem(n, w.address + " shares its block");
+        if (dialect_ != Dialect::Siemens)
+          r_.problem(n, w.address + " is the 840D's");
+        if ((w.address == "TRAORI") == traori_)
+          r_.problem(n, w.address + (traori_ ? " while the transformation is on" : " while it is off"));
+        traori_ = w.address == "TRAORI";
+        return;
       } else if (w.address == "MSG" || w.address == "MCALL" || w.address == "CSPLINE" || w.address == "BAUTO" ||
                  w.address == "EAUTO") {
         keywords.push_back(w.address);
@@ -374,7 +385,11 @@ private:
     const bool rotaryAlone = rotaryWords && std::all_of(seen.begin(), seen.end(), [](const auto &w) {
       return w.first == "A" || w.first == "B" || w.first == "C";
     });
-    if (rotaryAlone && has(0)) {
+    if (rotaryWords && dialect_ == Dialect::Siemens && !traori_) {
+      r_.problem(n, "rotary axes turned with the transformation off (TRAORI first)");
+      return;
+    }
+    if (rotaryAlone && has(0) && !traori_) {
       // A turn (3+2, or before a step that tilts the tool): where the tool
       // is over the workpiece is not known after it.
       rotate(seen);
@@ -1100,6 +1115,7 @@ private:
   std::optional<geom::ArcPlane> plane_;  ///< G17, G18, G19; none before the program selects one
   double feed_ = 0, speed_ = 0;
   bool inverseTime_ = false;  ///< G93: F is 1 / the block's minutes
+  bool traori_ = false;       ///< the 840D's TRAORI on
   std::array<double, 3> abc_ = {kNaN, kNaN, kNaN};  ///< A, B, C as last written
   bool spindleOn_ = false;
   std::optional<int> selected_, inSpindle_, offset_, pendingOffset_;

@@ -42,6 +42,10 @@ TargetDescriptor siemensDescriptor() {
   d.feedDecimals = 1;
   d.speedDecimals = 0;
   d.tolerance = 0.01;
+  // 5-axis with the controller's transformation (PROCESSES.md C2): the tip
+  // programmed in the workpiece, the rotary axes' positions on each block.
+  d.tcpOn = "TRAORI";
+  d.tcpOff = "TRAFOOF";
   return d;
 }
 

@@ -94,7 +94,7 @@ TOKEN_RE = re.compile(
     r'\s*(?:(?P<msg>MSG\("[^"]*"\))'
     r"|(?P<call>(?:CYCLE\d+)\([^()]*\))"
     r"|(?P<mcall>MCALL)(?![A-Z0-9_])"
-    r"|(?P<keyword>CSPLINE|BAUTO|EAUTO|DIAMON)(?![A-Z0-9_])"
+    r"|(?P<keyword>CSPLINE|BAUTO|EAUTO|DIAMON|TRAORI|TRAFOOF)(?![A-Z0-9_])"
     r"|(?P<assign>(?:CR|TURN|LIMS)=(?P<avalue>" + NUMBER + r"))"
     r"|(?P<letter>[A-Z])(?P<value>" + NUMBER + r"))")
 
@@ -282,6 +282,7 @@ class Checker:
         self.plane = "xy"
         self.lathe = False
         self.diameter = False
+        self.traori = False  # the 840D's TRAORI on
         self.per_rev = False
         self.css = False
         self.motion = None
@@ -399,9 +400,12 @@ class Checker:
         gs, ms = [], []
         bad = False
         for address, value in words:
-            if address in ("MSG", "CALL", "MCALL", "CSPLINE", "BAUTO", "EAUTO", "DIAMON"):
+            if address in ("MSG", "CALL", "MCALL", "CSPLINE", "BAUTO", "EAUTO", "DIAMON", "TRAORI", "TRAFOOF"):
                 continue
-            if address in LENGTH_WORDS or address in INTEGER_WORDS or address in "GM":
+            if address in "ABC" and not self.traori:
+                self.problem(n, "rotary axis %s with the transformation off (TRAORI first)" % address)
+                bad = True
+            elif address in LENGTH_WORDS or address in INTEGER_WORDS or address in "GM" or address in "ABC":
                 problem = number_problem(address, value)
                 if problem:
                     self.problem(n, problem)
@@ -412,7 +416,17 @@ class Checker:
         if bad:
             return
         for address, value in words:
-            if address in ("MSG", "CALL", "MCALL", "CSPLINE", "BAUTO", "EAUTO"):
+            if address in ("TRAORI", "TRAFOOF"):
+                # The 840D's 5-axis transformation (PROCESSES.md C2): alone in
+                # its block, on then off; X Y Z stay the tool tip, A B C are
+                # the rotary axes (check-tcp.py checks those moves).
+                if len(words) != 1:
+                    self.problem(n, "%s shares its block" % address)
+                if (address == "TRAORI") == self.traori:
+                    self.problem(n, "%s while the transformation is %s" % (address, "on" if self.traori else "off"))
+                self.traori = address == "TRAORI"
+                return
+            if address in ("MSG", "CALL", "MCALL", "CSPLINE", "BAUTO", "EAUTO") or address in "ABC":
                 continue
             if address == "DIAMON":
                 self.diameter = True
@@ -619,7 +633,7 @@ class Checker:
 
     def make(self, n, kind, feed, at=None, **arc):
         to = at if at is not None else (self.pos["X"], self.pos["Y"], self.pos["Z"])
-        self.made.append(dict(kind=kind, to=to, feed=feed or 0, line=n, **arc))
+        self.made.append(dict(kind=kind, to=to, feed=feed or 0, line=n, tcp=self.traori, **arc))
 
     def arc(self, n, seen):
         if not self.modal["plane"]:
@@ -922,8 +936,10 @@ def main():
             problems = list(c.problems)
             compared = ""
             if ir and not problems:
-                moves = planned_moves(ir)
-                differences, count = compare_moves(moves, c.made, feeds_only=c.counts["holes"] > 0)
+                # Moves that tilt the tool (under TRAORI) are check-tcp.py's.
+                moves = [m for m in planned_moves(ir) if m.get("axis", (0.0, 0.0, 1.0)) == (0.0, 0.0, 1.0)]
+                made = [m for m in c.made if not m.get("tcp")]
+                differences, count = compare_moves(moves, made, feeds_only=c.counts["holes"] > 0)
                 problems += ["%s: %s" % (name, d) for d in differences]
                 compared = ", %d planned moves made" % count
             if problems:

@@ -1,0 +1,159 @@
+#!/usr/bin/env python3
+"""Checks the steps that tilt the tool of a SINUMERIK 840D program written
+with the controller's tool-centre-point control (TRAORI; docs/five-axis.md).
+
+No 840D interpreter is at hand: the program is read here by its documented
+meaning (PROCESSES.md C2). Between TRAORI and TRAFOOF, X Y Z are the tool
+tip in the workpiece and the rotary words (A, B, C) the machine's rotary
+axes, which the controller moves in proportion along each block while it
+keeps the tip on the block's line. The tool's direction for the angles is
+taken through the machine's forward kinematics, written in check-indexed.py
+from the machine file alone. The toolpath IR gives each move at feed of a
+step that tilts the tool (check-five-axis.py reads them). For each:
+
+  - the block that ends the move ends at its tip and axis (within the
+    program's rounding: 0.001 mm, 0.002 deg), and every block before it ends
+    on the move;
+  - halfway through each block (the angles halfway) the tool's direction is
+    within --axis-tolerance deg of the IR's there;
+  - each block's F is the IR's feed (mm/min along the tip's path).
+
+Every transformation that is turned on is turned off, with the rotary axes
+back at 0 before it goes.
+
+  check-tcp.py --program P.MPF --ir I --machine M.toml
+
+Exit status 0 when everything matches, 1 otherwise.
+"""
+import argparse
+import importlib.util
+import math
+import os
+import re
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, HERE)
+
+
+def load(name, file):
+    spec = importlib.util.spec_from_file_location(name, os.path.join(HERE, file))
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+check_indexed = load("check_indexed", "check-indexed.py")
+five = load("check_five_axis", "check-five-axis.py")
+
+TOL_MM = 1e-3
+TOL_DEG = 2e-3
+WORD_RE = re.compile(r"([A-Z]+)(=?)(-?[0-9.]+)")
+
+
+def program_blocks(path, chain):
+    """The G1 blocks under TRAORI: their start and end tip and angles and F;
+    and the problems of the transformation's use."""
+    blocks, problems = [], []
+    on = False
+    at = {"X": 0.0, "Y": 0.0, "Z": 0.0, "A": 0.0, "B": 0.0, "C": 0.0}
+    motion, feed = None, 0.0
+    with open(path) as f:
+        for n, line in enumerate(f, 1):
+            code = line.split(";")[0].strip()
+            if code == "TRAORI":
+                if on:
+                    problems.append("line %d: TRAORI while it is on" % n)
+                on = True
+                continue
+            if code == "TRAFOOF":
+                if not on:
+                    problems.append("line %d: TRAFOOF while it is off" % n)
+                if any(abs(at[a]) > 1e-9 for a in "ABC"):
+                    problems.append("line %d: TRAFOOF with the rotary axes at A%g B%g C%g, not 0" %
+                                    (n, at["A"], at["B"], at["C"]))
+                on = False
+                continue
+            words = dict((w, float(v)) for w, _, v in WORD_RE.findall(code) if w in ("G", "X", "Y", "Z", "A", "B", "C", "F"))
+            if "G" in words and words["G"] in (0, 1):
+                motion = int(words["G"])
+            if "F" in words:
+                feed = words["F"]
+            before = dict(at)
+            for k in ("X", "Y", "Z", "A", "B", "C"):
+                if k in words:
+                    at[k] = words[k]
+            if any(k in words for k in "ABC") and not on:
+                problems.append("line %d: rotary words with the transformation off" % n)
+            if on and motion == 1 and at != before:
+                blocks.append({"from": before, "to": dict(at), "feed": feed, "text": "line %d: %s" % (n, code)})
+    if on:
+        problems.append("the program ends with the transformation on")
+    return blocks, problems
+
+
+def pose(chain, words):
+    tip = (words["X"], words["Y"], words["Z"])
+    axis = chain.to_workpiece((0.0, 0.0, 0.0), {"a": words["A"], "b": words["B"], "c": words["C"]}, (0.0, 0.0, 0.0))[1]
+    return tip, axis
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--program", required=True)
+    ap.add_argument("--ir", required=True)
+    ap.add_argument("--machine", required=True)
+    ap.add_argument("--axis-tolerance", type=float, default=0.01)
+    args = ap.parse_args()
+    chain = check_indexed.Chain(args.machine)
+    blocks, problems = program_blocks(args.program, chain)
+    want, _ = five.tilted_moves(args.ir)
+    if not want:
+        problems.append("the IR has no step that tilts the tool")
+    worst_end, worst_mid = (0.0, 0.0), 0.0
+    k = 0
+    for mv in want:
+        while not problems:
+            if k == len(blocks):
+                problems.append("IR line %d (%s): no block ends at its end" % (mv["line"], mv["text"]))
+                break
+            b = blocks[k]
+            k += 1
+            tip, axis = pose(chain, b["to"])
+            mm, deg, _ = five.on_move(mv, tip, axis)
+            half = {a: (b["from"][a] + b["to"][a]) / 2 for a in b["to"]}
+            mid_tip, mid_axis = pose(chain, half)
+            _, mid_deg, _ = five.on_move(mv, mid_tip, mid_axis)
+            worst_mid = max(worst_mid, mid_deg)
+            if mid_deg > args.axis_tolerance + TOL_DEG:
+                problems.append("%s: halfway through, the tool is %.4f deg off IR line %d" % (b["text"], mid_deg, mv["line"]))
+            if abs(b["feed"] - mv["feed"]) > 0.05:
+                problems.append("%s: F%g where the IR's feed is %g mm/min" % (b["text"], b["feed"], mv["feed"]))
+            end = math.dist(tip, mv["to"]), five.angle(axis, mv["axis"])
+            if end[0] <= TOL_MM and end[1] <= TOL_DEG:
+                worst_end = (max(worst_end[0], end[0]), max(worst_end[1], end[1]))
+                break
+            # Where along the move a block ends is read from its tip, printed
+            # to 0.001 mm: the axis there is known within the turn over that.
+            length = math.dist(mv["start"], mv["to"])
+            slack = five.angle(mv["from_axis"], mv["axis"]) * (TOL_MM / length if length > 0 else 1.0)
+            if mm > TOL_MM or deg > TOL_DEG + slack:
+                problems.append("%s ends %.4f mm and %.4f deg off IR line %d (%s)" %
+                                (b["text"], mm, deg, mv["line"], mv["text"]))
+                break
+        if problems:
+            break
+    if not problems and k != len(blocks):
+        problems.append("%d blocks at feed under TRAORI after the IR's last move: %s" % (len(blocks) - k, blocks[k]["text"]))
+    if problems:
+        for p in problems[:5]:
+            print("FAIL: " + p)
+        return 1
+    print("ok: %d moves at feed that tilt the tool, in %d blocks under TRAORI, match through the machine's "
+          "kinematics: ends within %.4f mm and %.4f deg, halfway within %.4f deg" %
+          (len(want), len(blocks), worst_end[0], worst_end[1], worst_mid))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
