@@ -136,15 +136,28 @@ void BM_PlanFiveAxis(benchmark::State &state) {
   }
   PlanOptions options;
   options.kinematics = k.get();
-  options.workOffset = Eigen::Vector3d(250, 225, -250);
+  options.workOffset = Eigen::Vector3d(200, 200, -250);
   size_t segments = 0;
+  Trajectory last;
   for (auto _ : state) {
     Trajectory t = plan(path, m, options);
     segments = t.segments.size();
     benchmark::DoNotOptimize(t);
+    last = std::move(t);
   }
   state.SetItemsProcessed(state.iterations() * int64_t(path.moves.size()));
   state.counters["segments_out"] = double(segments);
+  // The plan played once (not timed): its joints within their limits.
+  SimOptions sim;
+  sim.workOffsetMm = options.workOffset;
+  sim.maxViolations = size_t(1) << 30;  // every one kept, to count them by kind
+  const SimReport report = simulate(last, m, sim);
+  size_t dynamics = 0;  // the joints' velocity, acceleration or jerk (the path is wider than the travel)
+  for (const Violation &v : report.violations)
+    dynamics += v.kind == ViolationKind::Velocity || v.kind == ViolationKind::Acceleration ||
+                v.kind == ViolationKind::Jerk;
+  state.counters["violations"] = double(report.violationCount);
+  state.counters["joint_limits"] = double(dynamics);
 }
 BENCHMARK(BM_PlanFiveAxis)->Arg(100000)->Unit(benchmark::kMillisecond);
 
