@@ -175,6 +175,11 @@ std::string writeNative(const Trajectory &trajectory, const std::string &source)
       appendNumbers(out, {seg.axis0.x(), seg.axis0.y(), seg.axis0.z(), seg.axis1.x(), seg.axis1.y(), seg.axis1.z()});
       out += " limited_axis ";
       out += info.axis >= 0 && size_t(info.axis) < t.axisNames.size() ? t.axisNames[size_t(info.axis)] : "none";
+      // The joints at the segment's end, when planned on them.
+      const size_t count = t.segments.empty() ? 0 : t.joints.size() / t.segments.size();
+      out += " joints " + std::to_string(count);
+      for (size_t k = 0; k < count; ++k)
+        appendNumbers(out, {t.joints[i * count + k]});
     }
     out += '\n';
   }
@@ -253,6 +258,7 @@ private:
   uint32_t version_ = kVersion;  ///< the file's format version
   uint32_t announced_ = 0;  ///< the header's segment count
   Vec3 at_ = Vec3::Zero();  ///< where the next segment starts
+  std::vector<double> jointsHere_;  ///< the joints the segment being read gives
   /// The speed and acceleration the previous segment ends with; NaN after a
   /// segment that could not be read (they are not compared).
   double v1_ = 0;
@@ -681,7 +687,13 @@ void Reader::segment(Trajectory &t, bool first) {
           it = t.axisNames.insert(t.axisNames.end(), std::string(w->text));
         info.axis = static_cast<int8_t>(it - t.axisNames.begin());
       }
-      endOfLine("the limiting axis");
+      keyword("joints");
+      const uint32_t count = integer("the number of joints");
+      if (ok_ && count > 16)
+        failHere("a machine has at most 16 joints here, not " + std::to_string(count));
+      for (uint32_t k = 0; k < count && ok_; ++k)
+        jointsHere_.push_back(real("a joint's position"));
+      endOfLine("the joints");
     } else {
       endOfLine("the synchronisation");
     }
@@ -768,6 +780,8 @@ void Reader::segment(Trajectory &t, bool first) {
   a1_ = prof.a1();
   seg.axis0 = axis0.normalized();
   seg.axis1 = axis1.normalized();
+  t.joints.insert(t.joints.end(), jointsHere_.begin(), jointsHere_.end());
+  jointsHere_.clear();
   t.segments.push_back(seg);
   t.profiles.push_back(prof);
   t.info.push_back(info);

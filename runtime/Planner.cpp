@@ -796,8 +796,17 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
     joints = Joints::Zero(static_cast<Eigen::Index>(options.kinematics->jointCount()));
     junctionCap.reserve(count);
   }
-  // Each dwell segment's wait, in the order of the segments.
+  // Each dwell segment's wait, in the order of the segments; the joints
+  // recorded at the last segment's end (Trajectory::joints).
   std::vector<double> dwellTimes;
+  Joints recorded;
+  // The joints at an upright segment's end, from the last recorded (the
+  // rotary axes kept where they are free).
+  auto record = [&](const Segment &seg) {
+    const Joints near = recorded.size() ? recorded : joints;
+    const InverseResult at = options.kinematics->inverse({seg.end + options.workOffset, seg.axis1}, &near);
+    recorded = at.joints ? *at.joints : near;
+  };
   // A segment that tilts the tool and starts where the tool lies along a
   // rotary axis (upright, after a step that does not tilt it, or where its
   // axis passes that way): the free axis is set from where the tool axis
@@ -852,6 +861,8 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
     info.move = info.nextMove = move;
     junctionCap.push_back(kInf);
     dwellTimes.push_back(wait);
+    recorded = joints;  // turned: the new ones
+    out.joints.insert(out.joints.end(), recorded.data(), recorded.data() + recorded.size());
     out.segments.push_back(std::move(moved));
     stop = StopReason::Dwell;
   };
@@ -919,6 +930,15 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
     lastEnds = ends;
     lastTilted = tilted;
     budget.limitsFor(d, feed, info);
+    // Where the joints are at the segment's end: where jointDemand left them
+    // on a tilted one; on an upright one, the inverse kinematics from the
+    // last recorded (the rotary axes kept; only recorded, the caps of the
+    // tilted segments keep chaining from the last tilted one).
+    if (tilted)
+      recorded = joints;
+    else
+      record(seg);
+    out.joints.insert(out.joints.end(), recorded.data(), recorded.data() + recorded.size());
   };
   StopReason stop = StopReason::Start;
   // The dwells before piece `piece`: a segment each, at rest (their limits
@@ -935,8 +955,11 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
       info.stop = StopReason::Dwell;
       stop = StopReason::Dwell;
       dwellTimes.push_back(d.timeS);
-      if (options.kinematics)
+      if (options.kinematics) {
         junctionCap.push_back(kInf);
+        record(out.segments.back());
+        out.joints.insert(out.joints.end(), recorded.data(), recorded.data() + recorded.size());
+      }
     }
   };
   {

@@ -79,6 +79,11 @@ struct Trajectory {
   Frame frame = Frame::Xyz;
   /// The names of the axes SegmentInfo::axis counts ("x", ..., "c").
   std::vector<std::string> axisNames;
+  /// Planned on a 5-axis machine's joints: where every joint is at each
+  /// segment's end (Machine::axes order, mm and deg; axisNames.size() values
+  /// per segment, machine coordinates with the workpiece's origin at the
+  /// plan's work offset). Empty otherwise.
+  std::vector<double> joints;
   Vec3 start = Vec3::Zero();
   std::vector<Segment> segments;
   std::vector<Profile> profiles;  ///< one per segment

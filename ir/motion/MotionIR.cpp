@@ -164,6 +164,10 @@ void attachMotion(ir::Module &module, const ProgramPath &program, const runtime:
       if (info.sync)
         s.set("sync", ir::Value::boolean(true));
     }
+    const size_t jointCount = trajectory.axisNames.size();
+    if (jointCount > 0 && trajectory.joints.size() == trajectory.segments.size() * jointCount)
+      s.set("joints", ir::Value::reals(std::vector<double>(trajectory.joints.begin() + long(k * jointCount),
+                                                           trajectory.joints.begin() + long((k + 1) * jointCount))));
     if (seg.tilted()) {
       s.set("axes", ir::Value::reals({seg.axis0.x(), seg.axis0.y(), seg.axis0.z(), seg.axis1.x(), seg.axis1.y(),
                                       seg.axis1.z()}));
@@ -290,6 +294,8 @@ std::optional<runtime::Trajectory> readMotion(const ir::Module &module, Diagnost
         seg.axis0 = a0.normalized();
         seg.axis1 = a1.normalized();
       }
+      if (const ir::Value *j = s.get("joints"); j && j->type == ir::ValueType::Reals)
+        out.joints.insert(out.joints.end(), j->numbers.begin(), j->numbers.end());
       if (const std::optional<std::string> name = s.text("limited_axis")) {
         auto it = std::find(out.axisNames.begin(), out.axisNames.end(), *name);
         if (it == out.axisNames.end())
