@@ -35,6 +35,12 @@ const Node *findIn(const Node &n, std::string_view symbol, const Node **parent) 
 
 std::string quotedKind(const Node &n) { return "'" + n.kindName() + "'"; }
 
+/// Whether `n` gives a tool axis other than +z (+z is what none means).
+bool tiltedAxis(const Node &n) {
+  const std::optional<Vec3> axis = n.vec("axis");
+  return axis && (*axis - Vec3::UnitZ()).norm() > 1e-9;
+}
+
 /// What of `n` itself (not its subtree) a 3-axis milling reader cannot take.
 std::optional<std::string> beyond(const Node &n, ArcPlanes planes, Deposition deposition, ToolAxes toolAxes) {
   if (n.is(Trait::ControlFlow))
@@ -45,7 +51,7 @@ std::optional<std::string> beyond(const Node &n, ArcPlanes planes, Deposition de
     return std::string("an operation of another process (") + quotedKind(n) + ")";
   switch (n.kind) {
   case Kind::Moves:
-    if (n.has("axis") && toolAxes != ToolAxes::Take)
+    if (tiltedAxis(n) && toolAxes != ToolAxes::Take)
       return std::string("a tool axis");
     if (n.has("x_mode"))
       return std::string("a lathe's X mode");
@@ -57,7 +63,7 @@ std::optional<std::string> beyond(const Node &n, ArcPlanes planes, Deposition de
   case Kind::Rapid:
   case Kind::Linear:
   case Kind::Arc:
-    if (n.has("axis") && toolAxes != ToolAxes::Take)
+    if (tiltedAxis(n) && toolAxes != ToolAxes::Take)
       return std::string("a tool axis per move");
     if (n.has("feed_per_rev"))
       return std::string("a feed per revolution");
@@ -98,7 +104,7 @@ std::optional<Beyond> firstBeyond(const Node &n, ArcPlanes planes, OtherProcesse
 
 /// Whether `n` or a node under it gives a tool axis other than +z.
 bool tilted(const Node &n) {
-  if (auto axis = n.vec("axis"); axis && (*axis - Vec3::UnitZ()).norm() > 1e-9)
+  if (tiltedAxis(n))
     return true;
   return std::any_of(n.children.begin(), n.children.end(), [](const Node &c) { return tilted(c); });
 }
