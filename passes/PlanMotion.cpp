@@ -34,9 +34,7 @@ public:
     // Steps that tilt the tool are planned on the joints of a 5-axis
     // machine, told where the workpiece sits on it.
     std::unique_ptr<runtime::Kinematics> kinematics;
-    const bool fiveAxis = machine->kinematics.chain == runtime::Chain::TableTable ||
-                          machine->kinematics.chain == runtime::Chain::HeadTable ||
-                          machine->kinematics.chain == runtime::Chain::HeadHead;
+    const bool fiveAxis = machine->kinematics.fiveAxis();
     const std::vector<const ir::Node *> order = ir::programOrder(module);
     const auto tilted = std::find_if(order.begin(), order.end(), [](const ir::Node *e) { return ir::tiltsTool(*e); });
     if (tilted != order.end()) {

@@ -78,6 +78,9 @@ struct KinematicsSpec {
   /// The tool's direction (unit, from its tip towards the spindle) with every
   /// axis at 0, in machine coordinates: +z for mills, +x for a lathe.
   Eigen::Vector3d toolAxis = Eigen::Vector3d::UnitZ();
+  /// Whether the chain is one of the 5-axis chains (table-table, head-table,
+  /// head-head): two rotary axes that turn the tool to the workpiece.
+  bool fiveAxis() const { return chain == Chain::TableTable || chain == Chain::HeadTable || chain == Chain::HeadHead; }
   /// Lathe: programs give X as a diameter (G7, DIAMON); the x axis itself
   /// always moves in radius.
   bool diameterProgramming = false;

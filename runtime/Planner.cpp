@@ -556,11 +556,11 @@ struct JointEnds {
 /// every 1 mm of the path, at least 8 pieces (fewer let the player find
 /// jerk 3 % over a limit on the shipped head-head machine). False (d
 /// unchanged) where a point is out of reach: the backends and the verifier
-/// refuse such a path before it is planned.
-
+/// refuse such a path before it is planned. `startSolved`: `near` is
+/// already the joints at the segment's start (turnFirst found them).
 bool jointDemand(const Segment &seg, const Kinematics &kin, const Vec3 &offset, Joints &near, AxisDemand &d,
-                 JointEnds &ends) {
-  constexpr double kMargin = 1.25;  // what 16 or more pieces of differences may miss of a peak
+                 JointEnds &ends, bool startSolved) {
+  constexpr double kMargin = 1.25;  // what 8 or more pieces of differences may miss of a peak
   const double turned = std::acos(std::clamp(seg.axis0.dot(seg.axis1), -1.0, 1.0)) * 180 / std::numbers::pi;
   const int n = std::clamp(static_cast<int>(std::ceil(std::max(turned / 0.5, seg.length / 1.0))), 8, 64);
   const double h = seg.length / n;
@@ -568,7 +568,8 @@ bool jointDemand(const Segment &seg, const Kinematics &kin, const Vec3 &offset, 
     return false;
   std::array<Joints, 65> q;
   Joints at = near;
-  for (int i = 0; i <= n; ++i) {
+  q[0] = near;
+  for (int i = startSolved ? 1 : 0; i <= n; ++i) {
     const double s = seg.length * i / n;
     const InverseResult r = kin.inverse({seg.at(s).p + offset, seg.axisAt(s)}, &at);
     if (!r.joints)
@@ -814,6 +815,7 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   // joints that must move to get there turn first, the tip at rest: a
   // dwell as long as the slowest of them takes, from rest to rest within
   // its limits (the tool stops there).
+  // True when `joints` is then the solution at the segment's start.
   auto turnFirst = [&](StopReason &stop, uint32_t move, bool fromMiddle) {
     Segment &seg = out.segments.back();
     const Kinematics &kin = *options.kinematics;
@@ -829,14 +831,14 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
           near[Eigen::Index(k)] = 0;
     InverseResult at = kin.inverse({seg.start + offset, seg.axis0}, &near);
     if (!at.joints)
-      return;
+      return false;
     if (at.singular && seg.length > 0) {
       const double ahead = std::min(seg.length, 1e-3);
       const InverseResult next = kin.inverse({seg.at(ahead).p + offset, seg.axisAt(ahead)}, &joints);
       if (next.joints)
         at = kin.inverse({seg.start + offset, seg.axis0}, &*next.joints);
       if (!at.joints)
-        return;
+        return false;
     }
     // Joints that agree within what the inverse kinematics' rounding leaves
     // need no turn.
@@ -849,7 +851,7 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
     }
     joints = *at.joints;
     if (!(wait > 0))
-      return;
+      return true;
     Segment moved = std::move(seg);
     out.segments.pop_back();
     Segment turn = Segment::dwell(moved.start);
@@ -865,11 +867,13 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
     out.joints.insert(out.joints.end(), recorded.data(), recorded.data() + recorded.size());
     out.segments.push_back(std::move(moved));
     stop = StopReason::Dwell;
+    return true;
   };
   auto push = [&](double feed, uint32_t move, uint32_t next, StopReason stop, const AxisDemand &given) {
+    bool startSolved = false;
     if (options.kinematics && out.segments.back().tilted()) {
       const Segment &here = out.segments.back();
-      turnFirst(stop, move, feed == 0 && here.kind == SegmentKind::Line && here.axis0 != here.axis1);
+      startSolved = turnFirst(stop, move, feed == 0 && here.kind == SegmentKind::Line && here.axis0 != here.axis1);
     }
     const Segment &seg = out.segments.back();
     lengths.push_back(seg.length);
@@ -890,7 +894,7 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
     const bool tilted = seg.tilted();
     if (tilted) {
       JointEnds e;
-      if (jointDemand(seg, *options.kinematics, options.workOffset, joints, d, e))
+      if (jointDemand(seg, *options.kinematics, options.workOffset, joints, d, e, startSolved))
         ends = e;
     } else if (seg.kind != SegmentKind::Dwell && seg.length > 0) {
       JointEnds e;

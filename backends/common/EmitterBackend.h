@@ -101,9 +101,7 @@ private:
     if (!options.machine)
       missing = "a 5-axis machine (--machine=table-table-5axis, head-table-5axis, head-head-5axis or a file of "
                 "one's own)";
-    else if (options.machine->kinematics.chain != runtime::Chain::TableTable &&
-             options.machine->kinematics.chain != runtime::Chain::HeadTable &&
-             options.machine->kinematics.chain != runtime::Chain::HeadHead)
+    else if (!options.machine->kinematics.fiveAxis())
       missing = "a 5-axis machine (" + options.machine->name + " has no two rotary axes that turn the tool)";
     else if (!options.workOffset && !tcp)
       missing = "where the workpiece's origin is on the machine (--work-offset=X,Y,Z, machine coordinates with "
@@ -123,10 +121,7 @@ private:
   /// (Indexing.h) where the target writes it, with the workpiece's place on
   /// the table given; elsewhere the re-clamps stay, and a warning says why.
   bool index(Program &program, const EmitOptions &options, DiagnosticEngine &diags) const {
-    if (program.clampings.empty() || !options.machine ||
-        (options.machine->kinematics.chain != runtime::Chain::TableTable &&
-         options.machine->kinematics.chain != runtime::Chain::HeadTable &&
-         options.machine->kinematics.chain != runtime::Chain::HeadHead))
+    if (program.clampings.empty() || !options.machine || !options.machine->kinematics.fiveAxis())
       return true;
     if (!descriptor().rotaryIndexing) {
       diags.warning(SourceLoc{}, descriptor().name + " does not turn the rotary axes to each face yet (rs274 does): "

@@ -67,6 +67,11 @@ public:
                                         [](const auto &a) { return std::abs(a.second) > 1e-9; });
         continue;
       }
+      if (!placedAsIs(s.setup)) {
+        error(s, "tilts the tool on another face of the workpiece (setup " + s.setup->symbol +
+                     "), which stepnc does not write yet: give it in the first clamping's frame");
+        return false;
+      }
       if (!(tcp_ ? tcpStep(s) : step(s)))
         return false;
       turned = !tcp_;  // a TCP step turns its axes back to 0 itself
@@ -132,7 +137,7 @@ private:
       error(s, "the machine cannot put the tool at " + pointText(tip) + " along " + axisText(axis) + ": " + r.why);
       return std::nullopt;
     }
-    if (r.outsideTravel && (checkLinear_ || outsideRotary(*r.joints))) {
+    if (r.outsideTravel && (checkLinear_ || !outsideTravel(machine_, *r.joints, true).empty())) {
       error(s, "the tool at " + pointText(tip) + " along " + axisText(axis) +
                    " needs the machine's axes outside their travel (" + outsideTravel(machine_, *r.joints) +
                    ") with the workpiece's origin at " +
@@ -142,25 +147,10 @@ private:
     return r.joints;
   }
 
-  /// Whether a rotary axis of `q` is outside its travel.
-  bool outsideRotary(const runtime::Joints &q) const {
-    for (size_t k : rotary_) {
-      const double v = q[static_cast<Eigen::Index>(k)];
-      if (v < machine_.axes[k].travelMin - 1e-9 || v > machine_.axes[k].travelMax + 1e-9)
-        return true;
-    }
-    return false;
-  }
-
   /// A step for tool-centre-point control: the tip as the IR has it, the
   /// rotary angles on every move, moves halved where the angles' straight
   /// line would turn the tool off the IR's axis; the axes back to 0 after.
   bool tcpStep(Step &s) {
-    if (!placedAsIs(s.setup)) {
-      error(s, "tilts the tool on another face of the workpiece (setup " + s.setup->symbol +
-                   "), which stepnc does not write yet: give it in the first clamping's frame");
-      return false;
-    }
     std::vector<Move> out;
     bool placed = false;
     Vec3 at = Vec3::Zero();
@@ -191,43 +181,30 @@ private:
         near_ = *q;
         continue;
       }
-      // Halves until the rotary angles' straight line keeps the tool axis
+      // Halved until the rotary angles' straight line keeps the tool axis
       // within kJointAxisTolerance of the IR's halfway along each block.
-      struct Piece {
-        double ta, tb;
-        runtime::Joints qa, qb;
-        int depth;
-      };
-      std::vector<Piece> stack{{0, 1, near_, *q, 0}};
-      while (!stack.empty()) {
-        Piece piece = std::move(stack.back());
-        stack.pop_back();
-        const double tm = (piece.ta + piece.tb) / 2;
-        const Vec3 axis = kin_.forward((piece.qa + piece.qb) / 2).axis;
-        const double off = ir::angleBetween(axis, ir::turnAxis(m.fromAxis, m.axis, tm));
-        if (off > kJointAxisTolerance && piece.depth < kMaxHalvings) {
-          const std::optional<runtime::Joints> qm =
-              inverse(s, poseAt(m, tm).first, poseAt(m, tm).second, piece.qa);
-          if (!qm)
-            return false;
-          stack.push_back({tm, piece.tb, *qm, piece.qb, piece.depth + 1});
-          stack.push_back({piece.ta, tm, piece.qa, *qm, piece.depth + 1});
-          continue;
-        }
-        if (off > kJointAxisTolerance) {
-          error(s, "the rotary axes cannot follow the tool axis of the move to " + pointText(m.to) +
-                       " within " + formatShortest(kJointAxisTolerance) + " deg (it passes near a rotary axis)");
-          return false;
-        }
-        Move b = m;
-        b.from = at;
-        b.to = poseAt(m, piece.tb).first;
-        b.rotary = rotaryOf(piece.qb);
-        b.fromAxis = ir::turnAxis(m.fromAxis, m.axis, piece.ta);
-        b.axis = ir::turnAxis(m.fromAxis, m.axis, piece.tb);
-        out.push_back(b);
-        at = b.to;
-      }
+      const bool written = halve(
+          s, m, near_, *q,
+          [&](double ta, double tb, const runtime::Joints &qa, const runtime::Joints &qb) {
+            const Vec3 axis = kin_.forward((qa + qb) / 2).axis;
+            return ir::angleBetween(axis, ir::turnAxis(m.fromAxis, m.axis, (ta + tb) / 2)) <= kJointAxisTolerance;
+          },
+          [&](const runtime::Joints &, const runtime::Joints &) {
+            return "the rotary axes cannot follow the tool axis of the move to " + pointText(m.to) + " within " +
+                   formatShortest(kJointAxisTolerance) + " deg (it passes near a rotary axis)";
+          },
+          [&](double ta, double tb, const runtime::Joints &qb) {
+            Move b = m;
+            b.from = at;
+            b.to = poseAt(m, tb).first;
+            b.rotary = rotaryOf(qb);
+            b.fromAxis = ir::turnAxis(m.fromAxis, m.axis, ta);
+            b.axis = ir::turnAxis(m.fromAxis, m.axis, tb);
+            out.push_back(b);
+            at = b.to;
+          });
+      if (!written)
+        return false;
       near_ = *q;
     }
     if (placed) {
@@ -252,11 +229,6 @@ private:
   }
 
   bool step(Step &s) {
-    if (!placedAsIs(s.setup)) {
-      error(s, "tilts the tool on another face of the workpiece (setup " + s.setup->symbol +
-                   "), which stepnc does not write as joints yet: give it in the first clamping's frame");
-      return false;
-    }
     radius_ = s.tool >= 0 ? p_.tools[static_cast<size_t>(s.tool)].diameter / 2 : 0;
     std::vector<Move> out;
     bool placed = false;
@@ -347,6 +319,52 @@ private:
     const double minutes = (length > 1e-9 ? length : turn * radius_) / m.feed;
     if (!(minutes > 0))
       return true;  // no motion
+    auto swing = [&](const runtime::Joints &a, const runtime::Joints &b) {
+      double most = 0;
+      for (size_t k : rotary_)
+        most = std::max(most, std::abs(b[static_cast<Eigen::Index>(k)] - a[static_cast<Eigen::Index>(k)]));
+      return most;
+    };
+    return halve(
+        s, m, qa, qb,
+        [&](double ta, double tb, const runtime::Joints &a, const runtime::Joints &b) {
+          // The IR's pose nearest the joints' middle: by where the tip is
+          // along the move (halfway when it turns in place).
+          const runtime::ToolPose mid = kin_.forward((a + b) / 2);
+          double t = (ta + tb) / 2;
+          if (length > 1e-9)
+            t = std::clamp((mid.tipMm - offset_ - m.from).dot(m.to - m.from) / (length * length), ta, tb);
+          const auto [tip, axis] = poseAt(m, t);
+          return (mid.tipMm - offset_ - tip).norm() <= kJointTolerance &&
+                 ir::angleBetween(mid.axis, axis) <= kJointAxisTolerance && swing(a, b) < kFlipDeg;
+        },
+        [&](const runtime::Joints &a, const runtime::Joints &b) {
+          return "the machine's joints cannot follow the move to " + pointText(m.to) + " along " + axisText(m.axis) +
+                 ": the rotary axes would turn " + formatFixed(swing(a, b), 3) +
+                 " deg within one block (the tool axis passes near a rotary axis, where the other has to swing "
+                 "round, or an axis runs out of travel and only the chain's other solution is left)";
+        },
+        [&](double ta, double tb, const runtime::Joints &b) {
+          Move block = m;
+          block.from = at;
+          block.to = programPoint(b);
+          block.rotary = rotaryOf(b);
+          block.inverseTime = 1 / (minutes * (tb - ta));
+          block.fromAxis = ir::turnAxis(m.fromAxis, m.axis, ta);
+          block.axis = ir::turnAxis(m.fromAxis, m.axis, tb);
+          out.push_back(block);
+          at = block.to;
+        });
+  }
+
+  /// Move m from joints qa to qb cut in halves, each half's end through the
+  /// inverse kinematics at the IR's pose there, until `holds(ta, tb, qa, qb)`
+  /// says the block between keeps to the move; `emit(ta, tb, qb)` writes the
+  /// blocks in order. False (reported: `why(qa, qb)` of the block that still
+  /// does not hold after kMaxHalvings) when it cannot be made to.
+  template <class Holds, class Why, class Emit>
+  bool halve(const Step &s, const Move &m, const runtime::Joints &qa, const runtime::Joints &qb, Holds holds, Why why,
+             Emit emit) {
     struct Piece {
       double ta, tb;
       runtime::Joints qa, qb;
@@ -356,40 +374,17 @@ private:
     while (!stack.empty()) {
       Piece piece = std::move(stack.back());
       stack.pop_back();
-      const double tm = (piece.ta + piece.tb) / 2;
-      const runtime::ToolPose mid = kin_.forward((piece.qa + piece.qb) / 2);
-      // The IR's pose nearest the joints' middle: by where the tip is along
-      // the move (halfway when it turns in place).
-      double t = tm;
-      if (length > 1e-9)
-        t = std::clamp((mid.tipMm - offset_ - m.from).dot(m.to - m.from) / (length * length), piece.ta, piece.tb);
-      const auto [tip, axis] = poseAt(m, t);
-      const double off = (mid.tipMm - offset_ - tip).norm();
-      const double offDeg = ir::angleBetween(mid.axis, axis);
-      double swing = 0;
-      for (size_t k : rotary_)
-        swing = std::max(swing, std::abs(piece.qb[static_cast<Eigen::Index>(k)] - piece.qa[static_cast<Eigen::Index>(k)]));
-      if ((off <= kJointTolerance && offDeg <= kJointAxisTolerance && swing < kFlipDeg) || piece.depth >= kMaxHalvings) {
-        if (swing >= kFlipDeg || off > kJointTolerance || offDeg > kJointAxisTolerance) {
-          error(s, "the machine's joints cannot follow the move to " + pointText(m.to) + " along " +
-                       axisText(m.axis) + ": the rotary axes would turn " + formatFixed(swing, 3) +
-                       " deg within one block (the tool axis passes near a rotary axis, where the other has to "
-                       "swing round, or an axis runs out of travel and only the chain's other solution is left)");
-          return false;
-        }
-        Move b = m;
-        b.from = at;
-        b.to = programPoint(piece.qb);
-        b.rotary = rotaryOf(piece.qb);
-        b.inverseTime = 1 / (minutes * (piece.tb - piece.ta));
-        b.fromAxis = ir::turnAxis(m.fromAxis, m.axis, piece.ta);
-        b.axis = ir::turnAxis(m.fromAxis, m.axis, piece.tb);
-        out.push_back(b);
-        at = b.to;
+      if (holds(piece.ta, piece.tb, piece.qa, piece.qb)) {
+        emit(piece.ta, piece.tb, piece.qb);
         continue;
       }
-      const auto [midTip, midAxis] = poseAt(m, tm);
-      const std::optional<runtime::Joints> qm = inverse(s, midTip, midAxis, piece.qa);
+      if (piece.depth >= kMaxHalvings) {
+        error(s, why(piece.qa, piece.qb));
+        return false;
+      }
+      const double tm = (piece.ta + piece.tb) / 2;
+      const auto [tip, axis] = poseAt(m, tm);
+      const std::optional<runtime::Joints> qm = inverse(s, tip, axis, piece.qa);
       if (!qm)
         return false;
       // The second half after the first: pushed first.

@@ -53,9 +53,11 @@ std::string axisAddress(const runtime::Axis &axis) {
   return s;
 }
 
-std::string outsideTravel(const runtime::Machine &machine, const Eigen::VectorXd &joints) {
+std::string outsideTravel(const runtime::Machine &machine, const Eigen::VectorXd &joints, bool rotaryOnly) {
   std::string axes;
   for (size_t k = 0; k < machine.axes.size(); ++k) {
+    if (rotaryOnly && !machine.axes[k].rotary)
+      continue;
     const double v = joints[static_cast<Eigen::Index>(k)];
     if (v < machine.axes[k].travelMin - 1e-9 || v > machine.axes[k].travelMax + 1e-9)
       axes += (axes.empty() ? "" : ", ") + axisAddress(machine.axes[k]) + formatShortest(v);

@@ -38,8 +38,8 @@ namespace stepnc::backends {
 std::string axisAddress(const runtime::Axis &axis);
 
 /// The axes `joints` puts outside their travel, as a program writes them
-/// ("A-130, C400"); "" when none is.
-std::string outsideTravel(const runtime::Machine &machine, const Eigen::VectorXd &joints);
+/// ("A-130, C400"); "" when none is. `rotaryOnly`: the rotary axes alone.
+std::string outsideTravel(const runtime::Machine &machine, const Eigen::VectorXd &joints, bool rotaryOnly = false);
 
 /// The kinematics of `machine` for a program that turns its rotary axes
 /// with the workpiece's origin at `workOffset`; null (reported) when it

@@ -23,6 +23,11 @@ Node Emitter::rapidNode(const Vec3 &to, const char *role) {
   return m;
 }
 
+Node Emitter::tilted(Node move, const Vec3 &axis) {
+  move.set("axis", ir::Value::direction(axis));
+  return move;
+}
+
 Node Emitter::linearNode(const Vec3 &to, double feed, const char *role) {
   Node m(ir::Kind::Linear);
   m.set("to", Value::point(to));

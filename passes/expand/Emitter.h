@@ -28,6 +28,13 @@ public:
   /// linear() write, for passes that edit moves already written.
   static ir::Node rapidNode(const ir::Vec3 &to, const char *role);
   static ir::Node linearNode(const ir::Vec3 &to, double feed, const char *role);
+  /// A move node with the tool axis at its end (5-axis moves, IR `axis`).
+  static ir::Node tilted(ir::Node move, const ir::Vec3 &axis);
+  /// The point along the tool axis `axis` (z part above 0) from `from` at
+  /// height z: where a tilted tool is reached down, or left up, its axis.
+  static ir::Vec3 alongAxisTo(const ir::Vec3 &from, const ir::Vec3 &axis, double z) {
+    return from + axis * ((z - from.z()) / axis.z());
+  }
 
   /// A rapid to `to`; none when the tool is already there.
   void rapid(const ir::Vec3 &to, const char *role = "position");

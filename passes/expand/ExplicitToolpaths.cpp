@@ -132,12 +132,11 @@ bool expandTiltedToolpaths(Expander &x, const Step &step) {
   std::optional<Vec3> at;
   Vec3 axis = Vec3::UnitZ();
   auto add = [&](Node m, const Vec3 &to, const Vec3 &a) {
-    m.set("axis", ir::Value::direction(a));
-    moves.add(std::move(m));
+    moves.add(Emitter::tilted(std::move(m), a));
     at = to;
     axis = a;
   };
-  auto upTo = [](const Vec3 &from, const Vec3 &a, double z) { return Vec3(from + a * ((z - from.z()) / a.z())); };
+  const auto upTo = Emitter::alongAxisTo;
   auto leave = [&]() {
     if (at && at->z() < secplane - 1e-9)
       add(Emitter::rapidNode(upTo(*at, axis, secplane), "retract"), upTo(*at, axis, secplane), axis);

@@ -252,13 +252,9 @@ private:
   }
 
   Node move(ir::Kind kind, const Vec3 &to, const Vec3 &axis, const char *role, double feed = 0) {
-    Node m = kind == ir::Kind::Rapid ? Emitter::rapidNode(to, role) : Emitter::linearNode(to, feed, role);
-    m.set("axis", ir::Value::direction(axis));
-    return m;
+    return Emitter::tilted(kind == ir::Kind::Rapid ? Emitter::rapidNode(to, role) : Emitter::linearNode(to, feed, role),
+                           axis);
   }
-
-  /// Above a point along the axis to height z.
-  static Vec3 upTo(const Vec3 &from, const Vec3 &axis, double z) { return from + axis * ((z - from.z()) / axis.z()); }
 
   /// Down to the first pose from off the wall, round, and back out and up.
   void cut(const std::vector<Pose> &poses) {
@@ -266,15 +262,15 @@ private:
     const Pose &start = poses.front(), &end = poses.back();
     // Off the wall along its normal by a lead, where the tool stands clear.
     const Vec3 in = start.tip + kLead * start.normal, out = end.tip + kLead * end.normal;
-    moves.add(move(ir::Kind::Rapid, upTo(in, start.axis, secplane_), start.axis, "position"));
+    moves.add(move(ir::Kind::Rapid, Emitter::alongAxisTo(in, start.axis, secplane_), start.axis, "position"));
     if (p_.clearanceZ > in.z())
-      moves.add(move(ir::Kind::Rapid, upTo(in, start.axis, p_.clearanceZ), start.axis, "approach"));
+      moves.add(move(ir::Kind::Rapid, Emitter::alongAxisTo(in, start.axis, p_.clearanceZ), start.axis, "approach"));
     moves.add(move(ir::Kind::Linear, in, start.axis, "plunge", p_.plungeFeed));
     moves.add(move(ir::Kind::Linear, start.tip, start.axis, "approach", p_.feed));
     for (size_t k = 1; k < poses.size(); ++k)
       moves.add(move(ir::Kind::Linear, poses[k].tip, poses[k].axis, "cut", p_.feed));
     moves.add(move(ir::Kind::Linear, out, end.axis, "retract", p_.feed));
-    moves.add(move(ir::Kind::Rapid, upTo(out, end.axis, secplane_), end.axis, "retract"));
+    moves.add(move(ir::Kind::Rapid, Emitter::alongAxisTo(out, end.axis, secplane_), end.axis, "retract"));
   }
 
   /// mm the tool starts and ends off the wall, along its normal.
