@@ -13,11 +13,13 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <map>
 #include <mutex>
 #include <numbers>
+#include <span>
 
 namespace stepnc::runtime {
 
@@ -55,7 +57,7 @@ bool inTravel(const Axis &a, double v) {
 /// and nearest `nearDeg` among those.
 double wrapNear(const Axis &a, double deg, double nearDeg) {
   const double k0 = std::round((nearDeg - deg) / 360);
-  std::vector<double> tries = {deg + 360 * (k0 - 1), deg + 360 * k0, deg + 360 * (k0 + 1),
+  const std::array<double, 5> tries = {deg + 360 * (k0 - 1), deg + 360 * k0, deg + 360 * (k0 + 1),
                                deg + 360 * std::ceil((a.travelMin - deg) / 360),
                                deg + 360 * std::floor((a.travelMax - deg) / 360)};
   double best = deg + 360 * k0;
@@ -72,7 +74,7 @@ double wrapNear(const Axis &a, double deg, double nearDeg) {
 
 /// Of several solutions, the one inside every axis's travel (if any) whose
 /// rotary axes turn least from `near`, then whose linear axes move least.
-InverseResult choose(const std::vector<Joints> &solutions, const std::vector<Axis> &axes, const Joints &near,
+InverseResult choose(std::span<const Joints> solutions, const std::vector<Axis> &axes, const Joints &near,
                      bool singular) {
   InverseResult r;
   r.singular = singular;
@@ -133,8 +135,10 @@ public:
       r.why = "an xyz machine holds its tool along +z";
       return r;
     }
-    return choose({Joints(pose.tipMm)}, axes_, nearOrZero(near, 3), false);
+    const Joints q = pose.tipMm;
+    return choose({&q, 1}, axes_, nearOrZero(near, 3), false);
   }
+  std::optional<Mat3> tipTurn(const Joints &) const override { return Mat3::Identity(); }
 
 private:
   std::vector<Axis> axes_;
@@ -207,11 +211,13 @@ public:
       return none;
     }
     const double g = std::sqrt(std::max(0.0, g2));
-    std::vector<Joints> solutions;
+    std::array<Joints, 2> solutions;
+    size_t found = 0;
     bool singular = false;
     for (double sign : {1.0, -1.0}) {
       const Vec3 c = a * w1 + b * w2 + sign * g * across;
-      Joints q = near;
+      Joints &q = solutions[found++];
+      q = near;
       // A free angle (k0 along w2, or k along w1) keeps its value in `near`.
       const std::optional<double> t2 = angleTaking(w2, k0_, c);
       const std::optional<double> t1 = angleTaking(w1, c, k);
@@ -219,17 +225,48 @@ public:
       const Eigen::Index j1 = last.rotary.joint, j2 = first.rotary.joint;
       q[j2] = t2 ? wrapNear(axes_[static_cast<size_t>(j2)], *t2 / first.sign, near[j2]) : near[j2];
       q[j1] = t1 ? wrapNear(axes_[static_cast<size_t>(j1)], *t1 / last.sign, near[j1]) : near[j1];
-      // The tip in machine coordinates: turned by the table (innermost
-      // first), less the head's offset.
+      if (g == 0)
+        break;  // the cones touch: one solution
+    }
+    // The tip in machine coordinates: turned by the table (innermost
+    // first), less the head's offset.
+    auto place = [&](Joints &q) {
       Vec3 tip = pose.tipMm;
       for (auto it = table_.rbegin(); it != table_.rend(); ++it)
         tip = it->pivotMm + rotation(it->direction, q[it->joint]) * (tip - it->pivotMm);
       q.head<3>() = tip - headAt(q).first;
-      solutions.push_back(q);
-      if (g == 0)
-        break;  // the cones touch: one solution
+    };
+    // The solution whose rotary axes turn least, when it is inside every
+    // axis's travel and the other turns them more, is what choose() takes:
+    // the other's positions are not needed (most calls, along a path).
+    auto turned = [&](const Joints &q) {
+      double sum = 0;
+      for (const Rotary &r : head_)
+        sum += std::abs(q[r.joint] - near[r.joint]);
+      for (const Rotary &r : table_)
+        sum += std::abs(q[r.joint] - near[r.joint]);
+      return sum;
+    };
+    const size_t least = found == 2 && turned(solutions[1]) < turned(solutions[0]) ? 1 : 0;
+    place(solutions[least]);
+    if (found == 1 || turned(solutions[1 - least]) > turned(solutions[least]) + 1e-9) {
+      bool in = true;
+      for (size_t j = 0; j < axes_.size(); ++j)
+        in &= inTravel(axes_[j], solutions[least][static_cast<Eigen::Index>(j)]);
+      if (in)
+        return verified(*this, pose, choose({&solutions[least], 1}, axes_, near, singular));
     }
-    return verified(*this, pose, choose(solutions, axes_, near, singular));
+    if (found == 2)
+      place(solutions[1 - least]);
+    return verified(*this, pose, choose({solutions.data(), found}, axes_, near, singular));
+  }
+
+  std::optional<Mat3> tipTurn(const Joints &q) const override {
+    // The table's turns act on the tip innermost first (inverse above).
+    Mat3 m = Mat3::Identity();
+    for (const Rotary &t : table_)
+      m = m * rotation(t.direction, q[t.joint]);
+    return m;
   }
 
 private:
@@ -280,7 +317,7 @@ public:
     q[1] = p.z();
     if (c_ < 0) {
       q[0] = p.x();
-      return verified(*this, pose, choose({q}, axes_, near, false));
+      return verified(*this, pose, choose({&q, 1}, axes_, near, false));
     }
     const double r = std::hypot(p.x(), p.y());
     if (r < kSingular * (1 + std::abs(p.z()))) {
@@ -293,7 +330,7 @@ public:
       if (!free)
         q[c_] = wrapNear(axes_[static_cast<size_t>(c_)],
                          (std::atan2(k0_.y(), k0_.x()) - std::atan2(k.y(), k.x())) / kDeg, near[c_]);
-      return verified(*this, pose, choose({q}, axes_, near, free));
+      return verified(*this, pose, choose({&q, 1}, axes_, near, free));
     }
     // The workpiece turned by c shows the tip at angle -c in its frame.
     const double c = -std::atan2(p.y(), p.x()) / kDeg;
@@ -303,7 +340,8 @@ public:
     q[c_] = wrapNear(axisC, c, near[c_]);
     across[0] = -r;
     across[c_] = wrapNear(axisC, c + 180, near[c_]);
-    return verified(*this, pose, choose({q, across}, axes_, near, false));
+    const std::array<Joints, 2> both = {q, across};
+    return verified(*this, pose, choose(both, axes_, near, false));
   }
 
 private:

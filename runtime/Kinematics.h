@@ -27,8 +27,10 @@
 
 namespace stepnc::runtime {
 
-/// Joint values in Machine::axes order: mm for linear axes, deg for rotary.
-using Joints = Eigen::VectorXd;
+/// Joint values in Machine::axes order: mm for linear axes, deg for rotary;
+/// on the stack (at most kMaxJoints), so that the planner's inverse
+/// kinematics at every sample allocate nothing.
+using Joints = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxJoints, 1>;
 
 /// Where the tool is, in the workpiece's frame.
 struct ToolPose {
@@ -66,6 +68,17 @@ public:
   /// joints; 0 when null) is taken; at a singularity the free rotary axis
   /// keeps its value from `near`.
   virtual InverseResult inverse(const ToolPose &pose, const Joints *near = nullptr) const = 0;
+  /// Where the joints x, y, z are the tip turned and moved by the rotary
+  /// axes (the serial chains: a table turning the workpiece, a head
+  /// offsetting the tip by its angles alone): the rotation M with which, at
+  /// joints q and the tool's direction held, a move dp of the tip in the
+  /// workpiece's frame moves x, y, z by M dp. The planner bounds the joints'
+  /// curvature from the path's own through it. nullopt (the default) where
+  /// they are not (parallel kinematics).
+  virtual std::optional<Eigen::Matrix3d> tipTurn(const Joints &q) const {
+    (void)q;
+    return std::nullopt;
+  }
 };
 
 /// Makes a solver for a generic chain; `error` says why not when it returns

@@ -219,6 +219,9 @@ bool readChain(TomlReader &r, const toml::table &t, KinematicsSpec &spec) {
       }
       if (list->empty())
         r.error(n->source(), "kinematics.joints names no axis");
+      else if (list->size() > size_t(kMaxJoints))
+        r.error(n->source(), "kinematics.joints names " + std::to_string(list->size()) + " axes; stepnc moves at most " +
+                                 std::to_string(kMaxJoints));
       spec.head = *list;  // kept in `head` until the axes are read
     }
     if (const toml::table *p = r.table(t, "parameters", "kinematics.parameters", false))

@@ -103,6 +103,10 @@ struct DepositionCodes {
   std::optional<double> maxWire;    ///< mm/min
 };
 
+/// The most axes a machine's kinematics moves (a hexapod has 6, a hybrid
+/// machine a few more): joint vectors (runtime::Joints) live on the stack.
+inline constexpr int kMaxJoints = 8;
+
 struct Machine {
   std::string name;
   KinematicsSpec kinematics;

@@ -17,6 +17,8 @@ namespace stepnc::runtime {
 
 namespace {
 
+using Mat3 = Eigen::Matrix3d;
+
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 // How an axis's budget is shared on a curved segment (REFERENCES: v <=
@@ -548,40 +550,96 @@ struct JointEnds {
   Joints d1Start, d1End, d2Start, d2End;
 };
 
+/// The pose the joints were last solved at by jointDemand (a segment's end),
+/// so that the next segment starting there need not solve it again.
+struct SolvedPose {
+  Vec3 tip = Vec3::Zero();  ///< in machine coordinates at zero (the work offset added)
+  Vec3 axis = Vec3::Zero();
+  Mat3 turn = Mat3::Identity();  ///< Kinematics::tipTurn there (serial chains)
+  bool valid = false;  ///< the planner's joints are that pose's, not singular there
+  bool at(const Vec3 &t, const Vec3 &a) const { return valid && tip == t && axis == a; }
+};
+
 /// The demand a segment that tilts the tool makes of the machine's joints:
-/// the joints at points along it (each solution the nearest the one before,
-/// starting from `near`, which is left at the segment's end), and their
-/// first three derivatives with respect to the tip's path by finite
-/// differences, with a margin. Points: every 0.5 deg the axis turns and
-/// every 1 mm of the path, at least 8 pieces (fewer let the player find
-/// jerk 3 % over a limit on the shipped head-head machine). False (d
+/// their first three derivatives with respect to the tip's path, from the
+/// joints at points along it (each solution the nearest the one before,
+/// starting from `near`, which is left at the segment's end). False (d
 /// unchanged) where a point is out of reach: the backends and the verifier
 /// refuse such a path before it is planned. `startSolved`: `near` is
 /// already the joints at the segment's start (turnFirst found them).
+///
+/// On a serial chain (Kinematics::tipTurn) the linear joints are the tip
+/// turned, x(s) = M(s) p(s) + c(s), M and c functions of the tool's
+/// direction alone: their derivatives are M0 p^(n) (the path's own, whose
+/// bounds d already holds, exact at every curvature peak however short the
+/// segment) plus those of the rest, rho(s) = x(s) - M0 p(s), which changes
+/// only as the direction turns (slowly and smoothly along the segment's
+/// great circle): so a few points suffice, every 0.5 deg of turn and every
+/// 1 mm of path, at least 3 pieces (the third differences). Bounds per axis:
+/// margin x (|M0| d + |M1 - M0| d + differences of rho); the rotary joints
+/// by their differences, with the margin. The margin on the path's part is
+/// for the junctions: there the rotary axes' rates jump (each segment's
+/// great circle its own), which the junction caps bound but which adds to
+/// the jerk the segments' own limits use up (without it the player finds x
+/// and y jerk up to 23 % over just after junctions on the 5-axis benchmark
+/// path). Elsewhere (parallel kinematics) every joint by its differences, at
+/// least 8 pieces (fewer let the player find jerk 3 % over a limit on the
+/// shipped head-head machine); the path's own curvature as a floor.
+///
+/// The joints at the start are not solved again where the last segment
+/// ended (`solved`); so on a path of short segments each costs three
+/// inverse kinematics (BM_PlanFiveAxis, docs/performance.md).
 bool jointDemand(const Segment &seg, const Kinematics &kin, const Vec3 &offset, Joints &near, AxisDemand &d,
-                 JointEnds &ends, bool startSolved) {
-  constexpr double kMargin = 1.25;  // what 8 or more pieces of differences may miss of a peak
+                 JointEnds &ends, bool startSolved, SolvedPose &solved) {
+  constexpr double kMargin = 1.25;  // what the pieces' differences may miss of a peak
+  const std::optional<Mat3> turn0 = kin.tipTurn(near);
+  const bool serial = turn0.has_value();
+  const GreatCircle circle(seg.axis0, seg.axis1);
   const double turned = std::acos(std::clamp(seg.axis0.dot(seg.axis1), -1.0, 1.0)) * 180 / std::numbers::pi;
-  const int n = std::clamp(static_cast<int>(std::ceil(std::max(turned / 0.5, seg.length / 1.0))), 8, 64);
+  const int n = std::clamp(static_cast<int>(std::ceil(std::max(turned / 0.5, seg.length / 1.0))), serial ? 3 : 8, 64);
   const double h = seg.length / n;
   if (!(h > 0))
     return false;
   std::array<Joints, 65> q;
+  std::array<Vec3, 65> tip;
   Joints at = near;
   q[0] = near;
+  tip[0] = seg.pointAt(0) + offset;
+  const bool continued = solved.at(tip[0], seg.axis0);
+  startSolved |= continued;
+  bool singularEnd = false;
   for (int i = startSolved ? 1 : 0; i <= n; ++i) {
     const double s = seg.length * i / n;
-    const InverseResult r = kin.inverse({seg.at(s).p + offset, seg.axisAt(s)}, &at);
-    if (!r.joints)
+    tip[size_t(i)] = seg.pointAt(s) + offset;
+    const InverseResult r = kin.inverse({tip[size_t(i)], circle.at(seg.fraction(s))}, &at);
+    if (!r.joints) {
+      solved.valid = false;
       return false;
+    }
     at = *r.joints;
-    q[static_cast<size_t>(i)] = at;
+    q[size_t(i)] = at;
+    singularEnd = r.singular;
   }
   near = at;
+  // On a serial chain the linear joints' differences are taken of rho.
+  Mat3 m0 = Mat3::Identity(), m1 = Mat3::Identity();
+  if (serial) {
+    m0 = continued ? solved.turn : *kin.tipTurn(q[0]);
+    m1 = *kin.tipTurn(q[size_t(n)]);
+    for (int i = 0; i <= n; ++i)
+      q[size_t(i)].head<3>() -= m0 * tip[size_t(i)];
+  }
+  solved = {tip[size_t(n)], seg.axis1, m1, !singularEnd};
+  const Mat3 spread = (m1 - m0).cwiseAbs();
   ends.d1Start = (q[1] - q[0]) / h;
   ends.d1End = (q[size_t(n)] - q[size_t(n - 1)]) / h;
-  // The second derivatives near the ends: their largest over the segment
-  // (below), a bound for what finite differences see at the ends.
+  if (serial) {
+    ends.d1Start.head<3>() += m0 * seg.at(0).r1;
+    ends.d1End.head<3>() += m0 * seg.at(seg.length).r1;
+  }
+  // The path's own bounds as the linear joints see them.
+  const Mat3 bound = m0.cwiseAbs() + spread;
+  const Vec3 path1 = bound * d.r1, path2 = bound * d.r2, path3 = bound * d.r3;
   AxisDemand out;
   size_t rotary = 0;
   for (Eigen::Index k = 0; k < near.size(); ++k) {
@@ -594,10 +652,16 @@ bool jointDemand(const Segment &seg, const Kinematics &kin, const Vec3 &offset, 
       r3 = std::max(r3, std::abs(q[size_t(i + 2)][k] - 3 * q[size_t(i + 1)][k] + 3 * q[size_t(i)][k] -
                                  q[size_t(i - 1)][k]) /
                             (h * h * h));
-    if (k < 3) {
+    if (k < 3 && serial) {
+      out.r1[k] = kMargin * (path1[k] + r1);
+      out.r2[k] = kMargin * (path2[k] + r2);
+      out.r3[k] = kMargin * (path3[k] + r3);
+    } else if (k < 3) {
+      // The joints' curvature cannot be less than the path's own (the tip's
+      // path is what the linear joints carry, turned).
       out.r1[k] = kMargin * r1;
-      out.r2[k] = kMargin * r2;
-      out.r3[k] = kMargin * r3;
+      out.r2[k] = std::max(kMargin * r2, d.r2[k]);
+      out.r3[k] = std::max(kMargin * r3, d.r3[k]);
     } else if (rotary < out.rotary1.size()) {
       out.rotary1[rotary] = kMargin * r1;
       out.rotary2[rotary] = kMargin * r2;
@@ -605,10 +669,6 @@ bool jointDemand(const Segment &seg, const Kinematics &kin, const Vec3 &offset, 
       ++rotary;
     }
   }
-  // The joints' curvature cannot be less than the path's own (the tip's
-  // path is what the linear joints carry, turned).
-  out.r2 = out.r2.cwiseMax(d.r2);
-  out.r3 = out.r3.cwiseMax(d.r3);
   d = out;
   ends.d2Start = ends.d2End = Joints::Zero(near.size());
   for (Eigen::Index k = 0; k < near.size(); ++k)
@@ -790,6 +850,7 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   // the joints' derivatives at the end of the segment before; and the speed
   // each junction may be passed at (joints' rates that jump there).
   Joints joints;
+  SolvedPose solved;  // where `joints` were solved, when jointDemand did
   std::optional<JointEnds> lastEnds;
   bool lastTilted = false;
   std::vector<double> junctionCap;
@@ -824,6 +885,11 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
     // solution nearest the middle of their travel (0), as the G-code
     // targets turn them (docs/five-axis.md): the path after has the most
     // travel either way.
+    // Starting where the last segment that tilted the tool ended, the
+    // joints are already there.
+    if (!fromMiddle && solved.at(seg.start + offset, seg.axis0))
+      return true;
+    solved.valid = false;
     Joints near = joints;
     if (fromMiddle)
       for (size_t k = 3; k < machine.axes.size() && Eigen::Index(k) < near.size(); ++k)
@@ -894,7 +960,7 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
     const bool tilted = seg.tilted();
     if (tilted) {
       JointEnds e;
-      if (jointDemand(seg, *options.kinematics, options.workOffset, joints, d, e, startSolved))
+      if (jointDemand(seg, *options.kinematics, options.workOffset, joints, d, e, startSolved, solved))
         ends = e;
     } else if (seg.kind != SegmentKind::Dwell && seg.length > 0) {
       JointEnds e;

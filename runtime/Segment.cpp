@@ -331,14 +331,22 @@ Segment Segment::arcTurns(const Vec3 &from, const Vec3 &to, const Vec3 &center, 
   return s;
 }
 
-Vec3 axisBetween(const Vec3 &u, const Vec3 &w, double t) {
-  if (t <= 0 || u == w)
-    return u;
-  if (t >= 1)
-    return w;
-  // The rotation taking u to w, a fraction t of it (a great circle).
-  const Eigen::Quaterniond turn = Eigen::Quaterniond::FromTwoVectors(u, w);
-  return (Eigen::Quaterniond::Identity().slerp(t, turn) * u).normalized();
+GreatCircle::GreatCircle(const Vec3 &u, const Vec3 &w) : u_(u), w_(w) {
+  if (u == w)
+    return;
+  const Vec3 off = w - u * u.dot(w);  // w's part across u
+  angle_ = std::atan2(off.norm(), u.dot(w));
+  if (off.norm() > 1e-12) {
+    across_ = off.normalized();
+  } else if (u.dot(w) < 0) {
+    // Opposite: any great circle joins them; the one through the
+    // coordinate axis least along u.
+    Eigen::Index least = 0;
+    u.cwiseAbs().minCoeff(&least);
+    across_ = (Vec3::Unit(least) - u * u[least]).normalized();
+  } else {
+    angle_ = 0;  // equal to rounding
+  }
 }
 
 Segment Segment::part(double s0, double s1) const {
@@ -417,6 +425,35 @@ Segment Segment::dwell(const Vec3 &at) {
   return s;
 }
 
+double Segment::blendParameter(const QuinticCurve &q, double s) const {
+  // The table interval holding s, then Newton on the arc length within it.
+  int i = int(std::upper_bound(arcTable.begin(), arcTable.end(), s) - arcTable.begin()) - 1;
+  i = std::clamp(i, 0, kBlendTable - 1);
+  const double u0 = double(i) / kBlendTable, u1 = double(i + 1) / kBlendTable;
+  const double span = arcTable[i + 1] - arcTable[i];
+  double u = span > 0 ? u0 + (u1 - u0) * (s - arcTable[i]) / span : u0;
+  for (int it = 0; it < 4; ++it) {
+    const double g = arcTable[i] + q.length(u0, u) - s;
+    const double sp = q.speed(u);
+    if (sp <= 0)
+      break;
+    u = std::clamp(u - g / sp, u0, u1);
+    if (std::abs(g) < 1e-13)
+      break;
+  }
+  return u;
+}
+
+Vec3 Segment::curvePointAt(double s) const {
+  if (kind != SegmentKind::Blend)
+    return curveAt(s).p;
+  s = std::clamp(s, 0.0, length);
+  if (s >= length)
+    return end;
+  const QuinticCurve q(ctrl);
+  return q.point(blendParameter(q, s));
+}
+
 PathPoint Segment::curveAt(double s) const {
   s = std::clamp(s, 0.0, length);
   switch (kind) {
@@ -440,21 +477,7 @@ PathPoint Segment::curveAt(double s) const {
   }
   case SegmentKind::Blend: {
     const QuinticCurve q(ctrl);
-    // The table interval holding s, then Newton on the arc length within it.
-    int i = int(std::upper_bound(arcTable.begin(), arcTable.end(), s) - arcTable.begin()) - 1;
-    i = std::clamp(i, 0, kBlendTable - 1);
-    const double u0 = double(i) / kBlendTable, u1 = double(i + 1) / kBlendTable;
-    const double span = arcTable[i + 1] - arcTable[i];
-    double u = span > 0 ? u0 + (u1 - u0) * (s - arcTable[i]) / span : u0;
-    for (int it = 0; it < 4; ++it) {
-      const double g = arcTable[i] + q.length(u0, u) - s;
-      const double sp = q.speed(u);
-      if (sp <= 0)
-        break;
-      u = std::clamp(u - g / sp, u0, u1);
-      if (std::abs(g) < 1e-13)
-        break;
-    }
+    const double u = blendParameter(q, s);
     PathPoint out = fromParameter(q.point(u), q.d1(u), q.d2(u), q.d3(u));
     if (s >= length)
       out.p = end;

@@ -43,9 +43,31 @@ struct AxisDemand {
   std::array<double, 3> rotary1{}, rotary2{}, rotary3{};
 };
 
-/// The tool axis a fraction t (0..1) of the way from unit vector u to w:
-/// turning evenly in the plane of the two (the toolpath IR's rule).
-Vec3 axisBetween(const Vec3 &u, const Vec3 &w, double t);
+/// The great circle from unit vector u to unit vector w, turned along at an
+/// even rate: the tool axis between two poses (the toolpath IR's rule).
+/// Built once for the many points of one segment; opposite vectors turn
+/// through the axis of x, y, z least along u.
+class GreatCircle {
+public:
+  GreatCircle(const Vec3 &u, const Vec3 &w);
+  /// The point a fraction t (0..1) of the way: u at 0 and w at 1 exactly.
+  Vec3 at(double t) const {
+    if (t <= 0 || angle_ == 0)
+      return u_;
+    if (t >= 1)
+      return w_;
+    const double a = t * angle_;
+    return (u_ * std::cos(a) + across_ * std::sin(a)).normalized();
+  }
+
+private:
+  Vec3 u_, w_;
+  Vec3 across_ = Vec3::Zero();  ///< unit, in the plane of u and w, across u towards w
+  double angle_ = 0;            ///< rad from u to w; 0 when they are equal
+};
+
+/// The tool axis a fraction t (0..1) of the way from unit vector u to w.
+inline Vec3 axisBetween(const Vec3 &u, const Vec3 &w, double t) { return GreatCircle(u, w).at(t); }
 
 /// A quintic Bezier curve (the blends) in power form: B(u) = sum c[k] u^k.
 struct QuinticCurve {
@@ -91,7 +113,11 @@ struct Segment {
   Vec3 axis1 = Vec3::UnitZ();
   bool tilted() const { return axis0 != Vec3::UnitZ() || axis1 != Vec3::UnitZ(); }
   /// The tool axis at arc length s.
-  Vec3 axisAt(double s) const { return length > 0 ? axisBetween(axis0, axis1, std::clamp(s / length, 0.0, 1.0)) : axis1; }
+  Vec3 axisAt(double s) const { return length > 0 ? axisBetween(axis0, axis1, fraction(s)) : axis1; }
+  /// Blends: the curve's parameter at arc length s.
+  double blendParameter(const QuinticCurve &q, double s) const;
+  /// How far along the segment arc length s is, 0..1 (axisAt's fraction).
+  double fraction(double s) const { return std::clamp(s / length, 0.0, 1.0); }
 
   // Blend: a quintic Bezier curve; ctrl[0] = start, ctrl[5] = end.
   std::array<Vec3, 6> ctrl{Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero(), Vec3::Zero()};
@@ -133,6 +159,10 @@ struct Segment {
   }
   /// at() for arcs, blends and dwells.
   PathPoint curveAt(double s) const;
+  /// at(s).p for arcs, blends and dwells.
+  Vec3 curvePointAt(double s) const;
+  /// at(s).p alone, without the derivatives (the same bits).
+  Vec3 pointAt(double s) const { return kind == SegmentKind::Line ? at(s).p : curvePointAt(s); }
   /// Upper bounds of the derivatives per axis over the whole segment.
   AxisDemand demand() const;
 };

@@ -53,7 +53,7 @@ std::string axisAddress(const runtime::Axis &axis) {
   return s;
 }
 
-std::string outsideTravel(const runtime::Machine &machine, const Eigen::VectorXd &joints, bool rotaryOnly) {
+std::string outsideTravel(const runtime::Machine &machine, const runtime::Joints &joints, bool rotaryOnly) {
   std::string axes;
   for (size_t k = 0; k < machine.axes.size(); ++k) {
     if (rotaryOnly && !machine.axes[k].rotary)

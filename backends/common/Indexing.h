@@ -39,7 +39,7 @@ std::string axisAddress(const runtime::Axis &axis);
 
 /// The axes `joints` puts outside their travel, as a program writes them
 /// ("A-130, C400"); "" when none is. `rotaryOnly`: the rotary axes alone.
-std::string outsideTravel(const runtime::Machine &machine, const Eigen::VectorXd &joints, bool rotaryOnly = false);
+std::string outsideTravel(const runtime::Machine &machine, const runtime::Joints &joints, bool rotaryOnly = false);
 
 /// The kinematics of `machine` for a program that turns its rotary axes
 /// with the workpiece's origin at `workOffset`; null (reported) when it

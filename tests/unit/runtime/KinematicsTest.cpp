@@ -183,6 +183,50 @@ TEST_CASE("5-axis chains: inverse(forward(q)) == q over random joints", "[kinema
   CHECK(checks == 5 * 2 * kRandomPoses);
 }
 
+/// tipTurn(q) against the inverse kinematics' own differences: the tip
+/// moved 1e-4 mm along each coordinate, the direction held, moves x, y, z by
+/// the matrix's columns (to 1e-6: the differences' rounding), over random
+/// joints of `m`. Returns the number of joints checked.
+int tipTurns(const runtime::Machine &m, uint32_t seed) {
+  const auto k = kinematicsOf(m);
+  std::mt19937 rng(seed);
+  int checked = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const Joints q = randomJoints(m, rng);
+    const ToolPose pose = k->forward(q);
+    const std::optional<Eigen::Matrix3d> turn = k->tipTurn(q);
+    REQUIRE(turn);
+    constexpr double kStep = 1e-4;
+    for (int c = 0; c < 3; ++c) {
+      const runtime::InverseResult moved = k->inverse({pose.tipMm + kStep * Vec3::Unit(c), pose.axis}, &q);
+      REQUIRE(moved.joints);
+      if (moved.singular)
+        continue;
+      const Vec3 seen = ((*moved.joints).head<3>() - q.head<3>()) / kStep;
+      INFO("joints " << q.transpose() << ", column " << c);
+      CHECK((seen - turn->col(c)).norm() < 1e-6);
+    }
+    ++checked;
+  }
+  return checked;
+}
+
+TEST_CASE("5-axis chains: tipTurn is how the tip's moves move x, y, z", "[kinematics]") {
+  int checks = 0;
+  checks += tipTurns(test::shippedMachine("table-table-5axis"), 11);
+  checks += tipTurns(test::shippedMachine("head-table-5axis"), 12);
+  checks += tipTurns(test::shippedMachine("head-head-5axis"), 13);
+  checks += tipTurns(machineFrom(fiveAxis("table-table", "[]", "[\"b\", \"c\"]",
+                                          rotary("b", -110, 110, "[10, -20, -150]") +
+                                              rotary("c", -36000, 36000, "[30, 40, -120]"))),
+                     14);
+  CHECK(checks == 4 * 2000);
+  // An xyz machine's axes are the tip's coordinates.
+  const auto xyz = kinematicsOf(test::shippedMachine("hsc-3axis"));
+  REQUIRE(xyz->tipTurn(Joints::Zero(3)));
+  CHECK(*xyz->tipTurn(Joints::Zero(3)) == Eigen::Matrix3d::Identity());
+}
+
 TEST_CASE("table-table A/C: poses worked out by hand", "[kinematics]") {
   // The shipped machine: A about +x through y = 225, z = -300; C about +z
   // through x = 250, y = 225.
