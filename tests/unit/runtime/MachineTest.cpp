@@ -233,4 +233,10 @@ TEST_CASE("kinematics mistakes are located at their key", "[machine]") {
   REQUIRE(generic.errors.size() >= 2);
   CHECK(generic.errors[0].find("kinematics needs 'solver'") != std::string::npos);
   CHECK(generic.errors[1].find("a generic chain needs 'joints'") != std::string::npos);
+  // More joints than a joint vector holds (runtime::Joints, on the stack).
+  Read many = read(edited(kGood, "kinematics = \"xyz\"",
+                          "[kinematics]\ntype = \"generic\"\nsolver = \"s\"\n"
+                          "joints = [\"j1\", \"j2\", \"j3\", \"j4\", \"j5\", \"j6\", \"j7\", \"j8\", \"j9\"]"));
+  REQUIRE(!many.errors.empty());
+  CHECK(many.errors[0].find("kinematics.joints names 9 axes; stepnc moves at most 8") != std::string::npos);
 }
