@@ -57,6 +57,10 @@ bool inTravel(const Axis &a, double v) {
 /// and nearest `nearDeg` among those.
 double wrapNear(const Axis &a, double deg, double nearDeg) {
   const double k0 = std::round((nearDeg - deg) / 360);
+  // The nearest turn, when it is inside the travel, is the answer (most
+  // calls, along a path).
+  if (inTravel(a, deg + 360 * k0))
+    return deg + 360 * k0;
   const std::array<double, 5> tries = {deg + 360 * (k0 - 1), deg + 360 * k0, deg + 360 * (k0 + 1),
                                deg + 360 * std::ceil((a.travelMin - deg) / 360),
                                deg + 360 * std::floor((a.travelMax - deg) / 360)};

@@ -857,6 +857,7 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   if (options.kinematics) {
     joints = Joints::Zero(static_cast<Eigen::Index>(options.kinematics->jointCount()));
     junctionCap.reserve(count);
+    out.joints.reserve(count * options.kinematics->jointCount());
   }
   // Each dwell segment's wait, in the order of the segments; the joints
   // recorded at the last segment's end (Trajectory::joints).

@@ -451,6 +451,8 @@ Vec3 Segment::curvePointAt(double s) const {
   if (s >= length)
     return end;
   const QuinticCurve q(ctrl);
+  if (s <= 0)
+    return q.point(0);  // what the inversion gives there, without it
   return q.point(blendParameter(q, s));
 }
 
