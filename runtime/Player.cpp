@@ -276,6 +276,13 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
   // Travel: each sample's axis positions through the kinematics, the tool
   // along +z (the rotary axes stay at 0).
   r.travelNotChecked = machine.whyNotThreeAxis();
+  // A generic chain (a parallel-kinematic machine) through its solver, which
+  // needs where the workpiece is to know where the joints are.
+  if (machine.kinematics.chain == Chain::Generic)
+    r.travelNotChecked = options.workOffsetMm ? ""
+                                              : "the machine \"" + machine.name + "\" moves its joints through the "
+                                                "solver '" + machine.kinematics.solver +
+                                                    "', which needs where the program's origin is on it (--work-offset)";
   std::unique_ptr<Kinematics> kinematics;
   if (r.travelNotChecked.empty() && machine.kinematics.chain != Chain::Xyz) {
     std::string error;
@@ -284,6 +291,10 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
       r.travelNotChecked = error;
   }
   const bool checkTravel = r.travelNotChecked.empty() && !machine.axes.empty();
+  // Whether the axes x, y, z are the tip's coordinates (else every sample's
+  // joints are checked, as on a segment that tilts the tool).
+  const bool cartesian = !kinematics || kinematics->linearJointsAreCartesian();
+  r.axesAreTip = cartesian;
   r.workOffsetMm = options.workOffsetMm;
   const Vec3 offset = options.workOffsetMm.value_or(Vec3::Zero());
   // Per axis, taken once: the travel with its slack (positions beyond it
@@ -454,7 +465,7 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
       history.clear();
       return;
     }
-    jointDynamics(t, sg, tilted);
+    jointDynamics(t, sg, tilted || !cartesian);
   };
 
   // The segment under the samples, and what is known of it.
@@ -545,7 +556,7 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
       const uint32_t sg = s.segment;
       // A segment that tilts the tool: the joints' dynamics are checked
       // instead (checkTravelAt), not the tip's.
-      for (int a = 0; a < 3 && !trajectory.segments[seg].tilted(); ++a) {
+      for (int a = 0; a < 3 && cartesian && !trajectory.segments[seg].tilted(); ++a) {
         const double v = std::abs(s.v[a]), acc = std::abs(s.a[a]), j = std::abs(s.j[a]);
         r.maxVelocity[a] = std::max(r.maxVelocity[a], v);
         r.maxAcceleration[a] = std::max(r.maxAcceleration[a], acc);
@@ -766,8 +777,9 @@ std::string formatReport(const SimReport &report, const Trajectory &trajectory, 
     out += "feed on feed moves: no feed moves\n";
   }
 
-  out += "axis peaks (of the limit):\n";
-  for (size_t k = 0; k < 3 && k < machine.axes.size(); ++k) {
+  if (report.axesAreTip)
+    out += "axis peaks (of the limit):\n";
+  for (size_t k = 0; k < 3 && k < machine.axes.size() && report.axesAreTip; ++k) {
     const Axis &axis = machine.axes[k];
     auto of = [](double value, double limit) { return limit > 0 ? " (" + percent(value / limit) + ")" : ""; };
     out += "  " + axis.name + ": |v| " + perMinute(report.maxVelocity[k]) +
@@ -777,8 +789,8 @@ std::string formatReport(const SimReport &report, const Trajectory &trajectory, 
   }
   if (report.tiltedSamples > 0) {
     // Where the tool tilts the axes are the joints (differences of samples).
-    out += "joint peaks where the tool tilts (" + std::to_string(report.tiltedSamples) +
-           " samples; of the limit):\n";
+    out += std::string(report.axesAreTip ? "joint peaks where the tool tilts (" : "joint peaks (") +
+           std::to_string(report.tiltedSamples) + " samples; of the limit):\n";
     for (size_t k = 0; k < machine.axes.size() && k < report.jointMaxVelocity.size(); ++k) {
       const Axis &axis = machine.axes[k];
       const std::string unit = unitOf(machine, static_cast<int>(k));

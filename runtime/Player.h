@@ -143,6 +143,10 @@ struct SimReport {
   /// machine axis the largest |v|, |a|, |j| of the joints there (mm or deg,
   /// per s, s^2, s^3; by differences between samples).
   size_t tiltedSamples = 0;
+  /// Whether the axes x, y, z are the tip's coordinates (the tip's peaks are
+  /// theirs); false on a parallel-kinematic machine, whose every sample is
+  /// checked on its joints (tiltedSamples counts them all).
+  bool axesAreTip = true;
   std::vector<double> jointMaxVelocity, jointMaxAcceleration, jointMaxJerk;
   std::optional<Vec3> workOffsetMm;  ///< as given: positions checked, else extents only
   bool spindleChecked = false;
