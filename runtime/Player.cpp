@@ -181,6 +181,8 @@ std::string_view violationKindName(ViolationKind kind) {
     return "extent";
   case ViolationKind::Spindle:
     return "spindle";
+  case ViolationKind::Reach:
+    return "reach";
   }
   return "?";
 }
@@ -377,6 +379,7 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
     bool hasV = false, hasA = false;  ///< v and a are differences of samples, not placeholders
   };
   std::vector<JointSample> history;  // the last two samples with joints
+  bool outOfReach = false;           // the last sample's pose had no joints (a generic chain)
   r.jointMaxVelocity.assign(machine.axes.size(), 0);
   r.jointMaxAcceleration.assign(machine.axes.size(), 0);
   r.jointMaxJerk.assign(machine.axes.size(), 0);
@@ -443,8 +446,20 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
         if (machine.axes[k].rotary)
           near[static_cast<Eigen::Index>(k)] = 0;
     InverseResult ir = kinematics->inverse(ToolPose{tip, toolAxis}, haveJoints ? &near : nullptr);
-    if (!ir.joints)
-      return;  // not on a chain whose rotary axes can stay at 0 (whyNotThreeAxis says so)
+    if (!ir.joints) {
+      // A parallel-kinematic machine's joints are not known there: said
+      // where the path leaves the solver's reach, and the differences start
+      // again after it. (On the serial chains a pose only their tilt could
+      // refuse: whyNotThreeAxis says so.)
+      if (!cartesian) {
+        if (!outOfReach)
+          violate(ViolationKind::Reach, -1, t, sg, 0, 0);
+        outOfReach = true;
+        history.clear();
+      }
+      return;
+    }
+    outOfReach = false;
     if (ir.singular && tilted && ahead) {
       // The tool along a rotary axis leaves the other free: it is where the
       // tool axis goes next (as the planner set it).
@@ -894,6 +909,10 @@ std::string formatReport(const SimReport &report, const Trajectory &trajectory, 
     case ViolationKind::Extent:
       out += ", axis " + axisName(machine, v.axis) + ": the program spans " + formatFixed(v.value, 3) +
              " mm by here, more than the travel's " + formatFixed(v.limit, 3) + " mm (no program origin fits it)";
+      break;
+    case ViolationKind::Reach:
+      out += ": the machine's solver finds no joints for the pose here (a strut out of reach or beyond its angle "
+             "limits)";
       break;
     case ViolationKind::Spindle:
       out += ": spindle " + formatTrimmed(v.value, 6) + " rev/min " +

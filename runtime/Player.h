@@ -58,6 +58,10 @@ enum class ViolationKind : uint8_t {
   Travel,        ///< an axis's position (machine coordinates) outside its travel
   Extent,        ///< the program's extent on an axis is longer than its travel: no program origin fits
   Spindle,       ///< a move's spindle speed outside the machine's range
+  /// A parallel-kinematic machine's solver finds no joints for the pose (a
+  /// strut out of reach or beyond its angle limits): reported where the
+  /// path leaves the reach, once per excursion.
+  Reach,
 };
 std::string_view violationKindName(ViolationKind kind);
 
