@@ -114,7 +114,8 @@ private:
   /// On a generic chain, whether every move's end is a pose the machine
   /// reaches (each solution nearest the one before); the first that is not
   /// is an error at its step with the solver's reason. (Between the ends
-  /// the player checks every sample's joints against their travel.)
+  /// the player checks every sample's joints: their travel, their limits
+  /// and the solver's reach.)
   bool reachable(const ir::ProgramPath &program, const runtime::Kinematics &kinematics, DiagnosticEngine &diags) const {
     const runtime::Vec3 offset((*workOffset_)[0], (*workOffset_)[1], (*workOffset_)[2]);
     runtime::Joints near;

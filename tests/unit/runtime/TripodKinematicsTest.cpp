@@ -131,6 +131,35 @@ TEST_CASE("linear tripod: sliders worked out by hand", "[kinematics][tripod]") {
   CHECK((back.tipMm - Vec3(100, 0, 20)).norm() < 1e-9);
 }
 
+TEST_CASE("linear tripod: the table's choices are the table-table chain's", "[kinematics][tripod]") {
+  const auto k = tripod(test::shippedMachine("linear-tripod-5axis"));
+  // Upright, the tool lies along C: C keeps the value it has in `near`.
+  Joints near(5);
+  near << 900, 900, 900, 0, 123;
+  runtime::InverseResult r = k->inverse({{10, 20, 30}, Vec3::UnitZ()}, &near);
+  REQUIRE(r.joints);
+  CHECK(r.singular);
+  CHECK((*r.joints)[3] == 0);
+  CHECK((*r.joints)[4] == 123);
+  // Tilted, C takes the whole turn nearest `near`: two turns on, 725 deg.
+  Joints q(5);
+  q << 950, 900, 1000, 20, 5;
+  const ToolPose pose = k->forward(q);
+  near << 950, 900, 1000, 20, 700;
+  r = k->inverse(pose, &near);
+  REQUIRE(r.joints);
+  CHECK_FALSE(r.singular);
+  CHECK(std::abs((*r.joints)[4] - 725) < 1e-9);
+  CHECK(std::abs((*r.joints)[3] - 20) < 1e-9);
+  CHECK((r.joints->head<3>() - q.head<3>()).norm() < 1e-9);
+  // Without `near`, the other branch (A the other way, C half a turn on) is
+  // not taken while this one is in the travel and turns less from 0.
+  r = k->inverse(pose);
+  REQUIRE(r.joints);
+  CHECK(std::abs((*r.joints)[3] - 20) < 1e-9);
+  CHECK(std::abs((*r.joints)[4] - 5) < 1e-9);
+}
+
 TEST_CASE("linear tripod: forward(inverse(pose)) == pose over the workspace and tool axes", "[kinematics][tripod]") {
   const runtime::Machine m = test::shippedMachine("linear-tripod-5axis");
   const auto k = tripod(m);
