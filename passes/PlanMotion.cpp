@@ -32,9 +32,12 @@ public:
     if (machine->kinematics.chain == runtime::Chain::Lathe)
       return runLathe(module, *machine, diags, stats);
     // Steps that tilt the tool are planned on the joints of a 5-axis
-    // machine, told where the workpiece sits on it.
+    // machine, told where the workpiece sits on it; every step on those of
+    // a generic chain (a parallel-kinematic machine), whose solver moves
+    // axes that are not the tip's x, y, z.
     std::unique_ptr<runtime::Kinematics> kinematics;
-    const bool fiveAxis = machine->kinematics.fiveAxis();
+    const bool generic = machine->kinematics.chain == runtime::Chain::Generic;
+    const bool fiveAxis = machine->kinematics.fiveAxis() || generic;
     const std::vector<const ir::Node *> order = ir::programOrder(module);
     const auto tilted = std::find_if(order.begin(), order.end(), [](const ir::Node *e) { return ir::tiltsTool(*e); });
     if (tilted != order.end()) {
@@ -57,6 +60,20 @@ public:
         return {false, false};
       }
     }
+    if (generic && !kinematics) {
+      if (!workOffset_) {
+        diags.error({}, "plan-motion: the machine \"" + machine->name + "\" moves its joints through the solver '" +
+                            machine->kinematics.solver + "': plan-motion plans every move on them, which needs where "
+                            "the workpiece's origin is on the machine (--work-offset, or plan-motion<work-offset=X:Y:Z>)");
+        return {false, false};
+      }
+      std::string error;
+      kinematics = runtime::makeKinematics(*machine, error);
+      if (!kinematics) {
+        diags.error({}, "plan-motion: the machine's kinematics: " + error);
+        return {false, false};
+      }
+    }
     // Deposition steps are planned as any 3-axis moves (the head's state
     // changes take no time); the native format refuses them.
     if (!ir::requireThreeAxisMilling(module, "plan-motion", diags, ir::ArcPlanes::Principal,
@@ -65,7 +82,7 @@ public:
       return {false, false};
     // The planner moves x, y and z: a generic chain is refused rather than
     // planned with its axes taken for x, y, z.
-    if (const std::string why = machine->whyNotThreeAxis(); !why.empty()) {
+    if (const std::string why = machine->whyNotThreeAxis(); !why.empty() && !generic) {
       diags.error({}, "plan-motion: " + why);
       return {false, false};
     }
@@ -78,6 +95,8 @@ public:
       diags.warning({}, "plan-motion: the program has no moves to plan (run expand-strategies first)");
       return {true, false};
     }
+    if (generic && !reachable(program, *kinematics, diags))
+      return {false, false};
     runtime::PlanOptions options;
     if (tolerance_)
       options.tolerance = *tolerance_;
@@ -92,6 +111,37 @@ public:
   }
 
 private:
+  /// On a generic chain, whether every move's end is a pose the machine
+  /// reaches (each solution nearest the one before); the first that is not
+  /// is an error at its step with the solver's reason. (Between the ends
+  /// the player checks every sample's joints: their travel, their limits
+  /// and the solver's reach.)
+  bool reachable(const ir::ProgramPath &program, const runtime::Kinematics &kinematics, DiagnosticEngine &diags) const {
+    const runtime::Vec3 offset((*workOffset_)[0], (*workOffset_)[1], (*workOffset_)[2]);
+    runtime::Joints near;
+    for (size_t i = 0; i < program.path.moves.size(); ++i) {
+      const runtime::PathMove &move = program.path.moves[i];
+      const runtime::InverseResult at =
+          kinematics.inverse({move.to + offset, move.axis}, near.size() ? &near : nullptr);
+      if (at.joints) {
+        near = *at.joints;
+        continue;
+      }
+      const ir::Node *owner = i < program.owners.size() ? program.owners[i] : nullptr;
+      const std::string point = formatTrimmed(move.to.x(), 4) + ", " + formatTrimmed(move.to.y(), 4) + ", " +
+                                formatTrimmed(move.to.z(), 4);
+      const std::string text = "the machine cannot reach the move to (" + point + ") mm with the work offset given: " +
+                               at.why;
+      if (owner)
+        diags.error(owner->origin.loc, owner->kindName() + " " + owner->symbol + ": " + text)
+            .entity(owner->origin.entityId);
+      else
+        diags.error({}, "plan-motion: " + text);
+      return false;
+    }
+    return true;
+  }
+
   /// A lathe program: its turning steps and holes drilled on the axis,
   /// planned in the ZX plane with the spindle (ir/motion/LathePlan.h).
   PassResult runLathe(ir::Module &module, const runtime::Machine &machine, DiagnosticEngine &diags,

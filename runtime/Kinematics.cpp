@@ -10,6 +10,8 @@
 // by undoing the table's rotations about their pivots and the head's offset.
 #include "runtime/Kinematics.h"
 
+#include "runtime/TripodKinematics.h"
+
 #include <Eigen/Geometry>
 
 #include <algorithm>
@@ -357,6 +359,13 @@ private:
 struct Registry {
   std::mutex mutex;
   std::map<std::string, KinematicsFactory> factories;
+  std::map<std::string, std::vector<SolverParameter>> parameters;
+  /// The runtime's own solvers, there for every program that reads a
+  /// machine file.
+  Registry() {
+    factories[std::string(kLinearTripodSolver)] = makeLinearTripod;
+    parameters[std::string(kLinearTripodSolver)] = linearTripodParameters();
+  }
 };
 
 Registry &registry() {
@@ -366,13 +375,32 @@ Registry &registry() {
 
 } // namespace
 
-bool registerKinematicsSolver(const std::string &name, KinematicsFactory factory) {
+bool registerKinematicsSolver(const std::string &name, KinematicsFactory factory,
+                              std::optional<std::vector<SolverParameter>> parameters) {
   if (name.empty() || !factory)
     return false;
   Registry &r = registry();
   std::lock_guard lock(r.mutex);
   r.factories[name] = std::move(factory);
+  if (parameters)
+    r.parameters[name] = std::move(*parameters);
+  else
+    r.parameters.erase(name);
   return true;
+}
+
+std::optional<std::vector<SolverParameter>> kinematicsSolverParameters(const std::string &name) {
+  Registry &r = registry();
+  std::lock_guard lock(r.mutex);
+  if (auto it = r.parameters.find(name); it != r.parameters.end())
+    return it->second;
+  return std::nullopt;
+}
+
+bool kinematicsSolverRegistered(const std::string &name) {
+  Registry &r = registry();
+  std::lock_guard lock(r.mutex);
+  return r.factories.count(name) > 0;
 }
 
 std::vector<std::string> kinematicsSolverNames() {

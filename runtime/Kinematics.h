@@ -3,8 +3,10 @@
 // tool's pose in the workpiece's frame (forward), and back (inverse). Built
 // from a Machine's KinematicsSpec: xyz, the 5-axis chains table-table,
 // head-table and head-head (any two of a, b, c), and the lathe. A generic
-// chain (a parallel-kinematic machine, a hexapod) is moved by a solver that
-// the program linking this library registers by name.
+// chain (a parallel-kinematic machine, a hexapod) is moved by a solver
+// registered by name: the runtime's own (the linear tripod with a tilting
+// table, runtime/TripodKinematics.h) or one the program linking this library
+// registers.
 //
 // Conventions (docs/machine-model.md): with every axis at 0 the workpiece's
 // frame is the machine's, and the tool's tip is at (x, y, z); so on a 5-axis
@@ -24,6 +26,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace stepnc::runtime {
 
@@ -79,6 +82,24 @@ public:
     (void)q;
     return std::nullopt;
   }
+  /// Whether the linear joints (the first three) are the tool tip's x, y, z
+  /// in machine coordinates while the tool is along +z: true on the serial
+  /// chains, where a 3-axis program's positions are the axes'; false on a
+  /// parallel-kinematic machine, whose sliders move otherwise than the tip
+  /// even on a straight line (the planner and the player then take every
+  /// segment's joints through the inverse kinematics).
+  virtual bool linearJointsAreCartesian() const { return true; }
+};
+
+/// A number a solver reads from `[kinematics.parameters]`: its name, unit,
+/// range and meaning, so that a machine file naming the solver is checked
+/// where it is read (a missing, unknown or out-of-range parameter reported
+/// at its place in the file).
+struct SolverParameter {
+  std::string name;
+  std::string unit;  ///< "mm", "deg"
+  double min = 0, max = 0;
+  std::string meaning;
 };
 
 /// Makes a solver for a generic chain; `error` says why not when it returns
@@ -87,8 +108,19 @@ using KinematicsFactory = std::function<std::unique_ptr<Kinematics>(const Machin
 
 /// Registers the solver a generic chain names by `solver = "NAME"` (a
 /// parallel-kinematic machine's, say). Registering a name again replaces
-/// it. Returns false when the name is empty.
-bool registerKinematicsSolver(const std::string &name, KinematicsFactory factory);
+/// it. Returns false when the name is empty. `parameters`, when given, are
+/// every parameter the solver reads (readMachine checks a file naming it
+/// against them); without them the file's parameters are handed over as
+/// they are.
+bool registerKinematicsSolver(const std::string &name, KinematicsFactory factory,
+                              std::optional<std::vector<SolverParameter>> parameters = std::nullopt);
+
+/// The parameters a registered solver declared; nullopt when it is not
+/// registered or declared none.
+std::optional<std::vector<SolverParameter>> kinematicsSolverParameters(const std::string &name);
+
+/// Whether a solver of that name is registered.
+bool kinematicsSolverRegistered(const std::string &name);
 
 /// The names registered so far, sorted.
 std::vector<std::string> kinematicsSolverNames();

@@ -4,6 +4,7 @@
 // reading goes on, so one run shows every problem in the file.
 #include "runtime/Machine.h"
 
+#include "runtime/Kinematics.h"
 #include "runtime/TomlReader.h"
 #include "support/Format.h"
 
@@ -140,6 +141,41 @@ std::optional<std::vector<std::string>> names(TomlReader &r, const toml::table &
   return out;
 }
 
+/// A generic chain's parameters against those its solver declared
+/// (runtime/Kinematics.h), when it is registered with them: each unknown
+/// one at its key, each missing one at the table, each out of its range at
+/// its value.
+void checkSolverParameters(TomlReader &r, const toml::table &t, const KinematicsSpec &spec) {
+  const std::optional<std::vector<SolverParameter>> wanted = kinematicsSolverParameters(spec.solver);
+  if (!wanted)
+    return;
+  const toml::table *given = t.get("parameters") ? t.get("parameters")->as_table() : nullptr;
+  std::set<std::string> known;
+  std::string list;
+  for (const SolverParameter &p : *wanted) {
+    known.insert(p.name);
+    list += (list.empty() ? "" : ", ") + p.name;
+  }
+  if (given)
+    for (const auto &[key, value] : *given)
+      if (!known.count(std::string(key.str())))
+        r.error(key.source(), "unknown key '" + std::string(key.str()) + "' in [kinematics.parameters]: the solver '" +
+                                  spec.solver + "' reads " + list);
+  for (const SolverParameter &p : *wanted) {
+    const toml::node *n = given ? given->get(p.name) : nullptr;
+    if (!n) {
+      r.error(given ? given->source() : t.source(), "the solver '" + spec.solver + "' needs kinematics.parameters." +
+                                                        p.name + " (" + p.unit + ": " + p.meaning + ")");
+      continue;
+    }
+    const std::optional<double> v = n->value<double>();
+    if (v && std::isfinite(*v) && !(*v >= p.min && *v <= p.max))
+      r.error(n->source(), "kinematics.parameters." + p.name + " must be from " + formatTrimmed(p.min, 6) + " to " +
+                               formatTrimmed(p.max, 6) + " " + p.unit + " (" + p.meaning + "), not " +
+                               formatTrimmed(*v, 6));
+  }
+}
+
 /// The [kinematics] table. False when the chain's type is unknown (its axes
 /// cannot then be checked).
 bool readChain(TomlReader &r, const toml::table &t, KinematicsSpec &spec) {
@@ -231,6 +267,7 @@ bool readChain(TomlReader &r, const toml::table &t, KinematicsSpec &spec) {
         else
           r.error(value.source(), "kinematics.parameters." + std::string(key.str()) + " must be a number");
       }
+    checkSolverParameters(r, t, spec);
     break;
   }
   if (const toml::node *n = t.get("tool_axis"))
@@ -465,6 +502,14 @@ std::optional<Machine> readMachine(const SourceFile &file, DiagnosticEngine &dia
   if (m.deposition && std::find(m.processes.begin(), m.processes.end(), "deposition") == m.processes.end())
     r.error(root.get("deposition")->source(), "a machine with a [deposition] table deposits: list \"deposition\" "
                                               "among its processes");
+  // A generic chain whose solver is registered: what only the solver can
+  // check (its joints, how its numbers go together), at the [kinematics]
+  // table.
+  if (r.ok() && m.kinematics.chain == Chain::Generic && kinematicsSolverRegistered(m.kinematics.solver)) {
+    std::string error;
+    if (!makeKinematics(m, error))
+      r.error(root.get("kinematics")->source(), error);
+  }
   if (!r.ok())
     return std::nullopt;
   return m;

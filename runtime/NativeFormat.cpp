@@ -42,6 +42,10 @@ int versionFor(const Trajectory &t) {
   for (const Segment &seg : t.segments)
     if (seg.tilted())
       return kVersionWithToolAxes;
+  // Planned on the joints with the tool upright throughout (a
+  // parallel-kinematic machine's sliders): the joints need version 4 too.
+  if (!t.joints.empty())
+    return kVersionWithToolAxes;
   if (t.frame == Frame::Zxy)
     return kVersionWithSpindle;
   for (size_t i = 0; i < t.segments.size(); ++i)

@@ -854,11 +854,20 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   std::optional<JointEnds> lastEnds;
   bool lastTilted = false;
   std::vector<double> junctionCap;
+  // A parallel-kinematic machine's sliders are not the tip's coordinates:
+  // every segment's joints come from its inverse kinematics (upright ones
+  // too: a straight line of the tip is a curve of the sliders), starting
+  // from the joints at the path's start.
+  const bool everySegmentByJoints = options.kinematics && !options.kinematics->linearJointsAreCartesian();
   if (options.kinematics) {
     joints = Joints::Zero(static_cast<Eigen::Index>(options.kinematics->jointCount()));
     junctionCap.reserve(count);
     out.joints.reserve(count * options.kinematics->jointCount());
   }
+  if (everySegmentByJoints)
+    if (const InverseResult at = options.kinematics->inverse({input.start + options.workOffset, input.startAxis});
+        at.joints)
+      joints = *at.joints;
   // Each dwell segment's wait, in the order of the segments; the joints
   // recorded at the last segment's end (Trajectory::joints).
   std::vector<double> dwellTimes;
@@ -938,7 +947,7 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   };
   auto push = [&](double feed, uint32_t move, uint32_t next, StopReason stop, const AxisDemand &given) {
     bool startSolved = false;
-    if (options.kinematics && out.segments.back().tilted()) {
+    if (options.kinematics && (out.segments.back().tilted() || everySegmentByJoints)) {
       const Segment &here = out.segments.back();
       startSolved = turnFirst(stop, move, feed == 0 && here.kind == SegmentKind::Line && here.axis0 != here.axis1);
     }
@@ -959,7 +968,8 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
     // still; the tool upright keeps them at 0).
     std::optional<JointEnds> ends;
     const bool tilted = seg.tilted();
-    if (tilted) {
+    const bool byJoints = tilted || everySegmentByJoints;
+    if (byJoints) {
       JointEnds e;
       if (jointDemand(seg, *options.kinematics, options.workOffset, joints, d, e, startSolved, solved))
         ends = e;
@@ -1005,7 +1015,7 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
     // on a tilted one; on an upright one, the inverse kinematics from the
     // last recorded (the rotary axes kept; only recorded, the caps of the
     // tilted segments keep chaining from the last tilted one).
-    if (tilted)
+    if (byJoints)
       recorded = joints;
     else
       record(seg);

@@ -181,6 +181,8 @@ std::string_view violationKindName(ViolationKind kind) {
     return "extent";
   case ViolationKind::Spindle:
     return "spindle";
+  case ViolationKind::Reach:
+    return "reach";
   }
   return "?";
 }
@@ -276,6 +278,13 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
   // Travel: each sample's axis positions through the kinematics, the tool
   // along +z (the rotary axes stay at 0).
   r.travelNotChecked = machine.whyNotThreeAxis();
+  // A generic chain (a parallel-kinematic machine) through its solver, which
+  // needs where the workpiece is to know where the joints are.
+  if (machine.kinematics.chain == Chain::Generic)
+    r.travelNotChecked = options.workOffsetMm ? ""
+                                              : "the machine \"" + machine.name + "\" moves its joints through the "
+                                                "solver '" + machine.kinematics.solver +
+                                                    "', which needs where the program's origin is on it (--work-offset)";
   std::unique_ptr<Kinematics> kinematics;
   if (r.travelNotChecked.empty() && machine.kinematics.chain != Chain::Xyz) {
     std::string error;
@@ -284,6 +293,10 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
       r.travelNotChecked = error;
   }
   const bool checkTravel = r.travelNotChecked.empty() && !machine.axes.empty();
+  // Whether the axes x, y, z are the tip's coordinates (else every sample's
+  // joints are checked, as on a segment that tilts the tool).
+  const bool cartesian = !kinematics || kinematics->linearJointsAreCartesian();
+  r.axesAreTip = cartesian;
   r.workOffsetMm = options.workOffsetMm;
   const Vec3 offset = options.workOffsetMm.value_or(Vec3::Zero());
   // Per axis, taken once: the travel with its slack (positions beyond it
@@ -366,6 +379,7 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
     bool hasV = false, hasA = false;  ///< v and a are differences of samples, not placeholders
   };
   std::vector<JointSample> history;  // the last two samples with joints
+  bool outOfReach = false;           // the last sample's pose had no joints (a generic chain)
   r.jointMaxVelocity.assign(machine.axes.size(), 0);
   r.jointMaxAcceleration.assign(machine.axes.size(), 0);
   r.jointMaxJerk.assign(machine.axes.size(), 0);
@@ -432,8 +446,20 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
         if (machine.axes[k].rotary)
           near[static_cast<Eigen::Index>(k)] = 0;
     InverseResult ir = kinematics->inverse(ToolPose{tip, toolAxis}, haveJoints ? &near : nullptr);
-    if (!ir.joints)
-      return;  // not on a chain whose rotary axes can stay at 0 (whyNotThreeAxis says so)
+    if (!ir.joints) {
+      // A parallel-kinematic machine's joints are not known there: said
+      // where the path leaves the solver's reach, and the differences start
+      // again after it. (On the serial chains a pose only their tilt could
+      // refuse: whyNotThreeAxis says so.)
+      if (!cartesian) {
+        if (!outOfReach)
+          violate(ViolationKind::Reach, -1, t, sg, 0, 0);
+        outOfReach = true;
+        history.clear();
+      }
+      return;
+    }
+    outOfReach = false;
     if (ir.singular && tilted && ahead) {
       // The tool along a rotary axis leaves the other free: it is where the
       // tool axis goes next (as the planner set it).
@@ -454,7 +480,7 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
       history.clear();
       return;
     }
-    jointDynamics(t, sg, tilted);
+    jointDynamics(t, sg, tilted || !cartesian);
   };
 
   // The segment under the samples, and what is known of it.
@@ -545,7 +571,7 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
       const uint32_t sg = s.segment;
       // A segment that tilts the tool: the joints' dynamics are checked
       // instead (checkTravelAt), not the tip's.
-      for (int a = 0; a < 3 && !trajectory.segments[seg].tilted(); ++a) {
+      for (int a = 0; a < 3 && cartesian && !trajectory.segments[seg].tilted(); ++a) {
         const double v = std::abs(s.v[a]), acc = std::abs(s.a[a]), j = std::abs(s.j[a]);
         r.maxVelocity[a] = std::max(r.maxVelocity[a], v);
         r.maxAcceleration[a] = std::max(r.maxAcceleration[a], acc);
@@ -766,8 +792,9 @@ std::string formatReport(const SimReport &report, const Trajectory &trajectory, 
     out += "feed on feed moves: no feed moves\n";
   }
 
-  out += "axis peaks (of the limit):\n";
-  for (size_t k = 0; k < 3 && k < machine.axes.size(); ++k) {
+  if (report.axesAreTip)
+    out += "axis peaks (of the limit):\n";
+  for (size_t k = 0; k < 3 && k < machine.axes.size() && report.axesAreTip; ++k) {
     const Axis &axis = machine.axes[k];
     auto of = [](double value, double limit) { return limit > 0 ? " (" + percent(value / limit) + ")" : ""; };
     out += "  " + axis.name + ": |v| " + perMinute(report.maxVelocity[k]) +
@@ -777,8 +804,8 @@ std::string formatReport(const SimReport &report, const Trajectory &trajectory, 
   }
   if (report.tiltedSamples > 0) {
     // Where the tool tilts the axes are the joints (differences of samples).
-    out += "joint peaks where the tool tilts (" + std::to_string(report.tiltedSamples) +
-           " samples; of the limit):\n";
+    out += std::string(report.axesAreTip ? "joint peaks where the tool tilts (" : "joint peaks (") +
+           std::to_string(report.tiltedSamples) + " samples; of the limit):\n";
     for (size_t k = 0; k < machine.axes.size() && k < report.jointMaxVelocity.size(); ++k) {
       const Axis &axis = machine.axes[k];
       const std::string unit = unitOf(machine, static_cast<int>(k));
@@ -882,6 +909,10 @@ std::string formatReport(const SimReport &report, const Trajectory &trajectory, 
     case ViolationKind::Extent:
       out += ", axis " + axisName(machine, v.axis) + ": the program spans " + formatFixed(v.value, 3) +
              " mm by here, more than the travel's " + formatFixed(v.limit, 3) + " mm (no program origin fits it)";
+      break;
+    case ViolationKind::Reach:
+      out += ": the machine's solver finds no joints for the pose here (a strut out of reach or beyond its angle "
+             "limits)";
       break;
     case ViolationKind::Spindle:
       out += ": spindle " + formatTrimmed(v.value, 6) + " rev/min " +

@@ -58,6 +58,10 @@ enum class ViolationKind : uint8_t {
   Travel,        ///< an axis's position (machine coordinates) outside its travel
   Extent,        ///< the program's extent on an axis is longer than its travel: no program origin fits
   Spindle,       ///< a move's spindle speed outside the machine's range
+  /// A parallel-kinematic machine's solver finds no joints for the pose (a
+  /// strut out of reach or beyond its angle limits): reported where the
+  /// path leaves the reach, once per excursion.
+  Reach,
 };
 std::string_view violationKindName(ViolationKind kind);
 
@@ -143,6 +147,10 @@ struct SimReport {
   /// machine axis the largest |v|, |a|, |j| of the joints there (mm or deg,
   /// per s, s^2, s^3; by differences between samples).
   size_t tiltedSamples = 0;
+  /// Whether the axes x, y, z are the tip's coordinates (the tip's peaks are
+  /// theirs); false on a parallel-kinematic machine, whose every sample is
+  /// checked on its joints (tiltedSamples counts them all).
+  bool axesAreTip = true;
   std::vector<double> jointMaxVelocity, jointMaxAcceleration, jointMaxJerk;
   std::optional<Vec3> workOffsetMm;  ///< as given: positions checked, else extents only
   bool spindleChecked = false;

@@ -101,6 +101,10 @@ private:
     if (!options.machine)
       missing = "a 5-axis machine (--machine=table-table-5axis, head-table-5axis, head-head-5axis or a file of "
                 "one's own)";
+    else if (options.machine->kinematics.chain == runtime::Chain::Generic)
+      missing = "a serial 5-axis machine (" + options.machine->name + " is a generic chain moved by the solver '" +
+                options.machine->kinematics.solver + "': its programs give the tip's X Y Z for a controller that "
+                "runs its kinematics, and steps that tilt the tool are not written for it yet)";
     else if (!options.machine->kinematics.fiveAxis())
       missing = "a 5-axis machine (" + options.machine->name + " has no two rotary axes that turn the tool)";
     else if (!options.workOffset && !tcp)

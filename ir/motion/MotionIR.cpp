@@ -168,11 +168,18 @@ void attachMotion(ir::Module &module, const ProgramPath &program, const runtime:
     if (jointCount > 0 && trajectory.joints.size() == trajectory.segments.size() * jointCount)
       s.set("joints", ir::Value::reals(std::vector<double>(trajectory.joints.begin() + long(k * jointCount),
                                                            trajectory.joints.begin() + long((k + 1) * jointCount))));
-    if (seg.tilted()) {
+    if (seg.tilted())
       s.set("axes", ir::Value::reals({seg.axis0.x(), seg.axis0.y(), seg.axis0.z(), seg.axis1.x(), seg.axis1.y(),
                                       seg.axis1.z()}));
-      if (info.axis >= 0 && size_t(info.axis) < trajectory.axisNames.size())
-        s.set("limited_axis", ir::Value::word(trajectory.axisNames[size_t(info.axis)]));
+    // The joint that capped the segment: on one that tilts the tool, and on
+    // any whose limiting axis is not the tip's own coordinate (a
+    // parallel-kinematic machine's slider; on the serial chains an upright
+    // segment's x, y or z is that coordinate and says nothing more).
+    if (info.axis >= 0 && size_t(info.axis) < trajectory.axisNames.size()) {
+      const std::string &axis = trajectory.axisNames[size_t(info.axis)];
+      const bool tipCoordinate = info.axis < 3 && axis == std::string(1, "xyz"[info.axis]);
+      if (seg.tilted() || !tipCoordinate)
+        s.set("limited_axis", ir::Value::word(axis));
     }
     motion.add(std::move(s));
   }

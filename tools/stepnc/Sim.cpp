@@ -275,9 +275,25 @@ int runSim(const SimCommandOptions &opts) {
     return kExitUsage;
   if (machine->kinematics.chain == runtime::Chain::Lathe)
     return runLatheSim(opts, *machine, machineName, source, diags);
-  if (const std::string why = machine->whyNotThreeAxis(); !why.empty()) {
+  // A generic chain (a parallel-kinematic machine) is played on its joints
+  // through its solver, which needs where the program's origin is on it.
+  const bool generic = machine->kinematics.chain == runtime::Chain::Generic;
+  if (const std::string why = machine->whyNotThreeAxis(); !why.empty() && !generic) {
     printToolError("sim: " + why);
     return kExitUsage;
+  }
+  if (generic) {
+    std::string error;
+    if (!runtime::makeKinematics(*machine, error)) {
+      printToolError("sim: " + error);
+      return kExitUsage;
+    }
+    if (opts.workOffset.empty()) {
+      printToolError("sim: the machine \"" + machine->name + "\" moves its joints through the solver '" +
+                     machine->kinematics.solver + "': sim plans and plays every move on them, which needs where the "
+                     "program's origin is on the machine (--work-offset=X,Y,Z)");
+      return kExitUsage;
+    }
   }
   std::optional<runtime::Vec3> workOffset;
   if (!opts.workOffset.empty()) {
