@@ -93,7 +93,7 @@ private:
     if (!descriptor().jointMoves && descriptor().tcpOn.empty()) {
       diags.error(at.origin.loc, "workingstep " + at.symbol + " tilts the tool (5-axis): " + descriptor().name +
                                      " does not write such steps yet (rs274 does, as the machine's joints; "
-                                     "siemens-840d with TRAORI: docs/five-axis.md)")
+                                     "siemens-840d with TRAORI, heidenhain-tnc with FUNCTION TCPM: docs/five-axis.md)")
           .entity(at.origin.entityId);
       return false;
     }

@@ -53,6 +53,13 @@ TargetDescriptor tncDescriptor() {
   d.feedDecimals = 0;
   d.speedDecimals = 0;
   d.tolerance = 0.01;
+  // 5-axis with the control's tool-centre-point control (PROCESSES.md C3):
+  // FUNCTION TCPM says in the block each thing the program relies on (the
+  // feed along the tip, the rotary words as axis positions, the axes
+  // interpolated in proportion), where M128 leaves them to the machine's
+  // set-up; README.md, "5-axis".
+  d.tcpOn = "FUNCTION TCPM F TCP AXIS POS PATHCTRL AXIS";
+  d.tcpOff = "FUNCTION RESET TCPM";
   return d;
 }
 
@@ -107,6 +114,7 @@ public:
   static ProgramReading read(const std::string &text, const TargetDescriptor &d) { return readKlartext(text, d); }
 
   std::optional<std::string> run(const Program &p) {
+    program_ = &p;
     const std::string name = sanitizedName(o_.programName);
     if (name != o_.programName)
       diags_.warning(SourceLoc{}, "the program name '" + o_.programName + "' is written as '" + name +
@@ -303,8 +311,20 @@ private:
       flushM();
       return;
     }
-    for (const Move &m : s.moves)
+    // A step that tilts the tool runs under the control's tool-centre-point
+    // control from its first move that gives the rotary axes (the clearance
+    // move before is along Z as after any tool call) to its end, where the
+    // rotary axes are back at 0 (FiveAxis.h, tcpMoves).
+    bool tcp = false;
+    for (const Move &m : s.moves) {
+      if (s.tilted && !tcp && !m.rotary.empty()) {
+        out_.block(d_.tcpOn);
+        tcp = true;
+      }
       move(m);
+    }
+    if (tcp)
+      out_.block(d_.tcpOff);
     flushM();
   }
 
@@ -367,13 +387,33 @@ private:
       upAlongZ(m.to.z());
       return;
     }
-    line(m.to, m.kind == Move::Kind::Rapid, m.feed);
+    line(m.to, m.kind == Move::Kind::Rapid, m.feed, rotaryWords(m));
+  }
+
+  /// The rotary axes' words of a move under tool-centre-point control, for
+  /// the angles that change as printed, in the order A B C after X Y Z
+  /// (" A+20 C+2.479"; a head-head machine's C comes first in its chain).
+  std::string rotaryWords(const Move &m) {
+    std::vector<std::pair<std::string, std::string>> changed;
+    for (size_t k = 0; k < m.rotary.size() && k < program_->rotaryAxes.size(); ++k) {
+      const std::string &name = program_->rotaryAxes[k];
+      const std::string v = num(m.rotary[k]);
+      if (modal_.change(name, v))
+        changed.emplace_back(name, v);
+    }
+    std::sort(changed.begin(), changed.end());
+    std::string words;
+    for (const auto &[name, v] : changed)
+      words += " " + name + v;
+    return words;
   }
 
   static std::string seconds(double s) { return formatNumber(s, {3, false, false}); }
 
-  void line(const Vec3 &to, bool rapid, double feed) {
-    const std::string words = axes(to);
+  void line(const Vec3 &to, bool rapid, double feed, const std::string &rotary = "") {
+    std::string words = axes(to) + rotary;
+    if (!words.empty() && words.front() == ' ')
+      words.erase(0, 1);
     if (words.empty())
       return;  // no motion as printed
     std::string text = "L " + words + " R0";
@@ -606,6 +646,7 @@ private:
   const TargetDescriptor &d_;
   const EmitOptions &o_;
   DiagnosticEngine &diags_;
+  const Program *program_ = nullptr;
   BlockWriter out_;
   StepLines stepLines_;
   ModalState modal_;

@@ -15,6 +15,10 @@ what the control would reject or do differently:
     MIN below MAX; cycle 32 and cycle 200 with all their Q parameters; cycle
     247 (a clamping's datum, then Z alone first as after a TOOL CALL); cycle
     9 (`CYCL DEF 9.0 DWELL TIME`, then `CYCL DEF 9.1 DWELL t`, t > 0 s);
+  * 5-axis: `FUNCTION TCPM F TCP AXIS POS PATHCTRL AXIS` and `FUNCTION RESET
+    TCPM` in turn, rotary words (A, B, C after X Y Z) only between them, no
+    TOOL CALL between them, the rotary axes back at 0 at the reset, none
+    left on at the end;
   * motion: the first after each TOOL CALL is an L block with Z alone (up
     to the clearance height: where the tool change left the tool is the
     machine's business, so X and Y only move once it is up); no motion
@@ -29,7 +33,8 @@ TNC manual describes it: README.md; its Q211 and cycle 9 as dwells) are also com
 IR's moves: runs of rapids by where they end, feed moves by end point and
 feed, arcs also by direction, sweep and path (points at eighths of each
 written arc within 0.005 mm of the IR's circle; an arc that keeps that
-close to its chord may be a line).
+close to its chord may be a line). The moves that tilt the tool (under
+FUNCTION TCPM) are check-tcp.py's, through the machine's kinematics.
 
 Exit status 0 when clean, 1 listing each problem with its block number.
 """
@@ -43,6 +48,8 @@ import toolpath_ir
 NUM_SIGNED = r"[+-]\d+(?:\.\d+)?"
 NUM_UNSIGNED = r"\d+(?:\.\d+)?"
 M_ALLOWED = {0, 1, 2, 3, 4, 5, 7, 8, 9, 30, 99}
+TCPM_ON = "FUNCTION TCPM F TCP AXIS POS PATHCTRL AXIS"
+TCPM_OFF = "FUNCTION RESET TCPM"
 CYCLE_200_Q = [200, 201, 206, 202, 210, 203, 204, 211]
 END_TOL = 0.002   # a CP ends where the control turns the start: printed angle and pole
 PATH_TOL = 0.005  # along arcs: printed endpoints, and poles moved on the grid to balance the radii
@@ -123,6 +130,8 @@ class Machine:
         self.cycle = None
         self.motions = []
         self.up_first = None  # the TOOL CALL whose first motion is still to come
+        self.tcp = False  # FUNCTION TCPM on
+        self.abc = {}  # the rotary axes as last written
 
     def need_tool(self, where, z_alone=False):
         if self.tool is None:
@@ -162,7 +171,7 @@ class Machine:
             target["XYZ".index(k)] = v
         if axes:
             self.motions.append({"kind": "rapid" if rapid else "linear", "to": tuple(target),
-                                 "feed": None if rapid else self.feed, "where": where})
+                                 "feed": None if rapid else self.feed, "where": where, "tcp": self.tcp})
         self.pos = target
 
     def arc(self, where, end_xy, ccw, feed):
@@ -260,20 +269,23 @@ def turn_angle(a, b, ccw):
 
 
 def check_l(words, where, mach, problems, is_last_before_end):
-    """An L block: X Y Z (signed, in order), R0/RL/RR, F<n> or FMAX, one M."""
+    """An L block: X Y Z (signed, in order), under FUNCTION TCPM also A B C,
+    R0/RL/RR, F<n> or FMAX, one M."""
     axes = {}
-    order = "XYZ"
+    order = "XYZABC"
     state = 0  # 0 axes, 1 after R, 2 after F, 3 after M
     rapid = False
     feed = None
     ms = []
     for w in words:
-        m = re.fullmatch(r"([XYZ])(.*)", w)
+        m = re.fullmatch(r"([XYZABC])(.*)", w)
         if m and state == 0:
             axis = m.group(1)
             if axis in axes or (axes and order.index(axis) < order.index(list(axes)[-1])):
-                problems.add(where, "axis %s repeated or out of X Y Z order" % axis)
-            v = signed(m.group(2), where, problems, "coordinate " + axis)
+                problems.add(where, "axis %s repeated or out of X Y Z A B C order" % axis)
+            if axis in "ABC" and not mach.tcp:
+                problems.add(where, "rotary axis %s with FUNCTION TCPM off" % axis)
+            v = signed(m.group(2), where, problems, ("rotary axis " if axis in "ABC" else "coordinate ") + axis)
             if v is not None:
                 axes[axis] = v
             continue
@@ -305,6 +317,9 @@ def check_l(words, where, mach, problems, is_last_before_end):
         problems.add(where, "%d M functions in one block (stepnc writes one)" % len(ms))
     for n in ms:
         mach.m_function(where, n, before_motion=True)
+    for axis in "ABC":
+        if axis in axes:
+            mach.abc[axis] = axes.pop(axis)
     mach.line(where, axes, rapid, feed)
     for n in ms:
         mach.m_function(where, n, before_motion=False)
@@ -379,7 +394,26 @@ def check_program(text, arc_tol):
         if blk01 is not None and blk01[1] == number - 1:
             problems.add(where, "BLK FORM 0.1 without its BLK FORM 0.2 after it")
             blk01 = None
+        if body.startswith("FUNCTION "):
+            # Tool-centre-point control (PROCESSES.md C3), in the one form
+            # stepnc writes.
+            if body == TCPM_ON:
+                if mach.tcp:
+                    problems.add(where, "FUNCTION TCPM while it is on")
+                mach.tcp = True
+            elif body == TCPM_OFF:
+                if not mach.tcp:
+                    problems.add(where, "FUNCTION RESET TCPM while FUNCTION TCPM is off")
+                turned = ["%s%g" % (a, v) for a, v in sorted(mach.abc.items()) if v != 0]
+                if turned:
+                    problems.add(where, "FUNCTION RESET TCPM with the rotary axes at %s, not 0" % " ".join(turned))
+                mach.tcp = False
+            else:
+                problems.add(where, "FUNCTION block not of the form '%s' or '%s'" % (TCPM_ON, TCPM_OFF))
+            continue
         if body.startswith("TOOL CALL"):
+            if mach.tcp:
+                problems.add(where, "TOOL CALL with FUNCTION TCPM on")
             m = re.fullmatch(r"TOOL CALL (\d+) Z(?: S(\S+))?", body)
             if not m:
                 problems.add(where, "TOOL CALL not of the form 'TOOL CALL n Z S..'")
@@ -462,6 +496,8 @@ def check_program(text, arc_tol):
             mach.polar_arc(where, ipa, iz, ccw, feed)
             continue
         problems.add(where, "unknown block '%s'" % body)
+    if mach.tcp:
+        problems.add("block %d" % blocks[-1][0], "the program ends with FUNCTION TCPM on")
     if len(blocks) >= 2 and end:
         before = blocks[-2][1].split()
         if not (before and before[0] == "L" and ("M30" in before or "M2" in before)):
@@ -720,8 +756,10 @@ def main():
         text = f.read()
     problems, mach = check_program(text, args.arc_tol)
     if args.ir:
-        compare(normalise(program_moves(mach.motions), args.decimals),
-                normalise(ir_moves(args.ir), args.decimals), problems, args.decimals)
+        # Moves that tilt the tool (under FUNCTION TCPM) are check-tcp.py's.
+        made = [mv for mv in program_moves(mach.motions) if not mv.get("tcp")]
+        planned = [mv for mv in ir_moves(args.ir) if mv.get("axis", (0.0, 0.0, 1.0)) == (0.0, 0.0, 1.0)]
+        compare(normalise(made, args.decimals), normalise(planned, args.decimals), problems, args.decimals)
     if problems.items:
         for item in problems.items:
             print("%s: %s" % (args.program, item))

@@ -242,6 +242,72 @@ TEST_CASE("Klartext reader: each structural rule is a problem on its line", "[re
   }
 }
 
+/// A step under tool-centre-point control: rotary words on L blocks between
+/// FUNCTION TCPM and FUNCTION RESET TCPM, back at 0 before the reset. Block
+/// n is on line n + 1.
+const std::string kTcp = R"(0 BEGIN PGM TCP MM
+1 TOOL CALL 1 Z S3000
+2 L Z+60 R0 FMAX M3
+3 FUNCTION TCPM F TCP AXIS POS PATHCTRL AXIS
+4 L X+30 Y+40 A+20 C+0 R0 FMAX
+5 L Z+20 R0 F900
+6 L X+15 A+20.5 C+2.5 R0
+7 L Z+60 R0 FMAX
+8 L A+0 C+0 R0 FMAX
+9 FUNCTION RESET TCPM
+10 L Z+60 R0 FMAX M30
+11 END PGM TCP MM
+)";
+
+TEST_CASE("Klartext reader: tool-centre-point control", "[readback][heidenhain-tnc]") {
+  const ProgramReading r = read(kTcp);
+  INFO(problems(r));
+  REQUIRE(r.problems.empty());
+  // Up, across (A and C turning), down at the feed, along with A and C, up,
+  // the rotary axes alone back to 0 (a motion: the tip still).
+  REQUIRE(r.moves.size() == 6);
+  CHECK(r.moves[1].abc[0] == 20);
+  CHECK(r.moves[1].abc[2] == 0);
+  CHECK(std::isnan(r.moves[1].abc[1]));
+  CHECK(r.moves[3].kind == Move::Kind::Linear);
+  checkEnd(r.moves[3], 15, 40, 20);
+  CHECK(r.moves[3].abc[0] == 20.5);
+  CHECK(r.moves[3].abc[2] == 2.5);
+  CHECK(r.moves[3].feed == 900);
+  CHECK(r.moves[5].kind == Move::Kind::Rapid);
+  checkEnd(r.moves[5], 15, 40, 60);
+  CHECK(r.moves[5].abc[0] == 0);
+
+  auto problemsOf = [](const std::string &text) {
+    const ProgramReading p = read(text);
+    INFO(problems(p));
+    CHECK_FALSE(p.problems.empty());
+    return p;
+  };
+  SECTION("rotary words only under FUNCTION TCPM") {
+    const ProgramReading p = problemsOf(replaced(kTcp, "3 FUNCTION TCPM F TCP AXIS POS PATHCTRL AXIS", "3 ; off"));
+    CHECK(hasProblem(p, 5, "rotary axis A with FUNCTION TCPM off"));
+    CHECK(hasProblem(p, 10, "FUNCTION RESET TCPM while FUNCTION TCPM is off"));
+  }
+  SECTION("the one form of FUNCTION TCPM") {
+    const ProgramReading p = problemsOf(replaced(kTcp, "F TCP AXIS POS", "F CONT AXIS POS"));
+    CHECK(hasProblem(p, 4, "FUNCTION block not of the form 'FUNCTION TCPM F TCP AXIS POS PATHCTRL AXIS'"));
+  }
+  SECTION("the rotary axes back at 0 before the reset") {
+    const ProgramReading p = problemsOf(replaced(kTcp, "8 L A+0 C+0 R0 FMAX", "8 L A+0 R0 FMAX"));
+    CHECK(hasProblem(p, 10, "FUNCTION RESET TCPM with the rotary axis C2.5 turned"));
+  }
+  SECTION("X Y Z, then A B C") {
+    const ProgramReading p = problemsOf(replaced(kTcp, "4 L X+30 Y+40 A+20 C+0", "4 L X+30 A+20 Y+40 C+0"));
+    CHECK(hasProblem(p, 5, "axis Y repeated or out of X Y Z order"));
+  }
+  SECTION("no TOOL CALL, and no end, with it on") {
+    const ProgramReading p = problemsOf(replaced(kTcp, "9 FUNCTION RESET TCPM", "9 TOOL CALL 1 Z S3000"));
+    CHECK(hasProblem(p, 10, "TOOL CALL with FUNCTION TCPM on"));
+    CHECK(hasProblem(p, 12, "the program ends with FUNCTION TCPM on"));
+  }
+}
+
 /// `path` (a STEP-NC file) through the toolpath passes, as `stepnc compile` runs them.
 test::Loaded toolpaths(const std::string &path) {
   test::Loaded l = test::loadStepnc(path);
