@@ -123,8 +123,9 @@ private:
   bool index(Program &program, const EmitOptions &options, DiagnosticEngine &diags) const {
     if (program.clampings.empty() || !options.machine || !options.machine->kinematics.fiveAxis())
       return true;
-    if (!descriptor().rotaryIndexing) {
-      diags.warning(SourceLoc{}, descriptor().name + " does not turn the rotary axes to each face yet (rs274 does): "
+    if (!descriptor().rotaryIndexing && !descriptor().workingPlanes) {
+      diags.warning(SourceLoc{}, descriptor().name + " does not turn the rotary axes to each face yet (rs274 does, heidenhain-tnc with "
+                                 "PLANE SPATIAL): "
                                  "the program stops for the operator to re-clamp the workpiece for each face");
       return true;
     }
@@ -142,7 +143,8 @@ private:
           .entity(at ? at->origin.entityId : 0);
       return false;
     }
-    return indexClampings(program, *options.machine, *options.workOffset, descriptor().arcPlanes, diags);
+    return indexClampings(program, *options.machine, *options.workOffset, descriptor().arcPlanes,
+                          descriptor().workingPlanes, diags);
   }
 
   /// Positions printed in steps coarser than half the contour tolerance

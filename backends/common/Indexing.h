@@ -34,6 +34,11 @@ namespace stepnc::backends {
 /// `arcPlanes`: the target writes arcs in the ZX and YZ planes (where a
 /// leaning tool puts a face's arcs); an arc that lands in no plane the
 /// target writes keeps the re-clamps (with the warning).
+/// `workingPlanes`: the target tilts the controller's working plane to each
+/// face instead: the moves, cycles and heights stay in the face's frame,
+/// and each turn also gets the face's frame (Step::plane); which faces are
+/// reached, the rotary solution and the travel of every point are found
+/// and checked as for joints.
 /// A machine axis's address in a program: its name in capitals ("A").
 std::string axisAddress(const runtime::Axis &axis);
 
@@ -49,6 +54,6 @@ std::unique_ptr<runtime::Kinematics> turningKinematics(const Program &p, const r
                                                        const Vec3 &workOffset, DiagnosticEngine &diags);
 
 bool indexClampings(Program &p, const runtime::Machine &machine, const Vec3 &workOffset, bool arcPlanes,
-                    DiagnosticEngine &diags);
+                    bool workingPlanes, DiagnosticEngine &diags);
 
 } // namespace stepnc::backends

@@ -60,7 +60,22 @@ TargetDescriptor tncDescriptor() {
   // set-up; README.md, "5-axis".
   d.tcpOn = "FUNCTION TCPM F TCP AXIS POS PATHCTRL AXIS";
   d.tcpOff = "FUNCTION RESET TCPM";
+  // 3+2 with PLANE SPATIAL and a datum shift per face (README.md, "5-axis").
+  d.workingPlanes = true;
   return d;
+}
+
+/// The spatial angles of PLANE SPATIAL for a working plane whose axes (in
+/// the untilted coordinates) are the columns of `turn`: rotations about the
+/// fixed X, then Y, then Z (PROCESSES.md C3), so turn = Rz(C) Ry(B) Rx(A);
+/// degrees. Where B is +-90 deg only A - C (or A + C) is fixed: C is 0.
+std::array<double, 3> spatialAngles(const Eigen::Matrix3d &turn) {
+  const double degrees = 180 / kPi;
+  const double s = std::clamp(-turn(2, 0), -1.0, 1.0);
+  if (std::abs(s) > 1 - 1e-12)
+    return {std::atan2(-turn(1, 2), turn(1, 1)) * degrees, (s > 0 ? 90.0 : -90.0), 0.0};
+  return {std::atan2(turn(2, 1), turn(2, 2)) * degrees, std::atan2(s, std::hypot(turn(0, 0), turn(1, 0))) * degrees,
+          std::atan2(turn(1, 0), turn(0, 0)) * degrees};
 }
 
 bool isAsciiAlnum(char c) { return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9'); }
@@ -136,6 +151,8 @@ public:
         continue;
       case Step::Kind::Stop:
       case Step::Kind::OptionalStop:
+        if (s.index)
+          tilt(*s.index, s.plane);  // (none: the axes back at 0 for the operator)
         if (s.reclamp) {
           // The spindle and coolant stop before the operator re-clamps,
           // whatever the control does at M0.
@@ -151,6 +168,12 @@ public:
         break;
       }
       step(p, s);
+    }
+    if (tilted_) {
+      // The working plane and the datum shift reset, the rotary axes back at 0.
+      Index home;
+      home.retractZ = *tilted_;
+      tilt(home, std::nullopt);
     }
     flushM();
     if (spindleRunning_)
@@ -282,6 +305,8 @@ private:
       out_.raw("  Q339=+" + std::to_string(s.workOffset) + " ;DATUM NUMBER");
       forgetPosition();
     }
+    if (s.index)
+      tilt(*s.index, s.plane);
     if (s.taps()) {
       // Plain moves would feed the tap out with the spindle still turning
       // forward: it would break. Cycle 207 is left out until its facts are
@@ -368,6 +393,42 @@ private:
     at_[2] = rounded(z);
     out_.block("L Z" + num(z) + " R0 FMAX" + takeM());
     modal_.forget("F");
+  }
+
+  // --- 3+2: the working plane tilted to each face --------------------------------
+
+  /// The turn before a face (`plane`), or back to the untilted plane with
+  /// the rotary axes at 0 (none): up along Z to the top of its travel in
+  /// machine coordinates (M91), the plane in force reset without moving
+  /// (STAY; or with TURN back to 0), the datum shifted to the face's origin
+  /// in the untilted coordinates (cycle 7; 0 for none), then PLANE SPATIAL
+  /// about it with TURN: the control turns the rotary axes alone, the tool
+  /// where it is. The face's moves follow in its frame, starting with Z
+  /// alone as after a tool call.
+  void tilt(const Index &index, const std::optional<WorkingPlane> &plane) {
+    flushM();
+    out_.block("L Z" + num(index.retractZ) + " R0 FMAX M91");
+    modal_.forget("F");
+    // The shift is given in the untilted coordinates: the plane in force
+    // is reset first (without moving, when another face follows).
+    if (tilted_ || !plane)
+      out_.block(plane ? "PLANE RESET STAY" : "PLANE RESET TURN FMAX");
+    const Vec3 origin = plane ? plane->origin : Vec3::Zero();
+    out_.block("CYCL DEF 7.0 DATUM SHIFT");
+    out_.block("CYCL DEF 7.1 X" + num(origin.x()));
+    out_.block("CYCL DEF 7.2 Y" + num(origin.y()));
+    out_.block("CYCL DEF 7.3 Z" + num(origin.z()));
+    if (plane) {
+      const std::array<double, 3> a = spatialAngles(plane->turn);
+      const auto angle = [](double v) { return formatNumber(v, {kAngleDecimals, true, false}); };
+      out_.block("PLANE SPATIAL SPA" + angle(a[0]) + " SPB" + angle(a[1]) + " SPC" + angle(a[2]) + " TURN FMAX");
+      tilted_ = index.retractZ;
+    } else {
+      tilted_.reset();
+    }
+    forgetPosition();
+    modal_.forget("CC");
+    cc_.reset();
   }
 
   // --- Moves -------------------------------------------------------------------
@@ -653,6 +714,9 @@ private:
   /// Where the control has the tool, per axis, when known.
   std::array<std::optional<double>, 3> at_;
   std::optional<geom::Vec2> cc_;  ///< the pole in force, as printed
+  /// A working plane tilted to a face is in force: the top of z travel the
+  /// tool goes up to before the turn back.
+  std::optional<double> tilted_;
   std::vector<std::string> pendingM_;
   int tool_ = -1;
   double spindle_ = 0;

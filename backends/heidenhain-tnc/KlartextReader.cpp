@@ -5,7 +5,11 @@
 // where the control turns the start to), unknown in X and Y after a TOOL
 // CALL or a datum setting until a block sets them. Between FUNCTION TCPM and
 // FUNCTION RESET TCPM (tool-centre-point control) an L block may also give
-// the rotary axes A, B, C after X Y Z: X Y Z stay the tool tip. Problems are
+// the rotary axes A, B, C after X Y Z: X Y Z stay the tool tip. For 3+2, a
+// datum shift (cycle 7) and PLANE SPATIAL put the coordinates in a face's
+// frame; the rotary axes turn (TURN) only after the tool went up in
+// machine coordinates (L Z.. R0 FMAX M91), which is no move of the
+// program's: where the tool is after it is not known. Problems are
 // reported with the 1-based line of the block (of the parameter line, for
 // cycle 200's).
 #include "backends/heidenhain-tnc/KlartextReader.h"
@@ -37,7 +41,7 @@ const double kNaN = std::nan("");
 bool known(double v) { return std::isfinite(v); }
 
 /// The M functions the emitter writes.
-const std::set<int> kAllowedM = {0, 1, 2, 3, 4, 5, 7, 8, 9, 30, 99};
+const std::set<int> kAllowedM = {0, 1, 2, 3, 4, 5, 7, 8, 9, 30, 91, 99};
 
 /// Cycle 200's parameters, in the order the emitter (and the TNC) writes them.
 constexpr std::array<int, 8> kCycle200Q = {200, 201, 206, 202, 210, 203, 204, 211};
@@ -135,6 +139,8 @@ public:
     }
     if (tcp_)
       r_.problem(blocks.back().line, "the program ends with FUNCTION TCPM on (FUNCTION RESET TCPM missing)");
+    if (tilted_)
+      r_.problem(blocks.back().line, "the program ends with the working plane tilted (PLANE RESET missing)");
     if (blocks.size() >= 2 && ends) {
       const std::vector<std::string> before = splitWords(blocks[last - 1].body);
       const bool programEnd =
@@ -294,6 +300,14 @@ private:
     }
     if (startsWith(body, "FUNCTION ")) {
       tcpBlock(b);
+      return;
+    }
+    if (startsWith(body, "PLANE ")) {
+      planeBlock(b, words);
+      return;
+    }
+    if (startsWith(body, "CYCL DEF 7.")) {
+      datumShift(blocks, i);
       return;
     }
     if (twoBlockCycle(blocks, i, words))
@@ -540,6 +554,63 @@ private:
     upFirst_ = "the datum setting (cycle 247) on line " + std::to_string(b.line);
   }
 
+  /// CYCL DEF 7.0 DATUM SHIFT, then 7.1 X.., 7.2 Y.., 7.3 Z.. in the next
+  /// three blocks: the datum moved (in the untilted coordinates); where the
+  /// tool is in the new coordinates is not known.
+  void datumShift(const std::vector<Block> &blocks, size_t i) {
+    static const char *kParts[] = {"CYCL DEF 7.1 X", "CYCL DEF 7.2 Y", "CYCL DEF 7.3 Z"};
+    const Block &b = blocks[i];
+    if (b.body == "CYCL DEF 7.0 DATUM SHIFT") {
+      for (size_t k = 0; k < 3; ++k)
+        if (i + 1 + k >= blocks.size() || !startsWith(blocks[i + 1 + k].body, kParts[k])) {
+          r_.problem(b.line, "CYCL DEF 7.0 DATUM SHIFT not followed by CYCL DEF 7.1 X.., 7.2 Y.. and 7.3 Z..");
+          break;
+        }
+      pos_ = Vec3(kNaN, kNaN, kNaN);
+      return;
+    }
+    for (size_t k = 0; k < 3; ++k)
+      if (startsWith(b.body, kParts[k])) {
+        if (i < k + 1 || blocks[i - k - 1].body != "CYCL DEF 7.0 DATUM SHIFT")
+          r_.problem(b.line, std::string(kParts[k]).substr(0, 12) + " not in its place after CYCL DEF 7.0 DATUM SHIFT");
+        signedNumber(b.line, b.body.substr(std::string(kParts[k]).size()), "datum shift");
+        return;
+      }
+    r_.problem(b.line, "unknown block '" + b.body + "'");
+  }
+
+  /// PLANE SPATIAL SPA.. SPB.. SPC.. TURN FMAX, PLANE RESET STAY, PLANE
+  /// RESET TURN FMAX. TURN turns the rotary axes: the tool must have gone up
+  /// out of the way (M91) with nothing moved since; the first motion after
+  /// is Z alone, as after a TOOL CALL.
+  void planeBlock(const Block &b, const std::vector<std::string> &w) {
+    const bool spatial = w.size() == 7 && w[1] == "SPATIAL" && startsWith(w[2], "SPA") && startsWith(w[3], "SPB") &&
+                         startsWith(w[4], "SPC") && w[5] == "TURN" && w[6] == "FMAX";
+    const bool resetTurn = b.body == "PLANE RESET TURN FMAX", resetStay = b.body == "PLANE RESET STAY";
+    if (!spatial && !resetTurn && !resetStay) {
+      r_.problem(b.line, "PLANE not of the form 'PLANE SPATIAL SPA.. SPB.. SPC.. TURN FMAX', 'PLANE RESET STAY' or "
+                         "'PLANE RESET TURN FMAX'");
+      return;
+    }
+    if (spatial)
+      for (size_t k = 2; k <= 4; ++k)
+        signedNumber(b.line, w[k].substr(3), "spatial angle " + w[k].substr(0, 3));
+    if (tcp_)
+      r_.problem(b.line, "PLANE with FUNCTION TCPM on");
+    if (resetStay) {
+      if (!tilted_)
+        r_.problem(b.line, "PLANE RESET STAY with no working plane tilted");
+      tilted_ = false;
+      return;
+    }
+    if (!retracted_)
+      r_.problem(b.line, "the rotary axes turn (TURN) without the tool first up in machine coordinates "
+                         "(L Z.. R0 FMAX M91) and nothing moved since");
+    tilted_ = spatial;
+    pos_ = Vec3(kNaN, kNaN, kNaN);
+    upFirst_ = "the PLANE on line " + std::to_string(b.line);
+  }
+
   /// FUNCTION TCPM in the one form the emitter writes (the descriptor's: the
   /// feed along the tip, the rotary words as axis positions, the axes
   /// interpolated in proportion), and FUNCTION RESET TCPM with the rotary
@@ -629,6 +700,14 @@ private:
     }
     if (ms.size() > 1)
       r_.problem(b.line, std::to_string(ms.size()) + " M functions in one block (stepnc writes one)");
+    if (std::find(ms.begin(), ms.end(), 91) != ms.end()) {
+      // Up along Z in machine coordinates: the only M91 move stepnc writes.
+      if (!rapid || axes[0] || axes[1] || !axes[2] || rotary[0] || rotary[1] || rotary[2])
+        r_.problem(b.line, "M91 on a block other than 'L Z.. R0 FMAX M91'");
+      pos_ = Vec3(kNaN, kNaN, kNaN);
+      retracted_ = true;
+      return;
+    }
     for (int m : ms)
       mFunction(b.line, m, /*beforeMotion=*/true);
     straight(b.line, axes, rotary, rapid, feed);
@@ -751,6 +830,7 @@ private:
     m.to = to;
     m.line = line;
     r_.moves.push_back(m);
+    retracted_ = false;
     if (m.kind != Move::Kind::Dwell)
       pos_ = to;
   }
@@ -926,6 +1006,8 @@ private:
   /// The rotary axes A, B, C as the program last wrote them (NaN: never).
   std::array<double, 3> abc_ = {kNaN, kNaN, kNaN};
   bool tcp_ = false;  ///< FUNCTION TCPM on
+  bool tilted_ = false;  ///< a PLANE SPATIAL in force
+  bool retracted_ = false;  ///< up in machine coordinates (M91), nothing moved since
   std::optional<double> feed_;  ///< mm/min, modal
   std::optional<long> tool_;
   bool spindle_ = false;
