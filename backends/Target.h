@@ -82,6 +82,10 @@ struct TargetDescriptor {
   /// origin and tilts the working plane to it, and the controller turns the
   /// rotary axes (Step::plane; heidenhain-tnc PLANE SPATIAL).
   bool workingPlanes = false;
+  /// The swivel data set the working plane is tilted with (siemens-840d's
+  /// CYCLE800 _TC, the machine's own name for its kinematics; --target-opt
+  /// swivel-data=NAME). Empty: the target names none.
+  std::string swivelDataSet;
   /// Steps that tilt the tool (5-axis moves): the target writes them as the
   /// machine's joint positions with rotary words and inverse-time feeds, for
   /// a machine without tool-centre-point control (backends/common/FiveAxis.h).

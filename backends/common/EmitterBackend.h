@@ -124,8 +124,8 @@ private:
     if (program.clampings.empty() || !options.machine || !options.machine->kinematics.fiveAxis())
       return true;
     if (!descriptor().rotaryIndexing && !descriptor().workingPlanes) {
-      diags.warning(SourceLoc{}, descriptor().name + " does not turn the rotary axes to each face yet (rs274 does, heidenhain-tnc with "
-                                 "PLANE SPATIAL): "
+      diags.warning(SourceLoc{}, descriptor().name + " does not turn the rotary axes to each face yet (rs274, heidenhain-tnc and "
+                                 "siemens-840d do): "
                                  "the program stops for the operator to re-clamp the workpiece for each face");
       return true;
     }

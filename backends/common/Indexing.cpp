@@ -6,8 +6,10 @@
 
 #include <Eigen/Dense>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <numbers>
 
 namespace stepnc::backends {
 
@@ -416,6 +418,15 @@ bool indexClampings(Program &p, const runtime::Machine &machine, const Vec3 &wor
   for (const std::string &f : faces)
     p.indexing.push_back(f);
   return true;
+}
+
+std::array<double, 3> fixedAxisAngles(const Eigen::Matrix3d &turn) {
+  const double degrees = 180 / std::numbers::pi;
+  const double s = std::clamp(-turn(2, 0), -1.0, 1.0);
+  if (std::abs(s) > 1 - 1e-12)
+    return {std::atan2(-turn(1, 2), turn(1, 1)) * degrees, (s > 0 ? 90.0 : -90.0), 0.0};
+  return {std::atan2(turn(2, 1), turn(2, 2)) * degrees, std::atan2(s, std::hypot(turn(0, 0), turn(1, 0))) * degrees,
+          std::atan2(turn(1, 0), turn(0, 0)) * degrees};
 }
 
 } // namespace stepnc::backends

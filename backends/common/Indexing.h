@@ -14,6 +14,7 @@
 #include "runtime/Machine.h"
 #include "support/Diagnostics.h"
 
+#include <array>
 #include <memory>
 
 namespace stepnc::backends {
@@ -55,5 +56,14 @@ std::unique_ptr<runtime::Kinematics> turningKinematics(const Program &p, const r
 
 bool indexClampings(Program &p, const runtime::Machine &machine, const Vec3 &workOffset, bool arcPlanes,
                     bool workingPlanes, DiagnosticEngine &diags);
+
+/// The angles (deg) that turn coordinates to a working plane whose axes are
+/// the columns of `turn` (WorkingPlane::turn): turn = Rz(c) Ry(b) Rx(a),
+/// returned as {a, b, c}. That is a about the fixed X, then b about the
+/// fixed Y, then c about the fixed Z (heidenhain-tnc's PLANE SPATIAL); or
+/// equally c about Z, then b about the turned Y, then a about the twice
+/// turned X (siemens-840d's CYCLE800 axis by axis, ZYX). Where b is +-90
+/// deg only a - c (or a + c) is fixed: c is 0.
+std::array<double, 3> fixedAxisAngles(const Eigen::Matrix3d &turn);
 
 } // namespace stepnc::backends

@@ -10,6 +10,7 @@
 // tests/backends/check-heidenhain-tnc.py does in the tests.
 #include "backends/Backend.h"
 #include "backends/common/EmitterBackend.h"
+#include "backends/common/Indexing.h"
 #include "backends/common/IsoEmitter.h"
 #include "backends/common/Program.h"
 #include "backends/common/Words.h"
@@ -63,19 +64,6 @@ TargetDescriptor tncDescriptor() {
   // 3+2 with PLANE SPATIAL and a datum shift per face (README.md, "5-axis").
   d.workingPlanes = true;
   return d;
-}
-
-/// The spatial angles of PLANE SPATIAL for a working plane whose axes (in
-/// the untilted coordinates) are the columns of `turn`: rotations about the
-/// fixed X, then Y, then Z (PROCESSES.md C3), so turn = Rz(C) Ry(B) Rx(A);
-/// degrees. Where B is +-90 deg only A - C (or A + C) is fixed: C is 0.
-std::array<double, 3> spatialAngles(const Eigen::Matrix3d &turn) {
-  const double degrees = 180 / kPi;
-  const double s = std::clamp(-turn(2, 0), -1.0, 1.0);
-  if (std::abs(s) > 1 - 1e-12)
-    return {std::atan2(-turn(1, 2), turn(1, 1)) * degrees, (s > 0 ? 90.0 : -90.0), 0.0};
-  return {std::atan2(turn(2, 1), turn(2, 2)) * degrees, std::atan2(s, std::hypot(turn(0, 0), turn(1, 0))) * degrees,
-          std::atan2(turn(1, 0), turn(0, 0)) * degrees};
 }
 
 bool isAsciiAlnum(char c) { return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9'); }
@@ -419,7 +407,8 @@ private:
     out_.block("CYCL DEF 7.2 Y" + num(origin.y()));
     out_.block("CYCL DEF 7.3 Z" + num(origin.z()));
     if (plane) {
-      const std::array<double, 3> a = spatialAngles(plane->turn);
+      // SPA SPB SPC: rotations about the fixed X, Y, Z (PROCESSES.md C3).
+      const std::array<double, 3> a = fixedAxisAngles(plane->turn);
       const auto angle = [](double v) { return formatNumber(v, {kAngleDecimals, true, false}); };
       out_.block("PLANE SPATIAL SPA" + angle(a[0]) + " SPB" + angle(a[1]) + " SPC" + angle(a[2]) + " TURN FMAX");
       tilted_ = index.retractZ;
