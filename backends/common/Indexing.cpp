@@ -126,6 +126,20 @@ bool indexClampings(Program &p, const runtime::Machine &machine, const Vec3 &wor
                     bool workingPlanes, DiagnosticEngine &diags) {
   if (p.clampings.empty())
     return true;
+  if (workingPlanes) {
+    // Under a tilted working plane the coordinates of a step that tilts the
+    // tool would be the plane's, and the 840D's TRAORI does not go with a
+    // swivel: such a program keeps its re-clamps.
+    const auto tilted = std::find_if(p.steps.begin(), p.steps.end(), [](const Step &s) { return s.tilted; });
+    if (tilted != p.steps.end()) {
+      diags.warning(tilted->exec->origin.loc,
+                    "workingstep " + tilted->exec->symbol +
+                        " tilts the tool, which stepnc does not write under a tilted working plane yet: the program "
+                        "stops for the operator to re-clamp for each face instead")
+          .entity(tilted->exec->origin.entityId);
+      return true;
+    }
+  }
   const std::unique_ptr<runtime::Kinematics> kinematics = turningKinematics(p, machine, workOffset, diags);
   if (!kinematics)
     return false;

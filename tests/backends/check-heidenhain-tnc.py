@@ -137,6 +137,7 @@ class Machine:
         self.motions = []
         self.up_first = None  # the TOOL CALL whose first motion is still to come
         self.tcp = False  # FUNCTION TCPM on
+        self.step_start = 0  # the first motion of the step (after its "* - NAME" block)
         self.abc = {}  # the rotary axes as last written
         # 3+2: the datum shift and the spatial angles in force (None: no
         # plane tilted), the face the last re-clamp message put up, whether
@@ -400,6 +401,8 @@ def check_program(text, arc_tol):
             problems.add(where, "BEGIN PGM / END PGM inside the program")
             continue
         if body.startswith(";") or body.startswith("* - "):
+            if body.startswith("* - "):
+                mach.step_start = len(mach.motions)
             if body.rstrip().endswith("~"):
                 problems.add(where, "a comment ending in '~' continues the block")
             m = re.search(r"^; MESSAGE: re-clamp the workpiece with its ([+-][XYZ]) face up", body)
@@ -481,6 +484,9 @@ def check_program(text, arc_tol):
                 if mach.tcp:
                     problems.add(where, "FUNCTION TCPM while it is on")
                 mach.tcp = True
+                # The whole step is check-tcp.py's, its clearance move too.
+                for mv in mach.motions[mach.step_start:]:
+                    mv["tcp"] = True
             elif body == TCPM_OFF:
                 if not mach.tcp:
                     problems.add(where, "FUNCTION RESET TCPM while FUNCTION TCPM is off")
