@@ -1,5 +1,6 @@
 #include "backends/Target.h"
 
+#include <algorithm>
 #include <charconv>
 
 namespace stepnc::backends {
@@ -27,7 +28,7 @@ const char *cycleKindName(CycleKind kind) {
 std::string overrideHelp() {
   return "decimals=N (coordinates, 0..6), line-numbers=none|every, number-step=N, "
          "max-line-length=N (0: none), arcs=ijk|radius, cycles=on|off, splines=on|off, "
-         "nose-compensation=path|controller";
+         "nose-compensation=path|controller, swivel-data=NAME";
 }
 
 std::string applyOverrides(TargetDescriptor &d, const std::vector<std::string> &overrides) {
@@ -59,6 +60,16 @@ std::string applyOverrides(TargetDescriptor &d, const std::vector<std::string> &
         return "--target-opt splines: " + d.name + " has no spline blocks stepnc writes; smooth runs stay lines";
       if (value == "off")
         d.splines = SplineForm::None;
+    } else if (key == "swivel-data") {
+      // A name the cycle call carries in double quotes; "0" deselects.
+      const bool plain = !value.empty() && value != "0" && std::all_of(value.begin(), value.end(), [](char c) {
+        return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
+      });
+      if (d.swivelDataSet.empty())
+        return "--target-opt swivel-data: " + d.name + " names no swivel data set";
+      if (!plain)
+        return "--target-opt swivel-data: '" + value + "' is not a name of letters, digits and _ (\"0\" deselects)";
+      d.swivelDataSet = value;
     } else if (key == "nose-compensation" && (value == "path" || value == "controller")) {
       if (value == "controller" && !d.latheCompensation)
         return "--target-opt nose-compensation: " + d.name +

@@ -77,6 +77,15 @@ struct TargetDescriptor {
   /// turns its rotary axes to each face (3+2, positions computed by stepnc,
   /// backends/common/Indexing.h) instead of stopping to re-clamp.
   bool rotaryIndexing = false;
+  /// ... or with the controller's tilted working plane: each face's moves
+  /// stay in its own frame, the program shifts the datum to the face's
+  /// origin and tilts the working plane to it, and the controller turns the
+  /// rotary axes (Step::plane; heidenhain-tnc PLANE SPATIAL).
+  bool workingPlanes = false;
+  /// The swivel data set the working plane is tilted with (siemens-840d's
+  /// CYCLE800 _TC, the machine's own name for its kinematics; --target-opt
+  /// swivel-data=NAME). Empty: the target names none.
+  std::string swivelDataSet;
   /// Steps that tilt the tool (5-axis moves): the target writes them as the
   /// machine's joint positions with rotary words and inverse-time feeds, for
   /// a machine without tool-centre-point control (backends/common/FiveAxis.h).

@@ -93,7 +93,7 @@ private:
     if (!descriptor().jointMoves && descriptor().tcpOn.empty()) {
       diags.error(at.origin.loc, "workingstep " + at.symbol + " tilts the tool (5-axis): " + descriptor().name +
                                      " does not write such steps yet (rs274 does, as the machine's joints; "
-                                     "siemens-840d with TRAORI: docs/five-axis.md)")
+                                     "siemens-840d with TRAORI, heidenhain-tnc with FUNCTION TCPM: docs/five-axis.md)")
           .entity(at.origin.entityId);
       return false;
     }
@@ -127,8 +127,9 @@ private:
   bool index(Program &program, const EmitOptions &options, DiagnosticEngine &diags) const {
     if (program.clampings.empty() || !options.machine || !options.machine->kinematics.fiveAxis())
       return true;
-    if (!descriptor().rotaryIndexing) {
-      diags.warning(SourceLoc{}, descriptor().name + " does not turn the rotary axes to each face yet (rs274 does): "
+    if (!descriptor().rotaryIndexing && !descriptor().workingPlanes) {
+      diags.warning(SourceLoc{}, descriptor().name + " does not turn the rotary axes to each face yet (rs274, heidenhain-tnc and "
+                                 "siemens-840d do): "
                                  "the program stops for the operator to re-clamp the workpiece for each face");
       return true;
     }
@@ -146,7 +147,8 @@ private:
           .entity(at ? at->origin.entityId : 0);
       return false;
     }
-    return indexClampings(program, *options.machine, *options.workOffset, descriptor().arcPlanes, diags);
+    return indexClampings(program, *options.machine, *options.workOffset, descriptor().arcPlanes,
+                          descriptor().workingPlanes, diags);
   }
 
   /// Positions printed in steps coarser than half the contour tolerance

@@ -6,8 +6,10 @@
 
 #include <Eigen/Dense>
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <numbers>
 
 namespace stepnc::backends {
 
@@ -121,9 +123,23 @@ std::unique_ptr<runtime::Kinematics> turningKinematics(const Program &p, const r
 }
 
 bool indexClampings(Program &p, const runtime::Machine &machine, const Vec3 &workOffset, bool arcPlanes,
-                    DiagnosticEngine &diags) {
+                    bool workingPlanes, DiagnosticEngine &diags) {
   if (p.clampings.empty())
     return true;
+  if (workingPlanes) {
+    // Under a tilted working plane the coordinates of a step that tilts the
+    // tool would be the plane's, and the 840D's TRAORI does not go with a
+    // swivel: such a program keeps its re-clamps.
+    const auto tilted = std::find_if(p.steps.begin(), p.steps.end(), [](const Step &s) { return s.tilted; });
+    if (tilted != p.steps.end()) {
+      diags.warning(tilted->exec->origin.loc,
+                    "workingstep " + tilted->exec->symbol +
+                        " tilts the tool, which stepnc does not write under a tilted working plane yet: the program "
+                        "stops for the operator to re-clamp for each face instead")
+          .entity(tilted->exec->origin.entityId);
+      return true;
+    }
+  }
   const std::unique_ptr<runtime::Kinematics> kinematics = turningKinematics(p, machine, workOffset, diags);
   if (!kinematics)
     return false;
@@ -158,6 +174,10 @@ bool indexClampings(Program &p, const runtime::Machine &machine, const Vec3 &wor
   // places it; false (with why) when the machine cannot.
   auto turnStep = [&](Step &s, const Placement &base, const std::string &baseFace,
                       std::optional<Problem> &failure) -> bool {
+    // With the controller's working plane the step is written as planned:
+    // its moves go through the kinematics below only to find the turn and
+    // check every point's reach.
+    const Step planned = s;
     const Placement place = placementOf(s.setup);
     // The face's normal as the clamping holds the workpiece, and the name
     // of the face in the workpiece.
@@ -208,6 +228,15 @@ bool indexClampings(Program &p, const runtime::Machine &machine, const Vec3 &wor
         text += " " + axisAddress(machine.axes[k]) + formatShortest(near[static_cast<Eigen::Index>(k)]);
       }
       s.index = std::move(index);
+      if (workingPlanes) {
+        // The face's frame in the clamping's coordinates: a point q of the
+        // face is the workpiece's place.turn^T (q - place.at), which the
+        // clamping puts at base.at + base.turn of that.
+        WorkingPlane plane;
+        plane.turn = base.turn * place.turn.transpose();
+        plane.origin = base.at - plane.turn * place.at;
+        s.plane = plane;
+      }
       // Listed once per clamping.
       if (std::find(faces.begin() + static_cast<long>(clampingListed), faces.end(), text) == faces.end())
         faces.push_back(text);
@@ -260,6 +289,10 @@ bool indexClampings(Program &p, const runtime::Machine &machine, const Vec3 &wor
           break;
         bool positive = true;
         const std::optional<geom::ArcPlane> plane = geom::ArcPlane::about(*normal, positive);
+        if (workingPlanes) {
+          moves.push_back(m);  // stays in the face's frame, its reach checked by its ends and centre
+          continue;
+        }
         if (plane && (plane->isXY() || arcPlanes)) {
           m.plane = *plane;
           m.ccw = positive ? m.ccw : !m.ccw;
@@ -295,6 +328,13 @@ bool indexClampings(Program &p, const runtime::Machine &machine, const Vec3 &wor
       }
     }
     s.secplane += dz;
+    if (workingPlanes && !failure) {
+      // In the face's tilted working plane its moves, arcs and cycles are
+      // as on a 3-axis machine.
+      s.moves = planned.moves;
+      s.cycle = planned.cycle;
+      s.secplane = planned.secplane;
+    }
     return !failure;
   };
 
@@ -379,13 +419,28 @@ bool indexClampings(Program &p, const runtime::Machine &machine, const Vec3 &wor
                        (reclamps > 0 ? ", re-clamping " + std::to_string(reclamps) +
                                            (reclamps == 1 ? " time" : " times") + " for faces it cannot turn there"
                                      : std::string()));
-  p.indexing.push_back("one work offset for all: the workpiece's origin at X" + formatShortest(workOffset.x()) + " Y" +
-                       formatShortest(workOffset.y()) + " Z" + formatShortest(workOffset.z()) +
-                       " in machine coordinates with every axis at 0; before each turn the tool goes up to Z" +
-                       formatShortest(retractZ) + " (G53)");
+  const std::string origin = "the workpiece's origin at X" + formatShortest(workOffset.x()) + " Y" +
+                             formatShortest(workOffset.y()) + " Z" + formatShortest(workOffset.z()) +
+                             " in machine coordinates with every axis at 0";
+  if (workingPlanes)
+    p.indexing.push_back("one datum for all, " + origin + "; each face's moves in its own frame, the datum shifted to "
+                         "the face's origin and the working plane tilted to it; before each turn the tool goes up "
+                         "to Z" + formatShortest(retractZ) + " in machine coordinates");
+  else
+    p.indexing.push_back("one work offset for all: " + origin + "; before each turn the tool goes up to Z" +
+                         formatShortest(retractZ) + " (G53)");
   for (const std::string &f : faces)
     p.indexing.push_back(f);
   return true;
+}
+
+std::array<double, 3> fixedAxisAngles(const Eigen::Matrix3d &turn) {
+  const double degrees = 180 / std::numbers::pi;
+  const double s = std::clamp(-turn(2, 0), -1.0, 1.0);
+  if (std::abs(s) > 1 - 1e-12)
+    return {std::atan2(-turn(1, 2), turn(1, 1)) * degrees, (s > 0 ? 90.0 : -90.0), 0.0};
+  return {std::atan2(turn(2, 1), turn(2, 2)) * degrees, std::atan2(s, std::hypot(turn(0, 0), turn(1, 0))) * degrees,
+          std::atan2(turn(1, 0), turn(0, 0)) * degrees};
 }
 
 } // namespace stepnc::backends

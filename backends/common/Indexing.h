@@ -14,6 +14,7 @@
 #include "runtime/Machine.h"
 #include "support/Diagnostics.h"
 
+#include <array>
 #include <memory>
 
 namespace stepnc::backends {
@@ -34,6 +35,11 @@ namespace stepnc::backends {
 /// `arcPlanes`: the target writes arcs in the ZX and YZ planes (where a
 /// leaning tool puts a face's arcs); an arc that lands in no plane the
 /// target writes keeps the re-clamps (with the warning).
+/// `workingPlanes`: the target tilts the controller's working plane to each
+/// face instead: the moves, cycles and heights stay in the face's frame,
+/// and each turn also gets the face's frame (Step::plane); which faces are
+/// reached, the rotary solution and the travel of every point are found
+/// and checked as for joints.
 /// A machine axis's address in a program: its name in capitals ("A").
 std::string axisAddress(const runtime::Axis &axis);
 
@@ -49,6 +55,15 @@ std::unique_ptr<runtime::Kinematics> turningKinematics(const Program &p, const r
                                                        const Vec3 &workOffset, DiagnosticEngine &diags);
 
 bool indexClampings(Program &p, const runtime::Machine &machine, const Vec3 &workOffset, bool arcPlanes,
-                    DiagnosticEngine &diags);
+                    bool workingPlanes, DiagnosticEngine &diags);
+
+/// The angles (deg) that turn coordinates to a working plane whose axes are
+/// the columns of `turn` (WorkingPlane::turn): turn = Rz(c) Ry(b) Rx(a),
+/// returned as {a, b, c}. That is a about the fixed X, then b about the
+/// fixed Y, then c about the fixed Z (heidenhain-tnc's PLANE SPATIAL); or
+/// equally c about Z, then b about the turned Y, then a about the twice
+/// turned X (siemens-840d's CYCLE800 axis by axis, ZYX). Where b is +-90
+/// deg only a - c (or a + c) is fixed: c is 0.
+std::array<double, 3> fixedAxisAngles(const Eigen::Matrix3d &turn);
 
 } // namespace stepnc::backends

@@ -54,6 +54,8 @@ void IsoEmitter::turn(const Index &index) {
   }
 }
 
+void IsoEmitter::faceTurn(const Index &index, const std::optional<WorkingPlane> &) { turn(index); }
+
 std::string IsoEmitter::rotaryWords(const Move &m) {
   std::string words;
   for (size_t k = 0; k < m.rotary.size() && k < program_->rotaryAxes.size(); ++k) {
@@ -85,7 +87,7 @@ std::optional<std::string> IsoEmitter::run(const Program &p) {
     case Step::Kind::Stop:
     case Step::Kind::OptionalStop:
       if (s.index)
-        turn(*s.index);
+        faceTurn(*s.index, s.plane);
       if (s.reclamp)
         beforeReclamp();
       stop(s.kind == Step::Kind::OptionalStop);
@@ -95,7 +97,7 @@ std::optional<std::string> IsoEmitter::run(const Program &p) {
     }
     out_.block(comment(s.label));
     if (s.index)
-      turn(*s.index);
+      faceTurn(*s.index, s.plane);
     if (s.workOffset > 0) {
       const std::string offset = workOffsetWord(s.workOffset);
       if (offset.empty())

@@ -62,6 +62,10 @@ protected:
   /// The word that selects work offset `n` (1: the program's first); "" and
   /// an error when the controller has no such offset.
   virtual std::string workOffsetWord(int n) const = 0;
+  /// 3+2: the turn before a face (Step::index, with the face's frame in
+  /// Step::plane for a target that tilts the working plane; none: the axes
+  /// back at 0). The rotary axes' positions, written directly (turn()).
+  virtual void faceTurn(const Index &index, const std::optional<WorkingPlane> &plane);
 
   // --- Shared machinery ------------------------------------------------------------
   void move(const Move &m);

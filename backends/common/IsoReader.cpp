@@ -107,6 +107,8 @@ public:
                                                           : "the program does not end with M30");
     if (mcall_)
       r_.problem(mcall_->line, "MCALL " + mcall_->name + " never cancelled by a bare MCALL");
+    if (swivel_)
+      r_.problem(lines.size(), "the program ends with the plane swivelled (CYCLE800 with _TC \"0\" missing)");
     return std::move(r_);
   }
 
@@ -228,7 +230,7 @@ private:
           continue;
         }
         bool matched = false;
-        for (std::string_view k : {"MCALL", "CSPLINE", "BAUTO", "EAUTO", "TRAORI", "TRAFOOF"})
+        for (std::string_view k : {"MCALL", "CSPLINE", "BAUTO", "EAUTO", "TRAORI", "TRAFOOF", "SUPA"})
           if (keyword(k)) {
             out.push_back({std::string(k), ""});
             i += k.size();
@@ -274,7 +276,8 @@ private:
     bool ok = true;
     for (Word &w : ws) {
       if (w.address == "MSG" || w.address == "CALL" || w.address == "MCALL" || w.address == "CSPLINE" ||
-          w.address == "BAUTO" || w.address == "EAUTO" || w.address == "TRAORI" || w.address == "TRAFOOF")
+          w.address == "BAUTO" || w.address == "EAUTO" || w.address == "TRAORI" || w.address == "TRAFOOF" ||
+          w.address == "SUPA")
         continue;
       const auto &allowed = dialect_ == Dialect::Rs274 ? rs274Words : siemensWords;
       if (!allowed.count(w.address)) {
@@ -348,10 +351,12 @@ private:
           r_.problem(n, w.address + " is the 840D's");
         if ((w.address == "TRAORI") == traori_)
           r_.problem(n, w.address + (traori_ ? " while the transformation is on" : " while it is off"));
+        if (swivel_)
+          r_.problem(n, w.address + " with the plane swivelled (CYCLE800)");
         traori_ = w.address == "TRAORI";
         return;
       } else if (w.address == "MSG" || w.address == "MCALL" || w.address == "CSPLINE" || w.address == "BAUTO" ||
-                 w.address == "EAUTO") {
+                 w.address == "EAUTO" || w.address == "SUPA") {
         keywords.push_back(w.address);
       } else if (!seen.emplace(w.address, w.value).second) {
         r_.problem(n, w.address + " written twice in one block");
@@ -379,13 +384,24 @@ private:
       if (!has(0) || seen.size() != 1 || !seen.count("Z"))
         r_.problem(n, "G53 other than G53 G0 Z.. (the tool up before the table turns)");
       pos_ = Vec3(kNaN, kNaN, kNaN);
+      up_ = true;
+      return;
+    }
+    // The 840D's: up with every frame suppressed (G0 SUPA Z..) before a swivel.
+    if (std::count(keywords.begin(), keywords.end(), "SUPA")) {
+      if (!has(0) || seen.size() != 1 || !seen.count("Z") || gs.size() != 1)
+        r_.problem(n, "SUPA other than G0 SUPA Z.. (the tool up before the plane swivels)");
+      pos_ = Vec3(kNaN, kNaN, kNaN);
+      up_ = true;
       return;
     }
     const bool rotaryWords = seen.count("A") || seen.count("B") || seen.count("C");
     const bool rotaryAlone = rotaryWords && std::all_of(seen.begin(), seen.end(), [](const auto &w) {
       return w.first == "A" || w.first == "B" || w.first == "C";
     });
-    if (rotaryWords && dialect_ == Dialect::Siemens && !traori_) {
+    // (On the 840D the rotary axes turn alone at rapid only back to 0 after
+    // a swivel is deselected, with the tool up.)
+    if (rotaryWords && dialect_ == Dialect::Siemens && !traori_ && !(rotaryAlone && has(0) && up_ && !swivel_)) {
       r_.problem(n, "rotary axes turned with the transformation off (TRAORI first)");
       return;
     }
@@ -400,6 +416,8 @@ private:
       r_.problem(n, "rotary axes turned other than alone at rapid (G0 A.. C..) or on a straight move");
       return;
     }
+    if (seen.count("X") || seen.count("Y") || seen.count("Z"))
+      up_ = false;
     if (std::count(keywords.begin(), keywords.end(), "MCALL")) {
       mcallBlock(n, *ws, calls);
       return;
@@ -1065,6 +1083,10 @@ private:
 
   void directCall(size_t n, const std::string &call, size_t words) {
     auto [name, args] = callArgs(call);
+    if (name == "CYCLE800") {
+      swivel(n, args, words);
+      return;
+    }
     if (name == "CYCLE832") {
       if (words != 1)
         r_.problem(n, "CYCLE832 shares its block");
@@ -1103,6 +1125,51 @@ private:
     drill(n, *c);
   }
 
+  /// CYCLE800 in the one form the emitter writes (README.md, "3+2"): _FR 0,
+  /// _TC the swivel data set (or "0": deselect, every value 0), _ST 0,
+  /// _MODE 27 (axis by axis, Z Y X), X0 Y0 Z0 0, the three angles, the
+  /// rotated zero X1 Y1 Z1, _DIR -1, _FR_I 0; alone in its block, right
+  /// after the tool went up (G0 SUPA Z..) with nothing moved since. Where the
+  /// tool is in the new coordinates is not known after it.
+  void swivel(size_t n, const std::vector<std::string> &args, size_t words) {
+    if (words != 1)
+      r_.problem(n, "CYCLE800 shares its block");
+    if (args.size() != 15) {
+      r_.problem(n, "CYCLE800 with " + std::to_string(args.size()) +
+                        " arguments (it takes 15: _FR, _TC, _ST, _MODE, _X0, _Y0, _Z0, _A, _B, _C, _X1, _Y1, _Z1, "
+                        "_DIR, _FR_I)");
+      return;
+    }
+    const std::string &tc = args[1];
+    if (tc.size() < 3 || tc.front() != '"' || tc.back() != '"') {
+      r_.problem(n, "CYCLE800: _TC " + tc + " is not a name in double quotes");
+      return;
+    }
+    const bool deselect = tc == "\"0\"";
+    std::vector<double> v;
+    for (size_t k = 0; k < args.size(); ++k) {
+      if (k == 1)
+        continue;
+      std::string why;
+      if (!wellFormedNumber(args[k], false, why)) {
+        r_.problem(n, "CYCLE800: argument " + std::to_string(k + 1) + " " + why);
+        return;
+      }
+      v.push_back(std::strtod(args[k].c_str(), nullptr));
+    }
+    // v: _FR, _ST, _MODE, X0, Y0, Z0, A, B, C, X1, Y1, Z1, _DIR, _FR_I.
+    if (v[0] != 0 || v[1] != 0 || v[2] != 27 || v[3] != 0 || v[4] != 0 || v[5] != 0 || v[12] != -1 || v[13] != 0)
+      r_.problem(n, "CYCLE800 not of the form CYCLE800(0,\"..\",0,27,0.,0.,0.,A,B,C,X1,Y1,Z1,-1,0.)");
+    if (deselect && std::any_of(v.begin() + 6, v.begin() + 12, [](double x) { return x != 0; }))
+      r_.problem(n, "CYCLE800: a deselection (_TC \"0\") with angles or a zero point");
+    if (traori_)
+      r_.problem(n, "CYCLE800 with TRAORI on");
+    if (!up_)
+      r_.problem(n, "CYCLE800 swivels without the tool first up (G0 SUPA Z..) and nothing moved since");
+    swivel_ = !deselect;
+    pos_ = Vec3(kNaN, kNaN, kNaN);
+  }
+
   static constexpr int kCspline = -1;  ///< motion_: the 840D's CSPLINE
 
   Dialect dialect_;
@@ -1116,6 +1183,8 @@ private:
   double feed_ = 0, speed_ = 0;
   bool inverseTime_ = false;  ///< G93: F is 1 / the block's minutes
   bool traori_ = false;       ///< the 840D's TRAORI on
+  bool swivel_ = false;       ///< the 840D's plane swivelled (CYCLE800)
+  bool up_ = false;           ///< the tool up in machine coordinates (G53, SUPA), nothing moved since
   std::array<double, 3> abc_ = {kNaN, kNaN, kNaN};  ///< A, B, C as last written
   bool spindleOn_ = false;
   std::optional<int> selected_, inSpindle_, offset_, pendingOffset_;

@@ -46,6 +46,15 @@ struct Index {
   double retractZ = 0;  ///< machine z the tool goes up to first (the top of its travel), mm
 };
 
+/// 3+2 with the controller's tilted working plane (TargetDescriptor::
+/// workingPlanes): the frame a step's moves are in (its face's), placed in
+/// the coordinates of the workpiece as clamped. A point q of the step is at
+/// origin + turn q there; the tool goes along turn's third column.
+struct WorkingPlane {
+  Vec3 origin = Vec3::Zero();
+  Eigen::Matrix3d turn = Eigen::Matrix3d::Identity();  ///< the face frame's axes, as columns
+};
+
 struct Move {
   /// Dwell: the tool waits where it is for `dwell` seconds.
   enum class Kind { Rapid, Linear, Arc, Dwell } kind = Kind::Rapid;
@@ -143,6 +152,10 @@ struct Step {
   /// In a program that turns the rotary axes to each face instead of
   /// re-clamping: the turn before the step.
   std::optional<Index> index;
+  /// With the controller's tilted working plane: the plane the turn before
+  /// the step selects (set with `index`; the step's moves stay in its
+  /// face's frame).
+  std::optional<WorkingPlane> plane;
   double spindle = 0;     ///< rev/min, negative clockwise (M3); 0 on a rapid movement: keep
   std::string coolant;    ///< off, flood, mist, through_tool
   double secplane = 0;

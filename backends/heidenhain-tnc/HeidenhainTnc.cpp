@@ -10,6 +10,7 @@
 // tests/backends/check-heidenhain-tnc.py does in the tests.
 #include "backends/Backend.h"
 #include "backends/common/EmitterBackend.h"
+#include "backends/common/Indexing.h"
 #include "backends/common/IsoEmitter.h"
 #include "backends/common/Program.h"
 #include "backends/common/Words.h"
@@ -53,6 +54,15 @@ TargetDescriptor tncDescriptor() {
   d.feedDecimals = 0;
   d.speedDecimals = 0;
   d.tolerance = 0.01;
+  // 5-axis with the control's tool-centre-point control (PROCESSES.md C3):
+  // FUNCTION TCPM says in the block each thing the program relies on (the
+  // feed along the tip, the rotary words as axis positions, the axes
+  // interpolated in proportion), where M128 leaves them to the machine's
+  // set-up; README.md, "5-axis".
+  d.tcpOn = "FUNCTION TCPM F TCP AXIS POS PATHCTRL AXIS";
+  d.tcpOff = "FUNCTION RESET TCPM";
+  // 3+2 with PLANE SPATIAL and a datum shift per face (README.md, "5-axis").
+  d.workingPlanes = true;
   return d;
 }
 
@@ -107,6 +117,7 @@ public:
   static ProgramReading read(const std::string &text, const TargetDescriptor &d) { return readKlartext(text, d); }
 
   std::optional<std::string> run(const Program &p) {
+    program_ = &p;
     const std::string name = sanitizedName(o_.programName);
     if (name != o_.programName)
       diags_.warning(SourceLoc{}, "the program name '" + o_.programName + "' is written as '" + name +
@@ -128,6 +139,8 @@ public:
         continue;
       case Step::Kind::Stop:
       case Step::Kind::OptionalStop:
+        if (s.index)
+          tilt(*s.index, s.plane);  // (none: the axes back at 0 for the operator)
         if (s.reclamp) {
           // The spindle and coolant stop before the operator re-clamps,
           // whatever the control does at M0.
@@ -143,6 +156,12 @@ public:
         break;
       }
       step(p, s);
+    }
+    if (tilted_) {
+      // The working plane and the datum shift reset, the rotary axes back at 0.
+      Index home;
+      home.retractZ = *tilted_;
+      tilt(home, std::nullopt);
     }
     flushM();
     if (spindleRunning_)
@@ -274,6 +293,8 @@ private:
       out_.raw("  Q339=+" + std::to_string(s.workOffset) + " ;DATUM NUMBER");
       forgetPosition();
     }
+    if (s.index)
+      tilt(*s.index, s.plane);
     if (s.taps()) {
       // Plain moves would feed the tap out with the spindle still turning
       // forward: it would break. Cycle 207 is left out until its facts are
@@ -303,8 +324,20 @@ private:
       flushM();
       return;
     }
-    for (const Move &m : s.moves)
+    // A step that tilts the tool runs under the control's tool-centre-point
+    // control from its first move that gives the rotary axes (the clearance
+    // move before is along Z as after any tool call) to its end, where the
+    // rotary axes are back at 0 (FiveAxis.h, tcpMoves).
+    bool tcp = false;
+    for (const Move &m : s.moves) {
+      if (s.tilted && !tcp && !m.rotary.empty()) {
+        out_.block(d_.tcpOn);
+        tcp = true;
+      }
       move(m);
+    }
+    if (tcp)
+      out_.block(d_.tcpOff);
     flushM();
   }
 
@@ -350,6 +383,43 @@ private:
     modal_.forget("F");
   }
 
+  // --- 3+2: the working plane tilted to each face --------------------------------
+
+  /// The turn before a face (`plane`), or back to the untilted plane with
+  /// the rotary axes at 0 (none): up along Z to the top of its travel in
+  /// machine coordinates (M91), the plane in force reset without moving
+  /// (STAY; or with TURN back to 0), the datum shifted to the face's origin
+  /// in the untilted coordinates (cycle 7; 0 for none), then PLANE SPATIAL
+  /// about it with TURN: the control turns the rotary axes alone, the tool
+  /// where it is. The face's moves follow in its frame, starting with Z
+  /// alone as after a tool call.
+  void tilt(const Index &index, const std::optional<WorkingPlane> &plane) {
+    flushM();
+    out_.block("L Z" + num(index.retractZ) + " R0 FMAX M91");
+    modal_.forget("F");
+    // The shift is given in the untilted coordinates: the plane in force
+    // is reset first (without moving, when another face follows).
+    if (tilted_ || !plane)
+      out_.block(plane ? "PLANE RESET STAY" : "PLANE RESET TURN FMAX");
+    const Vec3 origin = plane ? plane->origin : Vec3::Zero();
+    out_.block("CYCL DEF 7.0 DATUM SHIFT");
+    out_.block("CYCL DEF 7.1 X" + num(origin.x()));
+    out_.block("CYCL DEF 7.2 Y" + num(origin.y()));
+    out_.block("CYCL DEF 7.3 Z" + num(origin.z()));
+    if (plane) {
+      // SPA SPB SPC: rotations about the fixed X, Y, Z (PROCESSES.md C3).
+      const std::array<double, 3> a = fixedAxisAngles(plane->turn);
+      const auto angle = [](double v) { return formatNumber(v, {kAngleDecimals, true, false}); };
+      out_.block("PLANE SPATIAL SPA" + angle(a[0]) + " SPB" + angle(a[1]) + " SPC" + angle(a[2]) + " TURN FMAX");
+      tilted_ = index.retractZ;
+    } else {
+      tilted_.reset();
+    }
+    forgetPosition();
+    modal_.forget("CC");
+    cc_.reset();
+  }
+
   // --- Moves -------------------------------------------------------------------
 
   void move(const Move &m) {
@@ -367,13 +437,33 @@ private:
       upAlongZ(m.to.z());
       return;
     }
-    line(m.to, m.kind == Move::Kind::Rapid, m.feed);
+    line(m.to, m.kind == Move::Kind::Rapid, m.feed, rotaryWords(m));
+  }
+
+  /// The rotary axes' words of a move under tool-centre-point control, for
+  /// the angles that change as printed, in the order A B C after X Y Z
+  /// (" A+20 C+2.479"; a head-head machine's C comes first in its chain).
+  std::string rotaryWords(const Move &m) {
+    std::vector<std::pair<std::string, std::string>> changed;
+    for (size_t k = 0; k < m.rotary.size() && k < program_->rotaryAxes.size(); ++k) {
+      const std::string &name = program_->rotaryAxes[k];
+      const std::string v = num(m.rotary[k]);
+      if (modal_.change(name, v))
+        changed.emplace_back(name, v);
+    }
+    std::sort(changed.begin(), changed.end());
+    std::string words;
+    for (const auto &[name, v] : changed)
+      words += " " + name + v;
+    return words;
   }
 
   static std::string seconds(double s) { return formatNumber(s, {3, false, false}); }
 
-  void line(const Vec3 &to, bool rapid, double feed) {
-    const std::string words = axes(to);
+  void line(const Vec3 &to, bool rapid, double feed, const std::string &rotary = "") {
+    std::string words = axes(to) + rotary;
+    if (!words.empty() && words.front() == ' ')
+      words.erase(0, 1);
     if (words.empty())
       return;  // no motion as printed
     std::string text = "L " + words + " R0";
@@ -606,12 +696,16 @@ private:
   const TargetDescriptor &d_;
   const EmitOptions &o_;
   DiagnosticEngine &diags_;
+  const Program *program_ = nullptr;
   BlockWriter out_;
   StepLines stepLines_;
   ModalState modal_;
   /// Where the control has the tool, per axis, when known.
   std::array<std::optional<double>, 3> at_;
   std::optional<geom::Vec2> cc_;  ///< the pole in force, as printed
+  /// A working plane tilted to a face is in force: the top of z travel the
+  /// tool goes up to before the turn back.
+  std::optional<double> tilted_;
   std::vector<std::string> pendingM_;
   int tool_ = -1;
   double spindle_ = 0;

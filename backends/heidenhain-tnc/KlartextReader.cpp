@@ -3,8 +3,15 @@
 // continue its block after a line ending in `~`); words are split at single
 // spaces; the position is tracked through the printed numbers (after a CP,
 // where the control turns the start to), unknown in X and Y after a TOOL
-// CALL or a datum setting until a block sets them. Problems are reported
-// with the 1-based line of the block (of the parameter line, for cycle 200's).
+// CALL or a datum setting until a block sets them. Between FUNCTION TCPM and
+// FUNCTION RESET TCPM (tool-centre-point control) an L block may also give
+// the rotary axes A, B, C after X Y Z: X Y Z stay the tool tip. For 3+2, a
+// datum shift (cycle 7) and PLANE SPATIAL put the coordinates in a face's
+// frame; the rotary axes turn (TURN) only after the tool went up in
+// machine coordinates (L Z.. R0 FMAX M91), which is no move of the
+// program's: where the tool is after it is not known. Problems are
+// reported with the 1-based line of the block (of the parameter line, for
+// cycle 200's).
 #include "backends/heidenhain-tnc/KlartextReader.h"
 
 #include "backends/common/Words.h"
@@ -34,7 +41,7 @@ const double kNaN = std::nan("");
 bool known(double v) { return std::isfinite(v); }
 
 /// The M functions the emitter writes.
-const std::set<int> kAllowedM = {0, 1, 2, 3, 4, 5, 7, 8, 9, 30, 99};
+const std::set<int> kAllowedM = {0, 1, 2, 3, 4, 5, 7, 8, 9, 30, 91, 99};
 
 /// Cycle 200's parameters, in the order the emitter (and the TNC) writes them.
 constexpr std::array<int, 8> kCycle200Q = {200, 201, 206, 202, 210, 203, 204, 211};
@@ -130,6 +137,10 @@ public:
         continue;
       block(blocks, i, i + 1 == last);
     }
+    if (tcp_)
+      r_.problem(blocks.back().line, "the program ends with FUNCTION TCPM on (FUNCTION RESET TCPM missing)");
+    if (tilted_)
+      r_.problem(blocks.back().line, "the program ends with the working plane tilted (PLANE RESET missing)");
     if (blocks.size() >= 2 && ends) {
       const std::vector<std::string> before = splitWords(blocks[last - 1].body);
       const bool programEnd =
@@ -282,7 +293,21 @@ private:
       r_.problem(b.line, "BLK FORM 0.1 without its BLK FORM 0.2 after it");
     blk01_.reset();
     if (startsWith(body, "TOOL CALL")) {
+      if (tcp_)
+        r_.problem(b.line, "TOOL CALL with FUNCTION TCPM on");
       toolCall(b, words);
+      return;
+    }
+    if (startsWith(body, "FUNCTION ")) {
+      tcpBlock(b);
+      return;
+    }
+    if (startsWith(body, "PLANE ")) {
+      planeBlock(b, words);
+      return;
+    }
+    if (startsWith(body, "CYCL DEF 7.")) {
+      datumShift(blocks, i);
       return;
     }
     if (twoBlockCycle(blocks, i, words))
@@ -529,11 +554,93 @@ private:
     upFirst_ = "the datum setting (cycle 247) on line " + std::to_string(b.line);
   }
 
-  /// An L block: X Y Z (signed, in that order), R0, F<n> or FMAX, one M
-  /// function. M3/M4 act before the motion, the stops after it, M99 calls
-  /// cycle 200 where the block ends.
+  /// CYCL DEF 7.0 DATUM SHIFT, then 7.1 X.., 7.2 Y.., 7.3 Z.. in the next
+  /// three blocks: the datum moved (in the untilted coordinates); where the
+  /// tool is in the new coordinates is not known.
+  void datumShift(const std::vector<Block> &blocks, size_t i) {
+    static const char *kParts[] = {"CYCL DEF 7.1 X", "CYCL DEF 7.2 Y", "CYCL DEF 7.3 Z"};
+    const Block &b = blocks[i];
+    if (b.body == "CYCL DEF 7.0 DATUM SHIFT") {
+      for (size_t k = 0; k < 3; ++k)
+        if (i + 1 + k >= blocks.size() || !startsWith(blocks[i + 1 + k].body, kParts[k])) {
+          r_.problem(b.line, "CYCL DEF 7.0 DATUM SHIFT not followed by CYCL DEF 7.1 X.., 7.2 Y.. and 7.3 Z..");
+          break;
+        }
+      pos_ = Vec3(kNaN, kNaN, kNaN);
+      return;
+    }
+    for (size_t k = 0; k < 3; ++k)
+      if (startsWith(b.body, kParts[k])) {
+        if (i < k + 1 || blocks[i - k - 1].body != "CYCL DEF 7.0 DATUM SHIFT")
+          r_.problem(b.line, std::string(kParts[k]).substr(0, 12) + " not in its place after CYCL DEF 7.0 DATUM SHIFT");
+        signedNumber(b.line, b.body.substr(std::string(kParts[k]).size()), "datum shift");
+        return;
+      }
+    r_.problem(b.line, "unknown block '" + b.body + "'");
+  }
+
+  /// PLANE SPATIAL SPA.. SPB.. SPC.. TURN FMAX, PLANE RESET STAY, PLANE
+  /// RESET TURN FMAX. TURN turns the rotary axes: the tool must have gone up
+  /// out of the way (M91) with nothing moved since; the first motion after
+  /// is Z alone, as after a TOOL CALL.
+  void planeBlock(const Block &b, const std::vector<std::string> &w) {
+    const bool spatial = w.size() == 7 && w[1] == "SPATIAL" && startsWith(w[2], "SPA") && startsWith(w[3], "SPB") &&
+                         startsWith(w[4], "SPC") && w[5] == "TURN" && w[6] == "FMAX";
+    const bool resetTurn = b.body == "PLANE RESET TURN FMAX", resetStay = b.body == "PLANE RESET STAY";
+    if (!spatial && !resetTurn && !resetStay) {
+      r_.problem(b.line, "PLANE not of the form 'PLANE SPATIAL SPA.. SPB.. SPC.. TURN FMAX', 'PLANE RESET STAY' or "
+                         "'PLANE RESET TURN FMAX'");
+      return;
+    }
+    if (spatial)
+      for (size_t k = 2; k <= 4; ++k)
+        signedNumber(b.line, w[k].substr(3), "spatial angle " + w[k].substr(0, 3));
+    if (tcp_)
+      r_.problem(b.line, "PLANE with FUNCTION TCPM on");
+    if (resetStay) {
+      if (!tilted_)
+        r_.problem(b.line, "PLANE RESET STAY with no working plane tilted");
+      tilted_ = false;
+      return;
+    }
+    if (!retracted_)
+      r_.problem(b.line, "the rotary axes turn (TURN) without the tool first up in machine coordinates "
+                         "(L Z.. R0 FMAX M91) and nothing moved since");
+    tilted_ = spatial;
+    pos_ = Vec3(kNaN, kNaN, kNaN);
+    upFirst_ = "the PLANE on line " + std::to_string(b.line);
+  }
+
+  /// FUNCTION TCPM in the one form the emitter writes (the descriptor's: the
+  /// feed along the tip, the rotary words as axis positions, the axes
+  /// interpolated in proportion), and FUNCTION RESET TCPM with the rotary
+  /// axes back at 0.
+  void tcpBlock(const Block &b) {
+    if (!d_.tcpOn.empty() && b.body == d_.tcpOn) {
+      if (tcp_)
+        r_.problem(b.line, "FUNCTION TCPM while it is on");
+      tcp_ = true;
+      return;
+    }
+    if (!d_.tcpOff.empty() && b.body == d_.tcpOff) {
+      if (!tcp_)
+        r_.problem(b.line, "FUNCTION RESET TCPM while FUNCTION TCPM is off");
+      for (int k = 0; k < 3; ++k)
+        if (known(abc_[k]) && abc_[k] != 0)
+          r_.problem(b.line, std::string("FUNCTION RESET TCPM with the rotary axis ") + "ABC"[k] +
+                                 formatTrimmed(abc_[k], 4) + " turned (the steps after run with it at 0)");
+      tcp_ = false;
+      return;
+    }
+    r_.problem(b.line, "FUNCTION block not of the form '" + d_.tcpOn + "' or '" + d_.tcpOff + "'");
+  }
+
+  /// An L block: X Y Z (signed, in that order), under FUNCTION TCPM also A B
+  /// C, R0, F<n> or FMAX, one M function. M3/M4 act before the motion, the
+  /// stops after it, M99 calls cycle 200 where the block ends.
   void straightBlock(const Block &b, const std::vector<std::string> &words, bool lastBeforeEnd) {
     std::array<std::optional<double>, 3> axes;
+    std::array<std::optional<double>, 3> rotary;
     int lastAxis = -1;
     int state = 0;  // 0 axes, 1 after R, 2 after F or FMAX, 3 after M
     bool rapid = false;
@@ -548,6 +655,17 @@ private:
         lastAxis = std::max(lastAxis, axis);
         if (const std::optional<double> v = signedNumber(b.line, w.substr(1), std::string("coordinate ") + w[0]))
           axes[axis] = v;
+        continue;
+      }
+      if (state == 0 && !w.empty() && (w[0] == 'A' || w[0] == 'B' || w[0] == 'C')) {
+        const int axis = 3 + (w[0] - 'A');
+        if (axis <= lastAxis)
+          r_.problem(b.line, std::string("axis ") + w[0] + " repeated or out of X Y Z A B C order");
+        lastAxis = std::max(lastAxis, axis);
+        if (!tcp_)
+          r_.problem(b.line, std::string("rotary axis ") + w[0] + " with FUNCTION TCPM off");
+        if (const std::optional<double> v = signedNumber(b.line, w.substr(1), std::string("rotary axis ") + w[0]))
+          rotary[axis - 3] = v;
         continue;
       }
       if ((w == "R0" || w == "RL" || w == "RR") && state < 1) {
@@ -582,9 +700,17 @@ private:
     }
     if (ms.size() > 1)
       r_.problem(b.line, std::to_string(ms.size()) + " M functions in one block (stepnc writes one)");
+    if (std::find(ms.begin(), ms.end(), 91) != ms.end()) {
+      // Up along Z in machine coordinates: the only M91 move stepnc writes.
+      if (!rapid || axes[0] || axes[1] || !axes[2] || rotary[0] || rotary[1] || rotary[2])
+        r_.problem(b.line, "M91 on a block other than 'L Z.. R0 FMAX M91'");
+      pos_ = Vec3(kNaN, kNaN, kNaN);
+      retracted_ = true;
+      return;
+    }
     for (int m : ms)
       mFunction(b.line, m, /*beforeMotion=*/true);
-    straight(b.line, axes, rapid, feed);
+    straight(b.line, axes, rotary, rapid, feed);
     for (int m : ms) {
       mFunction(b.line, m, /*beforeMotion=*/false);
       if (m == 99)
@@ -704,6 +830,7 @@ private:
     m.to = to;
     m.line = line;
     r_.moves.push_back(m);
+    retracted_ = false;
     if (m.kind != Move::Kind::Dwell)
       pos_ = to;
   }
@@ -718,26 +845,34 @@ private:
     return true;
   }
 
-  void straight(size_t line, const std::array<std::optional<double>, 3> &axes, bool rapid,
-                const std::optional<double> &feed) {
+  void straight(size_t line, const std::array<std::optional<double>, 3> &axes,
+                const std::array<std::optional<double>, 3> &rotary, bool rapid, const std::optional<double> &feed) {
     // An L block without coordinates ("L M30" in a program with no motion)
     // moves nothing: it needs no tool.
-    if (!axes[0] && !axes[1] && !axes[2])
+    const bool turns = rotary[0] || rotary[1] || rotary[2];
+    if (!axes[0] && !axes[1] && !axes[2] && !turns)
       return;
-    needTool(line, rapid && !axes[0] && !axes[1]);
+    needTool(line, rapid && !axes[0] && !axes[1] && !turns);
     if (!rapid)
       feedMove(line, feed);
     Vec3 to = pos_;
     for (int k = 0; k < 3; ++k)
       if (axes[k])
         to[k] = *axes[k];
-    if (printsAsNoMotion(to)) {
+    bool rotates = false;
+    for (int k = 0; k < 3; ++k)
+      if (rotary[k]) {
+        rotates = rotates || !(abc_[k] == *rotary[k]);
+        abc_[k] = *rotary[k];
+      }
+    if (printsAsNoMotion(to) && !rotates) {
       pos_ = to;
       return;
     }
     ReadMove m;
     m.kind = rapid ? Move::Kind::Rapid : Move::Kind::Linear;
     m.feed = rapid ? 0 : feed_.value_or(0);
+    m.abc = abc_;
     add(m, line, to);
   }
 
@@ -868,6 +1003,11 @@ private:
   /// not said.
   Vec3 pos_ = Vec3(kNaN, kNaN, kNaN);
   std::optional<geom::Vec2> cc_;
+  /// The rotary axes A, B, C as the program last wrote them (NaN: never).
+  std::array<double, 3> abc_ = {kNaN, kNaN, kNaN};
+  bool tcp_ = false;  ///< FUNCTION TCPM on
+  bool tilted_ = false;  ///< a PLANE SPATIAL in force
+  bool retracted_ = false;  ///< up in machine coordinates (M91), nothing moved since
   std::optional<double> feed_;  ///< mm/min, modal
   std::optional<long> tool_;
   bool spindle_ = false;

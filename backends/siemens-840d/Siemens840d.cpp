@@ -8,15 +8,18 @@
 // checked by tests/backends/check-siemens-840d.py.
 #include "backends/Backend.h"
 #include "backends/common/EmitterBackend.h"
+#include "backends/common/Indexing.h"
 #include "backends/common/IsoEmitter.h"
 #include "backends/common/IsoReader.h"
 #include "backends/common/LatheEmitter.h"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace stepnc::backends {
 
@@ -46,8 +49,17 @@ TargetDescriptor siemensDescriptor() {
   // programmed in the workpiece, the rotary axes' positions on each block.
   d.tcpOn = "TRAORI";
   d.tcpOff = "TRAFOOF";
+  // 3+2 with CYCLE800 (PROCESSES.md C2): the face's frame as the swivel's
+  // plane and rotated zero (README.md, "3+2").
+  d.workingPlanes = true;
+  d.swivelDataSet = "TC1";
   return d;
 }
+
+/// CYCLE800's _MODE for swivelling axis by axis, Z first, then Y, then X:
+/// bits 7-6 00 (axis by axis), bits 1-0 the first axis (11 Z), 3-2 the
+/// second (10 Y), 5-4 the third (01 X) (README.md, "3+2": unverified).
+constexpr int kAxisByAxisZyx = 0b011011;
 
 /// Names longer than this are cut: the older 840D limit (unverified, README).
 constexpr size_t kMaxNameLength = 24;
@@ -247,6 +259,13 @@ private:
   }
 
   void footer(const Program &) override {
+    if (swivelled_) {
+      // The swivel deselected, the rotary axes back at 0.
+      Index home;
+      home.retractZ = *swivelled_;
+      home.axes = homeAxes_;
+      faceTurn(home, std::nullopt);
+    }
     out_.block("M5");
     out_.block("M9");
     out_.block("CYCLE832(0.,0,1)");  // _TOLM 0: the high speed settings off again
@@ -259,6 +278,46 @@ private:
     out_.block(word("T", std::to_string(t.number)) + " D1");
     out_.block("M6");
   }
+
+  /// 3+2 (Step::plane): up to the top of z with every frame suppressed
+  /// (G0 SUPA Z..), then CYCLE800 swivels to the face: no retraction of its
+  /// own (_FR 0, the tool is up), the swivel data set, a new plane (_ST 0),
+  /// axis by axis in the order Z, Y, X (_MODE 27) about the workpiece's
+  /// origin (X0 Y0 Z0 at 0) by the angles that turn the coordinates to the
+  /// face's frame, the rotated zero X1 Y1 Z1 the face frame's origin in the
+  /// turned coordinates, the control's preferred direction minus (_DIR -1).
+  /// Back (none): the same retract, the swivel deselected (_TC "0") and
+  /// the rotary axes to 0 at rapid (G0 A0. C0.).
+  void faceTurn(const Index &index, const std::optional<WorkingPlane> &plane) override {
+    out_.block("G0 SUPA " + word("Z", num(index.retractZ)));
+    const auto n = [&](double v) { return num(v); };
+    if (plane) {
+      const std::array<double, 3> a = fixedAxisAngles(plane->turn);  // {about X, about Y, about Z}
+      const Vec3 zero = plane->turn.transpose() * plane->origin;    // the origin in the turned coordinates
+      out_.block("CYCLE800(0,\"" + d_.swivelDataSet + "\",0," + std::to_string(kAxisByAxisZyx) + ",0.,0.,0.," + n(a[2]) +
+                 "," + n(a[1]) + "," + n(a[0]) + "," + n(zero.x()) + "," + n(zero.y()) + "," + n(zero.z()) +
+                 ",-1,0.)");
+      swivelled_ = index.retractZ;
+      homeAxes_.clear();
+      for (const auto &[axis, deg] : index.axes)
+        homeAxes_.emplace_back(axis, 0.0);
+    } else {
+      out_.block("CYCLE800(0,\"0\",0," + std::to_string(kAxisByAxisZyx) + ",0.,0.,0.,0.,0.,0.,0.,0.,0.,-1,0.)");
+      std::string words = "G0";
+      for (const auto &[axis, deg] : index.axes)
+        words += " " + axis + num(deg);
+      out_.block(words);
+      swivelled_.reset();
+    }
+    // Where the axes are in the new coordinates is not where they were.
+    for (const char *w : {"G", "X", "Y", "Z"})
+      modal_.forget(w);
+  }
+
+  /// A swivel is in force: the top of z the tool goes up to before it is
+  /// deselected; the rotary axes to put back at 0.
+  std::optional<double> swivelled_;
+  std::vector<std::pair<std::string, double>> homeAxes_;
 
   std::string turnsWord(int64_t turns) const override { return word("TURN=", std::to_string(turns)); }
 

@@ -15,6 +15,16 @@ what the control would reject or do differently:
     MIN below MAX; cycle 32 and cycle 200 with all their Q parameters; cycle
     247 (a clamping's datum, then Z alone first as after a TOOL CALL); cycle
     9 (`CYCL DEF 9.0 DWELL TIME`, then `CYCL DEF 9.1 DWELL t`, t > 0 s);
+  * 5-axis: `FUNCTION TCPM F TCP AXIS POS PATHCTRL AXIS` and `FUNCTION RESET
+    TCPM` in turn, rotary words (A, B, C after X Y Z) only between them, no
+    TOOL CALL between them, the rotary axes back at 0 at the reset, none
+    left on at the end; 3+2: `CYCL DEF 7.0 DATUM SHIFT` with 7.1 X, 7.2 Y,
+    7.3 Z in the next blocks, `PLANE SPATIAL SPA.. SPB.. SPC.. TURN FMAX`,
+    `PLANE RESET STAY` and `PLANE RESET TURN FMAX`, every TURN right after
+    the tool went up in machine coordinates (`L Z.. R0 FMAX M91`, the only
+    M91 block, no move of the program's), Z alone first after a PLANE, no
+    plane left tilted at the end (check-working-plane.py checks where the
+    frames put the moves);
   * motion: the first after each TOOL CALL is an L block with Z alone (up
     to the clearance height: where the tool change left the tool is the
     machine's business, so X and Y only move once it is up); no motion
@@ -29,7 +39,8 @@ TNC manual describes it: README.md; its Q211 and cycle 9 as dwells) are also com
 IR's moves: runs of rapids by where they end, feed moves by end point and
 feed, arcs also by direction, sweep and path (points at eighths of each
 written arc within 0.005 mm of the IR's circle; an arc that keeps that
-close to its chord may be a line).
+close to its chord may be a line). The moves that tilt the tool (under
+FUNCTION TCPM) are check-tcp.py's, through the machine's kinematics.
 
 Exit status 0 when clean, 1 listing each problem with its block number.
 """
@@ -42,7 +53,9 @@ import toolpath_ir
 
 NUM_SIGNED = r"[+-]\d+(?:\.\d+)?"
 NUM_UNSIGNED = r"\d+(?:\.\d+)?"
-M_ALLOWED = {0, 1, 2, 3, 4, 5, 7, 8, 9, 30, 99}
+M_ALLOWED = {0, 1, 2, 3, 4, 5, 7, 8, 9, 30, 91, 99}
+TCPM_ON = "FUNCTION TCPM F TCP AXIS POS PATHCTRL AXIS"
+TCPM_OFF = "FUNCTION RESET TCPM"
 CYCLE_200_Q = [200, 201, 206, 202, 210, 203, 204, 211]
 END_TOL = 0.002   # a CP ends where the control turns the start: printed angle and pole
 PATH_TOL = 0.005  # along arcs: printed endpoints, and poles moved on the grid to balance the radii
@@ -123,6 +136,18 @@ class Machine:
         self.cycle = None
         self.motions = []
         self.up_first = None  # the TOOL CALL whose first motion is still to come
+        self.tcp = False  # FUNCTION TCPM on
+        self.step_start = 0  # the first motion of the step (after its "* - NAME" block)
+        self.abc = {}  # the rotary axes as last written
+        # 3+2: the datum shift and the spatial angles in force (None: no
+        # plane tilted), the face the last re-clamp message put up, whether
+        # the tool went up in machine coordinates (M91: its Z) with nothing
+        # moved since, and what each PLANE ... TURN turned with.
+        self.shift = (0.0, 0.0, 0.0)
+        self.plane = None
+        self.reclamp = None
+        self.retracted = None
+        self.turns = []
 
     def need_tool(self, where, z_alone=False):
         if self.tool is None:
@@ -162,7 +187,9 @@ class Machine:
             target["XYZ".index(k)] = v
         if axes:
             self.motions.append({"kind": "rapid" if rapid else "linear", "to": tuple(target),
-                                 "feed": None if rapid else self.feed, "where": where})
+                                 "feed": None if rapid else self.feed, "where": where, "tcp": self.tcp,
+                                 "frame": self.frame()})
+            self.retracted = None
         self.pos = target
 
     def arc(self, where, end_xy, ccw, feed):
@@ -189,7 +216,9 @@ class Machine:
         if math.hypot(x - self.pos[0], y - self.pos[1]) < 1e-9:
             sweep = 2 * math.pi
         self.motions.append({"kind": "arc", "to": (x, y, self.pos[2]), "centre": self.cc, "ccw": ccw,
-                             "sweep": sweep, "radius": r1, "feed": self.feed, "where": where})
+                             "sweep": sweep, "radius": r1, "feed": self.feed, "where": where,
+                             "frame": self.frame()})
+        self.retracted = None
         self.pos = [x, y, self.pos[2]]
 
     def polar_arc(self, where, ipa_deg, iz, ccw, feed):
@@ -207,8 +236,15 @@ class Machine:
         y = self.cc[1] + rx * math.sin(a) + ry * math.cos(a)
         z = self.pos[2] + iz
         self.motions.append({"kind": "arc", "to": (x, y, z), "centre": self.cc, "ccw": ccw, "sweep": abs(a),
-                             "radius": math.hypot(rx, ry), "feed": self.feed, "where": where})
+                             "radius": math.hypot(rx, ry), "feed": self.feed, "where": where,
+                             "frame": self.frame()})
+        self.retracted = None
         self.pos = [x, y, z]
+
+    def frame(self):
+        """What places the coordinates in force: (datum shift, spatial angles
+        or None, the face the last re-clamp put up or None)."""
+        return (self.shift, self.plane, self.reclamp)
 
     def call_cycle(self, where):
         """M99 at the end of an L block: cycle 200 at the position."""
@@ -236,7 +272,8 @@ class Machine:
             if reached < surface:
                 self.motions.append({"kind": "rapid", "to": (x, y, surface + clearance), "where": where})
                 self.motions.append({"kind": "rapid", "to": (x, y, reached + clearance), "where": where})
-            self.motions.append({"kind": "linear", "to": (x, y, target), "feed": q[206], "where": where})
+            self.motions.append({"kind": "linear", "to": (x, y, target), "feed": q[206], "where": where,
+                                 "frame": self.frame()})
             reached = target
             if target <= bottom + 1e-9:
                 if q[211] > 0:
@@ -260,20 +297,23 @@ def turn_angle(a, b, ccw):
 
 
 def check_l(words, where, mach, problems, is_last_before_end):
-    """An L block: X Y Z (signed, in order), R0/RL/RR, F<n> or FMAX, one M."""
+    """An L block: X Y Z (signed, in order), under FUNCTION TCPM also A B C,
+    R0/RL/RR, F<n> or FMAX, one M."""
     axes = {}
-    order = "XYZ"
+    order = "XYZABC"
     state = 0  # 0 axes, 1 after R, 2 after F, 3 after M
     rapid = False
     feed = None
     ms = []
     for w in words:
-        m = re.fullmatch(r"([XYZ])(.*)", w)
+        m = re.fullmatch(r"([XYZABC])(.*)", w)
         if m and state == 0:
             axis = m.group(1)
             if axis in axes or (axes and order.index(axis) < order.index(list(axes)[-1])):
-                problems.add(where, "axis %s repeated or out of X Y Z order" % axis)
-            v = signed(m.group(2), where, problems, "coordinate " + axis)
+                problems.add(where, "axis %s repeated or out of X Y Z A B C order" % axis)
+            if axis in "ABC" and not mach.tcp:
+                problems.add(where, "rotary axis %s with FUNCTION TCPM off" % axis)
+            v = signed(m.group(2), where, problems, ("rotary axis " if axis in "ABC" else "coordinate ") + axis)
             if v is not None:
                 axes[axis] = v
             continue
@@ -305,6 +345,17 @@ def check_l(words, where, mach, problems, is_last_before_end):
         problems.add(where, "%d M functions in one block (stepnc writes one)" % len(ms))
     for n in ms:
         mach.m_function(where, n, before_motion=True)
+    for axis in "ABC":
+        if axis in axes:
+            mach.abc[axis] = axes.pop(axis)
+    if 91 in ms:
+        # Up along Z in machine coordinates (no move of the program's): the
+        # only M91 block stepnc writes.
+        if not rapid or list(axes) != ["Z"]:
+            problems.add(where, "M91 on a block other than 'L Z.. R0 FMAX M91'")
+        mach.pos = [None, None, None]
+        mach.retracted = axes.get("Z")
+        return ms
     mach.line(where, axes, rapid, feed)
     for n in ms:
         mach.m_function(where, n, before_motion=False)
@@ -350,8 +401,13 @@ def check_program(text, arc_tol):
             problems.add(where, "BEGIN PGM / END PGM inside the program")
             continue
         if body.startswith(";") or body.startswith("* - "):
+            if body.startswith("* - "):
+                mach.step_start = len(mach.motions)
             if body.rstrip().endswith("~"):
                 problems.add(where, "a comment ending in '~' continues the block")
+            m = re.search(r"^; MESSAGE: re-clamp the workpiece with its ([+-][XYZ]) face up", body)
+            if m:
+                mach.reclamp = m.group(1)
             continue
         if cont and not body.startswith("CYCL DEF 200 ") and not body.startswith("CYCL DEF 247 "):
             problems.add(where, "continuation lines after a block that is not a cycle definition")
@@ -379,7 +435,71 @@ def check_program(text, arc_tol):
         if blk01 is not None and blk01[1] == number - 1:
             problems.add(where, "BLK FORM 0.1 without its BLK FORM 0.2 after it")
             blk01 = None
+        if body.startswith("CYCL DEF 7."):
+            # A datum shift (3+2): the new datum in the untilted coordinates.
+            if body == "CYCL DEF 7.0 DATUM SHIFT":
+                parts = []
+                for k, axis in enumerate("XYZ"):
+                    nxt = blocks[i + 1 + k][1] if i + 1 + k < len(blocks) else ""
+                    m = re.fullmatch(r"CYCL DEF 7\.%d %s(\S+)" % (k + 1, axis), nxt)
+                    parts.append(signed(m.group(1), where, problems, "datum shift " + axis) if m else None)
+                if None in parts:
+                    problems.add(where, "CYCL DEF 7.0 DATUM SHIFT not followed by CYCL DEF 7.1 X.., 7.2 Y.. and 7.3 Z..")
+                else:
+                    if mach.plane is not None:
+                        problems.add(where, "a datum shift with the working plane tilted (PLANE RESET first)")
+                    mach.shift = tuple(parts)
+                mach.pos = [None, None, None]
+            elif not re.fullmatch(r"CYCL DEF 7\.[123] [XYZ]\S+", body) or \
+                    blocks[i - int(body[11])][1] != "CYCL DEF 7.0 DATUM SHIFT":
+                problems.add(where, "%s not in its place after CYCL DEF 7.0 DATUM SHIFT" % body)
+            continue
+        if body.startswith("PLANE "):
+            # The working plane (3+2, PROCESSES.md C3).
+            m = re.fullmatch(r"PLANE SPATIAL SPA(\S+) SPB(\S+) SPC(\S+) TURN FMAX", body)
+            if not m and body not in ("PLANE RESET STAY", "PLANE RESET TURN FMAX"):
+                problems.add(where, "PLANE not of the form 'PLANE SPATIAL SPA.. SPB.. SPC.. TURN FMAX', "
+                                    "'PLANE RESET STAY' or 'PLANE RESET TURN FMAX'")
+                continue
+            if mach.tcp:
+                problems.add(where, "PLANE with FUNCTION TCPM on")
+            if body == "PLANE RESET STAY":
+                if mach.plane is None:
+                    problems.add(where, "PLANE RESET STAY with no working plane tilted")
+                mach.plane = None
+                continue
+            if mach.retracted is None:
+                problems.add(where, "the rotary axes turn (TURN) without the tool first up in machine coordinates "
+                                    "(L Z.. R0 FMAX M91) and nothing moved since")
+            angles = tuple(signed(v, where, problems, "spatial angle") for v in m.groups()) if m else None
+            mach.turns.append({"where": where, "z": mach.retracted, "angles": angles})
+            mach.plane = angles
+            mach.pos = [None, None, None]
+            mach.up_first = where
+            continue
+        if body.startswith("FUNCTION "):
+            # Tool-centre-point control (PROCESSES.md C3), in the one form
+            # stepnc writes.
+            if body == TCPM_ON:
+                if mach.tcp:
+                    problems.add(where, "FUNCTION TCPM while it is on")
+                mach.tcp = True
+                # The whole step is check-tcp.py's, its clearance move too.
+                for mv in mach.motions[mach.step_start:]:
+                    mv["tcp"] = True
+            elif body == TCPM_OFF:
+                if not mach.tcp:
+                    problems.add(where, "FUNCTION RESET TCPM while FUNCTION TCPM is off")
+                turned = ["%s%g" % (a, v) for a, v in sorted(mach.abc.items()) if v != 0]
+                if turned:
+                    problems.add(where, "FUNCTION RESET TCPM with the rotary axes at %s, not 0" % " ".join(turned))
+                mach.tcp = False
+            else:
+                problems.add(where, "FUNCTION block not of the form '%s' or '%s'" % (TCPM_ON, TCPM_OFF))
+            continue
         if body.startswith("TOOL CALL"):
+            if mach.tcp:
+                problems.add(where, "TOOL CALL with FUNCTION TCPM on")
             m = re.fullmatch(r"TOOL CALL (\d+) Z(?: S(\S+))?", body)
             if not m:
                 problems.add(where, "TOOL CALL not of the form 'TOOL CALL n Z S..'")
@@ -462,6 +582,10 @@ def check_program(text, arc_tol):
             mach.polar_arc(where, ipa, iz, ccw, feed)
             continue
         problems.add(where, "unknown block '%s'" % body)
+    if mach.tcp:
+        problems.add("block %d" % blocks[-1][0], "the program ends with FUNCTION TCPM on")
+    if mach.plane is not None:
+        problems.add("block %d" % blocks[-1][0], "the program ends with the working plane tilted (PLANE RESET missing)")
     if len(blocks) >= 2 and end:
         before = blocks[-2][1].split()
         if not (before and before[0] == "L" and ("M30" in before or "M2" in before)):
@@ -720,8 +844,10 @@ def main():
         text = f.read()
     problems, mach = check_program(text, args.arc_tol)
     if args.ir:
-        compare(normalise(program_moves(mach.motions), args.decimals),
-                normalise(ir_moves(args.ir), args.decimals), problems, args.decimals)
+        # Moves that tilt the tool (under FUNCTION TCPM) are check-tcp.py's.
+        made = [mv for mv in program_moves(mach.motions) if not mv.get("tcp")]
+        planned = [mv for mv in ir_moves(args.ir) if mv.get("axis", (0.0, 0.0, 1.0)) == (0.0, 0.0, 1.0)]
+        compare(normalise(made, args.decimals), normalise(planned, args.decimals), problems, args.decimals)
     if problems.items:
         for item in problems.items:
             print("%s: %s" % (args.program, item))

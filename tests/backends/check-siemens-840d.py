@@ -94,7 +94,7 @@ TOKEN_RE = re.compile(
     r'\s*(?:(?P<msg>MSG\("[^"]*"\))'
     r"|(?P<call>(?:CYCLE\d+)\([^()]*\))"
     r"|(?P<mcall>MCALL)(?![A-Z0-9_])"
-    r"|(?P<keyword>CSPLINE|BAUTO|EAUTO|DIAMON|TRAORI|TRAFOOF)(?![A-Z0-9_])"
+    r"|(?P<keyword>CSPLINE|BAUTO|EAUTO|DIAMON|TRAORI|TRAFOOF|SUPA)(?![A-Z0-9_])"
     r"|(?P<assign>(?:CR|TURN|LIMS)=(?P<avalue>" + NUMBER + r"))"
     r"|(?P<letter>[A-Z])(?P<value>" + NUMBER + r"))")
 
@@ -283,6 +283,14 @@ class Checker:
         self.lathe = False
         self.diameter = False
         self.traori = False  # the 840D's TRAORI on
+        # 3+2 (CYCLE800): the swivel in force ((angles about Z, Y, X in
+        # turn), the rotated zero) or None, the face the last re-clamp
+        # message put up, the Z of the last G0 SUPA Z.. with nothing moved
+        # since, and what each swivel turned with.
+        self.swivel = None
+        self.reclamp = None
+        self.up = None
+        self.turns = []
         self.per_rev = False
         self.css = False
         self.motion = None
@@ -368,6 +376,8 @@ class Checker:
             self.problem(len(self.lines), "the program does not end with M30")
         if self.mcall is not None:
             self.problem(self.mcall["line"], "MCALL %s never cancelled by a bare MCALL" % self.mcall["cycle"])
+        if self.swivel is not None:
+            self.problem(len(self.lines), "the program ends with the plane swivelled (CYCLE800 with _TC \"0\" missing)")
 
     def tokenize(self, n, code):
         words = []
@@ -399,10 +409,14 @@ class Checker:
         seen = {}
         gs, ms = [], []
         bad = False
+        # The rotary axes alone at rapid, back to 0 after a swivel is
+        # deselected with the tool up (3+2), are the only ones without TRAORI.
+        homing = all(a in "ABCG" for a, _ in words) and ("G", "0") in words and self.up is not None and \
+            self.swivel is None
         for address, value in words:
-            if address in ("MSG", "CALL", "MCALL", "CSPLINE", "BAUTO", "EAUTO", "DIAMON", "TRAORI", "TRAFOOF"):
+            if address in ("MSG", "CALL", "MCALL", "CSPLINE", "BAUTO", "EAUTO", "DIAMON", "TRAORI", "TRAFOOF", "SUPA"):
                 continue
-            if address in "ABC" and not self.traori:
+            if address in "ABC" and not self.traori and not homing:
                 self.problem(n, "rotary axis %s with the transformation off (TRAORI first)" % address)
                 bad = True
             elif address in LENGTH_WORDS or address in INTEGER_WORDS or address in "GM" or address in "ABC":
@@ -424,9 +438,11 @@ class Checker:
                     self.problem(n, "%s shares its block" % address)
                 if (address == "TRAORI") == self.traori:
                     self.problem(n, "%s while the transformation is %s" % (address, "on" if self.traori else "off"))
+                if self.swivel is not None:
+                    self.problem(n, "%s with the plane swivelled (CYCLE800)" % address)
                 self.traori = address == "TRAORI"
                 return
-            if address in ("MSG", "CALL", "MCALL", "CSPLINE", "BAUTO", "EAUTO") or address in "ABC":
+            if address in ("MSG", "CALL", "MCALL", "CSPLINE", "BAUTO", "EAUTO", "SUPA") or address in "ABC":
                 continue
             if address == "DIAMON":
                 self.diameter = True
@@ -464,6 +480,22 @@ class Checker:
         kinds = [a for a, _ in words]
         if "MSG" in kinds and len(words) > 1:
             self.problem(n, "MSG shares its block")
+        for address, value in words:
+            m = re.search(r"re-clamp the workpiece with its ([+-][XYZ]) face up", value) if address == "MSG" else None
+            if m:
+                self.reclamp = m.group(1)
+        if "SUPA" in kinds:
+            # Up with every frame suppressed (machine coordinates) before a
+            # swivel: no move of the program's, where the tool is after it
+            # is not known.
+            if gs != [0] or list(seen) != ["Z"]:
+                self.problem(n, "SUPA other than G0 SUPA Z.. (the tool up before the plane swivels)")
+            self.pos = {"X": None, "Y": None, "Z": None}
+            self.up = seen.get("Z")
+            return
+        if homing and any(a in "ABC" for a in kinds):
+            self.pos = {"X": None, "Y": None, "Z": None}
+            return
 
         # MCALL: on with a cycle, off bare.
         if "MCALL" in kinds:
@@ -581,6 +613,7 @@ class Checker:
         self.lacking = set(lacking)
 
     def move(self, n, seen):
+        self.up = None
         if self.motion is None:
             self.problem(n, "axis words with no motion G code (G0 G1 G2 G3)")
             return
@@ -633,7 +666,8 @@ class Checker:
 
     def make(self, n, kind, feed, at=None, **arc):
         to = at if at is not None else (self.pos["X"], self.pos["Y"], self.pos["Z"])
-        self.made.append(dict(kind=kind, to=to, feed=feed or 0, line=n, tcp=self.traori, **arc))
+        self.made.append(dict(kind=kind, to=to, feed=feed or 0, line=n, tcp=self.traori,
+                              frame=("cycle800", self.swivel, self.reclamp), **arc))
 
     def arc(self, n, seen):
         if not self.modal["plane"]:
@@ -839,8 +873,44 @@ class Checker:
         self.pos["Z"] = c["rtp"]
         self.make(n, "rapid", 0)
 
+    def swivel_call(self, n, args, nwords):
+        """CYCLE800 in the one form stepnc writes (README.md, "3+2"): _FR 0,
+        _TC a name ("0": deselect, every value 0), _ST 0, _MODE 27 (axis by
+        axis, Z then Y then X), X0 Y0 Z0 0, the angles, the rotated zero X1
+        Y1 Z1, _DIR -1, _FR_I 0; alone, right after G0 SUPA Z.."""
+        if nwords != 1:
+            self.problem(n, "CYCLE800 shares its block")
+        if len(args) != 15:
+            self.problem(n, "CYCLE800 with %d arguments (it takes 15)" % len(args))
+            return
+        tc = args[1]
+        if not re.fullmatch(r'"[A-Za-z0-9_]+"', tc):
+            self.problem(n, "CYCLE800: _TC %s is not a name in double quotes" % tc)
+            return
+        try:
+            v = [arg_number(a) for k, a in enumerate(args) if k != 1]
+        except ValueError as e:
+            self.problem(n, "CYCLE800: argument %r is not a plain number" % str(e))
+            return
+        # v: _FR, _ST, _MODE, X0, Y0, Z0, A, B, C, X1, Y1, Z1, _DIR, _FR_I
+        if v[0] != 0 or v[1] != 0 or v[2] != 27 or any(v[3:6]) or v[12] != -1 or v[13] != 0:
+            self.problem(n, "CYCLE800 not of the form CYCLE800(0,\"..\",0,27,0.,0.,0.,A,B,C,X1,Y1,Z1,-1,0.)")
+        deselect = tc == '"0"'
+        if deselect and any(v[6:12]):
+            self.problem(n, "CYCLE800: a deselection (_TC \"0\") with angles or a zero point")
+        if self.traori:
+            self.problem(n, "CYCLE800 with TRAORI on")
+        if self.up is None:
+            self.problem(n, "CYCLE800 swivels without the tool first up (G0 SUPA Z..) and nothing moved since")
+        self.turns.append({"where": "line %d" % n, "z": self.up})
+        self.swivel = None if deselect else (tuple(v[6:9]), tuple(v[9:12]))
+        self.pos = {"X": None, "Y": None, "Z": None}
+
     def direct_call(self, n, call, nwords):
         name, args = cycle_args(call)
+        if name == "CYCLE800":
+            self.swivel_call(n, args, nwords)
+            return
         if name == "CYCLE832":
             if nwords != 1:
                 self.problem(n, "CYCLE832 shares its block")

@@ -1,12 +1,16 @@
 #!/usr/bin/env python3
-"""Checks the steps that tilt the tool of a SINUMERIK 840D program written
-with the controller's tool-centre-point control (TRAORI; docs/five-axis.md).
+"""Checks the steps that tilt the tool of a program written with the
+controller's tool-centre-point control (docs/five-axis.md): a SINUMERIK
+840D program (TRAORI) or a HEIDENHAIN TNC Klartext program (FUNCTION TCPM).
 
-No 840D interpreter is at hand: the program is read here by its documented
-meaning (PROCESSES.md C2). Between TRAORI and TRAFOOF, X Y Z are the tool
-tip in the workpiece and the rotary words (A, B, C) the machine's rotary
-axes, which the controller moves in proportion along each block while it
-keeps the tip on the block's line. The tool's direction for the angles is
+No 840D or TNC interpreter is at hand: the program is read here by its
+documented meaning (PROCESSES.md C2, C3). Between TRAORI and TRAFOOF, or
+between `FUNCTION TCPM F TCP AXIS POS PATHCTRL AXIS` and `FUNCTION RESET
+TCPM`, X Y Z are the tool tip in the workpiece and the rotary words (A, B,
+C) the machine's rotary axes (AXIS POS), which the controller moves in
+proportion along each block (PATHCTRL AXIS) while it keeps the tip on the
+block's line, at the feed along the tip's path (F TCP). A FUNCTION TCPM
+with other options is refused: the check relies on these. The tool's direction for the angles is
 taken through the machine's forward kinematics, written in check-indexed.py
 from the machine file alone. The toolpath IR gives each move at feed of a
 step that tilts the tool (check-five-axis.py reads them). For each:
@@ -16,12 +20,14 @@ step that tilts the tool (check-five-axis.py reads them). For each:
     on the move;
   - halfway through each block (the angles halfway) the tool's direction is
     within --axis-tolerance deg of the IR's there;
-  - each block's F is the IR's feed (mm/min along the tip's path).
+  - each block's F is the IR's feed (mm/min along the tip's path; within
+    the program's rounding: 0.05 on the 840D, 0.5 on the TNC).
 
 Every transformation that is turned on is turned off, with the rotary axes
-back at 0 before it goes.
+back at 0 before it goes. The dialect is taken from the file's extension
+(.h: Klartext) unless --dialect says.
 
-  check-tcp.py --program P.MPF --ir I --machine M.toml
+  check-tcp.py --program P.MPF --ir I --machine M.toml [--dialect siemens|klartext]
 
 Exit status 0 when everything matches, 1 otherwise.
 """
@@ -51,7 +57,63 @@ TOL_DEG = 2e-3
 WORD_RE = re.compile(r"([A-Z]+)(=?)(-?[0-9.]+)")
 
 
-def program_blocks(path, chain):
+FEED_TOL = {"siemens": 0.05, "klartext": 0.5}
+TCPM_ON = "FUNCTION TCPM F TCP AXIS POS PATHCTRL AXIS"
+TCPM_OFF = "FUNCTION RESET TCPM"
+KLARTEXT_WORD_RE = re.compile(r"^([XYZABC])([+-][0-9]+(?:\.[0-9]+)?)$")
+
+
+def klartext_blocks(path):
+    """The feed blocks (L without FMAX) under FUNCTION TCPM: their start and
+    end tip and angles and F; and the problems of its use."""
+    blocks, problems = [], []
+    on = False
+    at = {"X": 0.0, "Y": 0.0, "Z": 0.0, "A": 0.0, "B": 0.0, "C": 0.0}
+    feed = 0.0
+    with open(path) as f:
+        for n, line in enumerate(f, 1):
+            parts = line.split(";")[0].strip().split(" ", 1)
+            if len(parts) < 2 or not parts[0].isdigit():
+                continue  # a cycle's parameter line, or an empty one
+            body = parts[1].strip()
+            if body.startswith("FUNCTION TCPM"):
+                if body != TCPM_ON:
+                    problems.append("line %d: %s is not %s, whose meaning this check reads" % (n, body, TCPM_ON))
+                if on:
+                    problems.append("line %d: FUNCTION TCPM while it is on" % n)
+                on = True
+                continue
+            if body == TCPM_OFF:
+                if not on:
+                    problems.append("line %d: FUNCTION RESET TCPM while it is off" % n)
+                if any(abs(at[a]) > 1e-9 for a in "ABC"):
+                    problems.append("line %d: FUNCTION RESET TCPM with the rotary axes at A%g B%g C%g, not 0" %
+                                    (n, at["A"], at["B"], at["C"]))
+                on = False
+                continue
+            words = body.split()
+            if not words or words[0] != "L":
+                if any(re.match(r"^[ABC][+-]", w) for w in words):
+                    problems.append("line %d: rotary words outside an L block" % n)
+                continue
+            before = dict(at)
+            rapid = "FMAX" in words
+            for w in words[1:]:
+                m = KLARTEXT_WORD_RE.match(w)
+                if m:
+                    at[m.group(1)] = float(m.group(2))
+                    if m.group(1) in "ABC" and not on:
+                        problems.append("line %d: rotary words with FUNCTION TCPM off" % n)
+                elif re.match(r"^F[0-9.]+$", w):
+                    feed = float(w[1:])
+            if on and not rapid and at != before:
+                blocks.append({"from": before, "to": dict(at), "feed": feed, "text": "line %d: %s" % (n, body)})
+    if on:
+        problems.append("the program ends with FUNCTION TCPM on")
+    return blocks, problems
+
+
+def siemens_blocks(path):
     """The G1 blocks under TRAORI: their start and end tip and angles and F;
     and the problems of the transformation's use."""
     blocks, problems = [], []
@@ -104,9 +166,11 @@ def main():
     ap.add_argument("--ir", required=True)
     ap.add_argument("--machine", required=True)
     ap.add_argument("--axis-tolerance", type=float, default=0.01)
+    ap.add_argument("--dialect", choices=("siemens", "klartext"))
     args = ap.parse_args()
+    dialect = args.dialect or ("klartext" if args.program.lower().endswith(".h") else "siemens")
     chain = check_indexed.Chain(args.machine)
-    blocks, problems = program_blocks(args.program, chain)
+    blocks, problems = (klartext_blocks if dialect == "klartext" else siemens_blocks)(args.program)
     want, _ = five.tilted_moves(args.ir)
     if not want:
         problems.append("the IR has no step that tilts the tool")
@@ -127,7 +191,7 @@ def main():
             worst_mid = max(worst_mid, mid_deg)
             if mid_deg > args.axis_tolerance + TOL_DEG:
                 problems.append("%s: halfway through, the tool is %.4f deg off IR line %d" % (b["text"], mid_deg, mv["line"]))
-            if abs(b["feed"] - mv["feed"]) > 0.05:
+            if abs(b["feed"] - mv["feed"]) > FEED_TOL[dialect] + 1e-9:
                 problems.append("%s: F%g where the IR's feed is %g mm/min" % (b["text"], b["feed"], mv["feed"]))
             end = math.dist(tip, mv["to"]), five.angle(axis, mv["axis"])
             if end[0] <= TOL_MM and end[1] <= TOL_DEG:
@@ -144,14 +208,16 @@ def main():
         if problems:
             break
     if not problems and k != len(blocks):
-        problems.append("%d blocks at feed under TRAORI after the IR's last move: %s" % (len(blocks) - k, blocks[k]["text"]))
+        problems.append("%d blocks at feed under tool-centre-point control after the IR's last move: %s" %
+                        (len(blocks) - k, blocks[k]["text"]))
     if problems:
         for p in problems[:5]:
             print("FAIL: " + p)
         return 1
-    print("ok: %d moves at feed that tilt the tool, in %d blocks under TRAORI, match through the machine's "
+    print("ok: %d moves at feed that tilt the tool, in %d blocks under %s, match through the machine's "
           "kinematics: ends within %.4f mm and %.4f deg, halfway within %.4f deg" %
-          (len(want), len(blocks), worst_end[0], worst_end[1], worst_mid))
+          (len(want), len(blocks), "FUNCTION TCPM" if dialect == "klartext" else "TRAORI", worst_end[0],
+           worst_end[1], worst_mid))
     return 0
 
 

@@ -140,6 +140,47 @@ TEST_CASE("840D reader: what the controller would refuse is a problem on its lin
   CHECK(hasProblem(backends::readSiemens840d("%_N_part_MPF\n;$PATH=/_N_MPF_DIR\nM30\n", d), 1, "upper case"));
 }
 
+TEST_CASE("840D reader: a plane swivelled with CYCLE800 (3+2)", "[readback]") {
+  const backends::TargetDescriptor d = descriptorOf("siemens-840d");
+  auto read = [&](const std::string &body) { return backends::readSiemens840d(siemensProgram(body), d); };
+  // Lines 10 on are the body: up, swivel, a face's moves, up, deselect, the
+  // rotary axes back at 0.
+  const std::string clean = "G0 SUPA Z0.\n"
+                            "CYCLE800(0,\"TC1\",0,27,0.,0.,0.,0.,90.,0.,-40.,0.,0.,-1,0.)\n"
+                            "G0 Z120.\n"
+                            "X20. Y30.\n"
+                            "G1 Z90. F120.\n"
+                            "G0 Z120.\n"
+                            "G0 SUPA Z0.\n"
+                            "CYCLE800(0,\"0\",0,27,0.,0.,0.,0.,0.,0.,0.,0.,0.,-1,0.)\n"
+                            "G0 A0. C0.\n";
+  const ProgramReading r = read(clean);
+  INFO(problems(r));
+  REQUIRE(r.problems.empty());
+  // The SUPA blocks and the swivels are no moves of the program's; up (X and
+  // Y unknown), across, down at the feed, up.
+  REQUIRE(r.moves.size() == 4);
+  CHECK(std::isnan(r.moves[0].to.x()));
+  CHECK(r.moves[2].to.isApprox(ir::Vec3(20, 30, 90)));
+
+  auto replaced = [](std::string text, const std::string &from, const std::string &to) {
+    const size_t at = text.find(from);
+    REQUIRE(at != std::string::npos);
+    return text.replace(at, from.size(), to);
+  };
+  CHECK(hasProblem(read(replaced(clean, "G0 SUPA Z0.\nCYCLE800(0,\"TC1\"", "CYCLE800(0,\"TC1\"")), 10,
+                   "CYCLE800 swivels without the tool first up"));
+  CHECK(hasProblem(read(replaced(clean, ",27,0.,0.,0.,0.,90.", ",57,0.,0.,0.,0.,90.")), 11,
+                   "CYCLE800 not of the form"));
+  // Without the deselection (the last 3 lines of the body): the last line, 19.
+  CHECK(hasProblem(read(replaced(clean, "G0 SUPA Z0.\nCYCLE800(0,\"0\",0,27,0.,0.,0.,0.,0.,0.,0.,0.,0.,-1,0.)\nG0 A0. C0.\n", "")),
+                   19, "the program ends with the plane swivelled"));
+  CHECK(hasProblem(read(replaced(clean, "G0 SUPA Z0.\nCYCLE800(0,\"0\",0,27,0.,0.,0.,0.,0.,0.,0.,0.,0.,-1,0.)\n", "")), 16,
+                   "rotary axes turned with the transformation off"));
+  CHECK(hasProblem(read(replaced(clean, "G0 SUPA Z0.\nCYCLE800", "G0 SUPA X0. Z0.\nCYCLE800")), 10,
+                   "SUPA other than G0 SUPA Z.."));
+}
+
 // --- The comparison ----------------------------------------------------------------
 
 /// The pocket module with workingstep @ws's moves written by hand: up, over,

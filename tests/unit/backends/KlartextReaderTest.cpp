@@ -242,6 +242,134 @@ TEST_CASE("Klartext reader: each structural rule is a problem on its line", "[re
   }
 }
 
+/// A step under tool-centre-point control: rotary words on L blocks between
+/// FUNCTION TCPM and FUNCTION RESET TCPM, back at 0 before the reset. Block
+/// n is on line n + 1.
+const std::string kTcp = R"(0 BEGIN PGM TCP MM
+1 TOOL CALL 1 Z S3000
+2 L Z+60 R0 FMAX M3
+3 FUNCTION TCPM F TCP AXIS POS PATHCTRL AXIS
+4 L X+30 Y+40 A+20 C+0 R0 FMAX
+5 L Z+20 R0 F900
+6 L X+15 A+20.5 C+2.5 R0
+7 L Z+60 R0 FMAX
+8 L A+0 C+0 R0 FMAX
+9 FUNCTION RESET TCPM
+10 L Z+60 R0 FMAX M30
+11 END PGM TCP MM
+)";
+
+TEST_CASE("Klartext reader: tool-centre-point control", "[readback][heidenhain-tnc]") {
+  const ProgramReading r = read(kTcp);
+  INFO(problems(r));
+  REQUIRE(r.problems.empty());
+  // Up, across (A and C turning), down at the feed, along with A and C, up,
+  // the rotary axes alone back to 0 (a motion: the tip still).
+  REQUIRE(r.moves.size() == 6);
+  CHECK(r.moves[1].abc[0] == 20);
+  CHECK(r.moves[1].abc[2] == 0);
+  CHECK(std::isnan(r.moves[1].abc[1]));
+  CHECK(r.moves[3].kind == Move::Kind::Linear);
+  checkEnd(r.moves[3], 15, 40, 20);
+  CHECK(r.moves[3].abc[0] == 20.5);
+  CHECK(r.moves[3].abc[2] == 2.5);
+  CHECK(r.moves[3].feed == 900);
+  CHECK(r.moves[5].kind == Move::Kind::Rapid);
+  checkEnd(r.moves[5], 15, 40, 60);
+  CHECK(r.moves[5].abc[0] == 0);
+
+  auto problemsOf = [](const std::string &text) {
+    const ProgramReading p = read(text);
+    INFO(problems(p));
+    CHECK_FALSE(p.problems.empty());
+    return p;
+  };
+  SECTION("rotary words only under FUNCTION TCPM") {
+    const ProgramReading p = problemsOf(replaced(kTcp, "3 FUNCTION TCPM F TCP AXIS POS PATHCTRL AXIS", "3 ; off"));
+    CHECK(hasProblem(p, 5, "rotary axis A with FUNCTION TCPM off"));
+    CHECK(hasProblem(p, 10, "FUNCTION RESET TCPM while FUNCTION TCPM is off"));
+  }
+  SECTION("the one form of FUNCTION TCPM") {
+    const ProgramReading p = problemsOf(replaced(kTcp, "F TCP AXIS POS", "F CONT AXIS POS"));
+    CHECK(hasProblem(p, 4, "FUNCTION block not of the form 'FUNCTION TCPM F TCP AXIS POS PATHCTRL AXIS'"));
+  }
+  SECTION("the rotary axes back at 0 before the reset") {
+    const ProgramReading p = problemsOf(replaced(kTcp, "8 L A+0 C+0 R0 FMAX", "8 L A+0 R0 FMAX"));
+    CHECK(hasProblem(p, 10, "FUNCTION RESET TCPM with the rotary axis C2.5 turned"));
+  }
+  SECTION("X Y Z, then A B C") {
+    const ProgramReading p = problemsOf(replaced(kTcp, "4 L X+30 Y+40 A+20 C+0", "4 L X+30 A+20 Y+40 C+0"));
+    CHECK(hasProblem(p, 5, "axis Y repeated or out of X Y Z order"));
+  }
+  SECTION("no TOOL CALL, and no end, with it on") {
+    const ProgramReading p = problemsOf(replaced(kTcp, "9 FUNCTION RESET TCPM", "9 TOOL CALL 1 Z S3000"));
+    CHECK(hasProblem(p, 10, "TOOL CALL with FUNCTION TCPM on"));
+    CHECK(hasProblem(p, 12, "the program ends with FUNCTION TCPM on"));
+  }
+}
+
+/// 3+2: the tool up in machine coordinates, the datum shifted and the plane
+/// tilted to a face, its moves in the face's frame, the plane reset at the
+/// end. Block n is on line n + 1.
+const std::string kPlane = R"(0 BEGIN PGM PLANE MM
+1 L Z+0 R0 FMAX M91
+2 CYCL DEF 7.0 DATUM SHIFT
+3 CYCL DEF 7.1 X+100
+4 CYCL DEF 7.2 Y+0
+5 CYCL DEF 7.3 Z+0
+6 PLANE SPATIAL SPA+0 SPB-90 SPC+0 TURN FMAX
+7 TOOL CALL 1 Z S3000
+8 L Z+120 R0 FMAX M3
+9 L X+25 Y+20 R0 FMAX
+10 L Z+90 R0 F120
+11 L Z+120 R0 FMAX
+12 L Z+0 R0 FMAX M91
+13 PLANE RESET TURN FMAX
+14 CYCL DEF 7.0 DATUM SHIFT
+15 CYCL DEF 7.1 X+0
+16 CYCL DEF 7.2 Y+0
+17 CYCL DEF 7.3 Z+0
+18 L M30
+19 END PGM PLANE MM
+)";
+
+TEST_CASE("Klartext reader: 3+2 with a tilted working plane", "[readback][heidenhain-tnc]") {
+  const ProgramReading r = read(kPlane);
+  INFO(problems(r));
+  REQUIRE(r.problems.empty());
+  // The M91 blocks are no moves of the program's: up, across, in, out.
+  REQUIRE(r.moves.size() == 4);
+  CHECK(std::isnan(r.moves[0].to.x()));
+  checkEnd(r.moves[2], 25, 20, 90);
+
+  auto problemsOf = [](const std::string &text) {
+    const ProgramReading p = read(text);
+    INFO(problems(p));
+    CHECK_FALSE(p.problems.empty());
+    return p;
+  };
+  SECTION("the rotary axes turn only right after the tool went up") {
+    const ProgramReading p = problemsOf(replaced(kPlane, "12 L Z+0 R0 FMAX M91", "12 L Z+130 R0 FMAX"));
+    CHECK(hasProblem(p, 14, "the rotary axes turn (TURN) without the tool first up in machine coordinates"));
+  }
+  SECTION("Z alone first after a PLANE") {
+    const ProgramReading p = problemsOf(replaced(kPlane, "8 L Z+120 R0 FMAX M3", "8 L X+25 Z+120 R0 FMAX M3"));
+    CHECK(hasProblem(p, 9, "is not Z alone"));
+  }
+  SECTION("M91 only on a Z block at rapid") {
+    const ProgramReading p = problemsOf(replaced(kPlane, "1 L Z+0 R0 FMAX M91", "1 L X+0 Z+0 R0 FMAX M91"));
+    CHECK(hasProblem(p, 2, "M91 on a block other than 'L Z.. R0 FMAX M91'"));
+  }
+  SECTION("a datum shift gives X, Y and Z") {
+    const ProgramReading p = problemsOf(replaced(kPlane, "4 CYCL DEF 7.2 Y+0", "4 CYCL DEF 7.2 Z+0"));
+    CHECK(hasProblem(p, 3, "CYCL DEF 7.0 DATUM SHIFT not followed by CYCL DEF 7.1 X.., 7.2 Y.. and 7.3 Z.."));
+  }
+  SECTION("no plane left tilted at the end") {
+    const ProgramReading p = problemsOf(replaced(kPlane, "13 PLANE RESET TURN FMAX", "13 ; no reset"));
+    CHECK(hasProblem(p, 20, "the program ends with the working plane tilted (PLANE RESET missing)"));
+  }
+}
+
 /// `path` (a STEP-NC file) through the toolpath passes, as `stepnc compile` runs them.
 test::Loaded toolpaths(const std::string &path) {
   test::Loaded l = test::loadStepnc(path);
