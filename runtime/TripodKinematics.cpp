@@ -104,6 +104,9 @@ private:
   /// nullopt with `why` when its strut cannot reach or leans beyond its limits.
   std::optional<double> slider(int i, const Vec3 &tip, std::string &why) const {
     const double across = (guide_[size_t(i)] - tip.head<2>()).norm();
+    if (across >= lowestLean_ && across <= highestLean_ && across < g_.strutLength)
+      return tip.z() + g_.toolLength + std::sqrt((g_.strutLength - across) * (g_.strutLength + across));
+    // Why not (the message built only here: the planner asks at every sample).
     const double lean = std::asin(std::min(1.0, across / g_.strutLength)) / kDeg;
     const std::string where = "the tool tip at machine (" + mm(tip.x()) + ", " + mm(tip.y()) + ", " + mm(tip.z()) +
                               ") mm: strut " + std::to_string(i + 1) + " ";
@@ -124,8 +127,8 @@ private:
             "could move sideways with the sliders still)";
       return std::nullopt;
     }
-    const double up = std::sqrt((g_.strutLength - across) * (g_.strutLength + across));
-    return tip.z() + g_.toolLength + up;
+    why = where + "cannot be placed: the tip's position is not a number";
+    return std::nullopt;
   }
 
   /// The tip (machine coordinates) with the sliders at s: the lower of the
