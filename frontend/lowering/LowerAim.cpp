@@ -907,14 +907,32 @@ std::optional<Node> AimLowerer::toolpath(const Instance &tp) {
     }
     return n;
   }
-  for (auto &[property, rep] : properties(tp, false))
-    if (property == "tool axis" || property == "surface normal" || property == "cross section area" ||
-        property == "contact point")
-      base_.unsupported(rep, property + " curves of a toolpath (5-axis and cutting-contact data)");
-  if (auto c = basicCurve(tp))
-    n.add(std::move(*c));
-  else
+  std::vector<Instance> toolAxes;
+  for (auto &[property, rep] : properties(tp, false)) {
+    if (property == "tool axis")
+      toolAxes.push_back(rep);
+    else if (property == "surface normal" || property == "cross section area" || property == "contact point")
+      base_.unsupported(rep, property + " curves of a toolpath (cutting-contact data)");
+  }
+  std::optional<Node> c = basicCurve(tp);
+  if (!c)
     return std::nullopt;
+  // The tool axis curve (ISO 14649-11's its_toolaxis as AP238 maps it: an
+  // action property 'tool axis' whose representation holds the curve), read
+  // as the ARM's is.
+  if (toolAxes.size() > 1) {
+    base_.missing(tp, "tool axis", "is not one: the toolpath has several 'tool axis' properties");
+    return std::nullopt;
+  }
+  if (!toolAxes.empty()) {
+    const std::vector<Instance> items = toolAxes.front().refs("items");
+    if (items.size() != 1) {
+      base_.missing(toolAxes.front(), "items", "must be one curve (the representation of a toolpath's tool axis)");
+      return std::nullopt;
+    }
+    base_.toolAxes(tp, items.front(), *c, "tool axis");
+  }
+  n.add(std::move(*c));
   return n;
 }
 

@@ -641,7 +641,7 @@ void Lowerer::toolDirection(const Instance &d, Node &n) {
   }
 }
 
-void Lowerer::toolAxes(const Instance &tp, const Instance &axes, Node &basic) {
+void Lowerer::toolAxes(const Instance &tp, const Instance &axes, Node &basic, std::string_view attribute) {
   // ISO 14649-11: its_toolaxis has the parameter range of basiccurve. Read
   // as the generators of such files write it: a polyline beside the
   // basiccurve's, each point, taken as a vector from the origin, the tool
@@ -652,7 +652,7 @@ void Lowerer::toolAxes(const Instance &tp, const Instance &axes, Node &basic) {
   }
   const std::vector<Instance> points = axes.refs("points");
   if (points.size() != basic.children.size()) {
-    missing(tp, "its_toolaxis",
+    missing(tp, attribute,
             "has " + std::to_string(points.size()) + " points and basiccurve " +
                 std::to_string(basic.children.size()) + ": each point of the path needs its tool axis");
     return;

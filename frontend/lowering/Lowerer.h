@@ -233,8 +233,9 @@ public:
   void toolDirection(const Instance &d, Node &n);
   /// Sets `axis` on each point of a toolpath's polyline `basic` from its
   /// tool axis curve `axes` (ISO 14649-11 its_toolaxis, a polyline of
-  /// directions beside it); reports what does not fit.
-  void toolAxes(const Instance &tp, const Instance &axes, Node &basic);
+  /// directions beside it); reports what does not fit, naming the tool
+  /// axis curve as `attribute` (the ARM's its_toolaxis; AP238's property).
+  void toolAxes(const Instance &tp, const Instance &axes, Node &basic, std::string_view attribute = "its_toolaxis");
 
   // --- additive (LowerAdditive.cpp) -----------------------------------------
   /// An added feature (am_feature) into `n`; false after reporting.
