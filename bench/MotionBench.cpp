@@ -119,6 +119,38 @@ void BM_InverseHeadTable(benchmark::State &state) {
 }
 BENCHMARK(BM_InverseHeadTable)->Arg(100000)->Unit(benchmark::kMillisecond);
 
+/// Plans `path` for every iteration of `state` (timed) and returns the last
+/// plan; counts the moves and the segments made.
+Trajectory planTimed(benchmark::State &state, const PathInput &path, const Machine &m, const PlanOptions &options) {
+  size_t segments = 0;
+  Trajectory last;
+  for (auto _ : state) {
+    Trajectory t = plan(path, m, options);
+    segments = t.segments.size();
+    benchmark::DoNotOptimize(t);
+    last = std::move(t);
+  }
+  state.SetItemsProcessed(state.iterations() * int64_t(path.moves.size()));
+  state.counters["segments_out"] = double(segments);
+  return last;
+}
+
+/// Plays a plan once (not timed), every violation kept, and counts them:
+/// all, and the joints' velocity, acceleration or jerk.
+SimReport playOnce(benchmark::State &state, const Trajectory &t, const Machine &m, const PlanOptions &options) {
+  SimOptions sim;
+  sim.workOffsetMm = options.workOffset;
+  sim.maxViolations = size_t(1) << 30;  // every one kept, to count them by kind
+  const SimReport report = simulate(t, m, sim);
+  size_t dynamics = 0;
+  for (const Violation &v : report.violations)
+    dynamics += v.kind == ViolationKind::Velocity || v.kind == ViolationKind::Acceleration ||
+                v.kind == ViolationKind::Jerk;
+  state.counters["violations"] = double(report.violationCount);
+  state.counters["joint_limits"] = double(dynamics);
+  return report;
+}
+
 /// BM_PlanFiveAxis: the same 100,000-move path as BM_Plan with the tool
 /// tilted along it (leaning 5 to 35 deg and turning round +z), planned on
 /// the shipped table-table machine's joints: the inverse kinematics at
@@ -139,27 +171,9 @@ void BM_PlanFiveAxis(benchmark::State &state) {
   PlanOptions options;
   options.kinematics = k.get();
   options.workOffset = Eigen::Vector3d(200, 200, -250);
-  size_t segments = 0;
-  Trajectory last;
-  for (auto _ : state) {
-    Trajectory t = plan(path, m, options);
-    segments = t.segments.size();
-    benchmark::DoNotOptimize(t);
-    last = std::move(t);
-  }
-  state.SetItemsProcessed(state.iterations() * int64_t(path.moves.size()));
-  state.counters["segments_out"] = double(segments);
-  // The plan played once (not timed): its joints within their limits.
-  SimOptions sim;
-  sim.workOffsetMm = options.workOffset;
-  sim.maxViolations = size_t(1) << 30;  // every one kept, to count them by kind
-  const SimReport report = simulate(last, m, sim);
-  size_t dynamics = 0;  // the joints' velocity, acceleration or jerk (the path is wider than the travel)
-  for (const Violation &v : report.violations)
-    dynamics += v.kind == ViolationKind::Velocity || v.kind == ViolationKind::Acceleration ||
-                v.kind == ViolationKind::Jerk;
-  state.counters["violations"] = double(report.violationCount);
-  state.counters["joint_limits"] = double(dynamics);
+  // The plan played once: its joints within their limits (the path is wider
+  // than the travel: "violations" counts those too).
+  playOnce(state, planTimed(state, path, m, options), m, options);
 }
 BENCHMARK(BM_PlanFiveAxis)->Arg(100000)->Unit(benchmark::kMillisecond);
 
@@ -176,28 +190,10 @@ void BM_PlanTripod(benchmark::State &state) {
   PlanOptions options;
   options.kinematics = k.get();
   options.workOffset = Eigen::Vector3d(-200, -150, 50);
-  size_t segments = 0;
-  Trajectory last;
-  for (auto _ : state) {
-    Trajectory t = plan(path, m, options);
-    segments = t.segments.size();
-    benchmark::DoNotOptimize(t);
-    last = std::move(t);
-  }
-  state.SetItemsProcessed(state.iterations() * int64_t(path.moves.size()));
-  state.counters["segments_out"] = double(segments);
-  SimOptions sim;
-  sim.workOffsetMm = options.workOffset;
-  sim.maxViolations = size_t(1) << 30;  // every one kept, to count them by kind
-  const SimReport report = simulate(last, m, sim);
-  size_t dynamics = 0, travel = 0;
-  for (const Violation &v : report.violations) {
-    dynamics += v.kind == ViolationKind::Velocity || v.kind == ViolationKind::Acceleration ||
-                v.kind == ViolationKind::Jerk;
+  const SimReport report = playOnce(state, planTimed(state, path, m, options), m, options);
+  size_t travel = 0;
+  for (const Violation &v : report.violations)
     travel += v.kind == ViolationKind::Travel;
-  }
-  state.counters["violations"] = double(report.violationCount);
-  state.counters["joint_limits"] = double(dynamics);
   state.counters["travel"] = double(travel);
   state.counters["motion_s"] = report.duration;
 }

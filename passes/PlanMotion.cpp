@@ -36,6 +36,13 @@ public:
     // a generic chain (a parallel-kinematic machine), whose solver moves
     // axes that are not the tip's x, y, z.
     std::unique_ptr<runtime::Kinematics> kinematics;
+    auto makeKinematics = [&]() {
+      std::string error;
+      std::unique_ptr<runtime::Kinematics> made = runtime::makeKinematics(*machine, error);
+      if (!made)
+        diags.error({}, "plan-motion: the machine's kinematics: " + error);
+      return made;
+    };
     const bool generic = machine->kinematics.chain == runtime::Chain::Generic;
     const bool fiveAxis = machine->kinematics.fiveAxis() || generic;
     const std::vector<const ir::Node *> order = ir::programOrder(module);
@@ -53,12 +60,8 @@ public:
             .entity(at.origin.entityId);
         return {false, false};
       }
-      std::string error;
-      kinematics = runtime::makeKinematics(*machine, error);
-      if (!kinematics) {
-        diags.error({}, "plan-motion: the machine's kinematics: " + error);
+      if (!(kinematics = makeKinematics()))
         return {false, false};
-      }
     }
     if (generic && !kinematics) {
       if (!workOffset_) {
@@ -67,12 +70,8 @@ public:
                             "the workpiece's origin is on the machine (--work-offset, or plan-motion<work-offset=X:Y:Z>)");
         return {false, false};
       }
-      std::string error;
-      kinematics = runtime::makeKinematics(*machine, error);
-      if (!kinematics) {
-        diags.error({}, "plan-motion: the machine's kinematics: " + error);
+      if (!(kinematics = makeKinematics()))
         return {false, false};
-      }
     }
     // Deposition steps are planned as any 3-axis moves (the head's state
     // changes take no time); the native format refuses them.

@@ -266,6 +266,30 @@ def run_with_offset(program, work, work_offset):
     return check_rs274.run_rs274(program, work)
 
 
+
+def compare_feed_moves(want, made, problems):
+    """The IR's feed moves (ir_feed_moves) against those the program made,
+    in order: ends, and arcs' centres and middles, within TOL_MM; the tool's
+    direction within TOL_DEG of the face's normal. Appends to `problems` and
+    returns the largest differences (mm, deg)."""
+    if len(made) != len(want):
+        problems.append("%d feed moves in the program, %d in the IR" % (len(made), len(want)))
+    worst_mm, worst_deg = 0.0, 0.0
+    for w, g in zip(want, made):
+        d = math.dist(w["to"], g["to"])
+        if "centre" in w:
+            d = max(d, math.dist(w["centre"], g.get("centre", (math.inf,) * 3)),
+                    math.dist(w["middle"], g.get("middle", (math.inf,) * 3)))
+        cosang = max(-1.0, min(1.0, sum(x * y for x, y in zip(w["normal"], g["axis"]))))
+        deg = math.degrees(math.acos(cosang))
+        worst_mm, worst_deg = max(worst_mm, d), max(worst_deg, deg)
+        if d > TOL_MM or deg > TOL_DEG:
+            problems.append("IR line %d (%s) against %s: %.4f mm, %.4f deg apart" %
+                            (w["line"], w["text"], g["text"], d, deg))
+            break
+    return worst_mm, worst_deg
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--program", required=True)
@@ -283,21 +307,7 @@ def main():
         setups, faces = read_setups(args.ir)
         made, problems = canon_feed_moves(canon, chain, work_offset, faces)
     want = ir_feed_moves(args.ir, setups)
-    if len(made) != len(want):
-        problems.append("%d feed moves in the program, %d in the IR" % (len(made), len(want)))
-    worst_mm, worst_deg = 0.0, 0.0
-    for w, g in zip(want, made):
-        d = math.dist(w["to"], g["to"])
-        if "centre" in w:
-            d = max(d, math.dist(w["centre"], g.get("centre", (math.inf,) * 3)),
-                    math.dist(w["middle"], g.get("middle", (math.inf,) * 3)))
-        cosang = max(-1.0, min(1.0, sum(x * y for x, y in zip(w["normal"], g["axis"]))))
-        deg = math.degrees(math.acos(cosang))
-        worst_mm, worst_deg = max(worst_mm, d), max(worst_deg, deg)
-        if d > TOL_MM or deg > TOL_DEG:
-            problems.append("IR line %d (%s) against %s: %.4f mm, %.4f deg apart" %
-                            (w["line"], w["text"], g["text"], d, deg))
-            break
+    worst_mm, worst_deg = compare_feed_moves(want, made, problems)
     if problems:
         for p in problems[:5]:
             print("FAIL: " + p)

@@ -32,7 +32,6 @@ back at 0 before it goes. The dialect is taken from the file's extension
 Exit status 0 when everything matches, 1 otherwise.
 """
 import argparse
-import importlib.util
 import math
 import os
 import re
@@ -41,13 +40,7 @@ import sys
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 
-
-def load(name, file):
-    spec = importlib.util.spec_from_file_location(name, os.path.join(HERE, file))
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
+from toolpath_ir import load_script as load  # noqa: E402
 
 check_indexed = load("check_indexed", "check-indexed.py")
 five = load("check_five_axis", "check-five-axis.py")

@@ -38,7 +38,6 @@ Z..). The dialect is taken from the file's extension (.h: Klartext, else
 Exit status 0 when everything matches, 1 otherwise.
 """
 import argparse
-import importlib.util
 import math
 import os
 import sys
@@ -46,13 +45,7 @@ import sys
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 
-
-def load(name, file):
-    spec = importlib.util.spec_from_file_location(name, os.path.join(HERE, file))
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
+from toolpath_ir import load_script as load  # noqa: E402
 
 check_indexed = load("check_indexed", "check-indexed.py")
 klartext = load("check_heidenhain_tnc", "check-heidenhain-tnc.py")
@@ -162,21 +155,7 @@ def main():
             entry["middle"] = placed(mv["frame"], faces, middle)[0]
         made.append(entry)
     want = check_indexed.ir_feed_moves(args.ir, setups)
-    if len(made) != len(want):
-        problems.append("%d feed moves in the program, %d in the IR" % (len(made), len(want)))
-    worst_mm, worst_deg = 0.0, 0.0
-    for w, g in zip(want, made):
-        d = math.dist(w["to"], g["to"])
-        if "centre" in w:
-            d = max(d, math.dist(w["centre"], g.get("centre", (math.inf,) * 3)),
-                    math.dist(w["middle"], g.get("middle", (math.inf,) * 3)))
-        cosang = max(-1.0, min(1.0, sum(x * y for x, y in zip(w["normal"], g["axis"]))))
-        deg = math.degrees(math.acos(cosang))
-        worst_mm, worst_deg = max(worst_mm, d), max(worst_deg, deg)
-        if d > TOL_MM or deg > TOL_DEG:
-            problems.append("IR line %d (%s) against %s: %.4f mm, %.4f deg apart" %
-                            (w["line"], w["text"], g["text"], d, deg))
-            break
+    worst_mm, worst_deg = check_indexed.compare_feed_moves(want, made, problems)
     if problems:
         for p in problems[:5]:
             print("FAIL: " + p)

@@ -1,6 +1,8 @@
 """The moves of a toolpath IR file (stepnc compile --emit=toolpath-ir), as the
 backend checkers compare programs with them."""
+import importlib.util
 import math
+import os
 import re
 
 MOVE_RE = re.compile(r"^\s*(rapid|linear|arc|dwell)\s+(.*)$")
@@ -108,3 +110,12 @@ def read_moves(path):
             pos = move["to"]
             out.append(move)
     return out
+
+
+def load_script(name, file, here=os.path.dirname(os.path.abspath(__file__))):
+    """Another checker of this folder as a module (their file names have
+    dashes, which import cannot take)."""
+    spec = importlib.util.spec_from_file_location(name, os.path.join(here, file))
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
