@@ -16,6 +16,7 @@
 #include <cmath>
 #include <fstream>
 #include <limits>
+#include <numbers>
 #include <random>
 #include <sstream>
 
@@ -552,4 +553,41 @@ TEST_CASE("a segment that tilts the tool is capped by the joint that binds, and 
   REQUIRE(m.axes[c].name == "c");
   CHECK(r.jointMaxVelocity[c] * 60 <= m.axes[c].velocity * 1.02);
   CHECK(r.jointMaxVelocity[c] * 60 >= 0.3 * m.axes[c].velocity);
+}
+
+TEST_CASE("GreatCircle: the tool axis between two poses, at an even rate on their great circle",
+          "[planner][five-axis]") {
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n(0, 1);
+  auto unit = [&] { return Vec3(n(rng), n(rng), n(rng)).normalized(); };
+  for (int i = 0; i < 1000; ++i) {
+    const Vec3 u = unit(), w = unit();
+    const GreatCircle circle(u, w);
+    // The ends exactly; outside [0, 1] clamped.
+    CHECK(circle.at(0) == u);
+    CHECK(circle.at(1) == w);
+    CHECK(circle.at(-0.5) == u);
+    CHECK(circle.at(2) == w);
+    const double whole = std::acos(std::clamp(u.dot(w), -1.0, 1.0));
+    for (double t : {0.1, 0.25, 0.5, 0.9}) {
+      const Vec3 p = circle.at(t);
+      INFO("u " << u.transpose() << ", w " << w.transpose() << ", t " << t);
+      CHECK(std::abs(p.norm() - 1) < 1e-12);
+      // In the plane of u and w, a fraction t of the angle from u and the
+      // rest from w.
+      CHECK(std::abs(p.dot(u.cross(w))) < 1e-9);
+      CHECK(std::abs(std::acos(std::clamp(p.dot(u), -1.0, 1.0)) - t * whole) < 1e-7);
+      CHECK(std::abs(std::acos(std::clamp(p.dot(w), -1.0, 1.0)) - (1 - t) * whole) < 1e-7);
+      CHECK(axisBetween(u, w, t) == p);
+    }
+  }
+  // Equal ends: no turn.
+  const Vec3 z = Vec3::UnitZ();
+  CHECK(GreatCircle(z, z).at(0.5) == z);
+  // Opposite ends: a half turn through a direction across both.
+  const GreatCircle half(z, -z);
+  const Vec3 middle = half.at(0.5);
+  CHECK(std::abs(middle.dot(z)) < 1e-12);
+  CHECK(std::abs(middle.norm() - 1) < 1e-12);
+  CHECK(std::abs(half.at(0.25).dot(z) - std::cos(std::numbers::pi / 4)) < 1e-12);
 }
