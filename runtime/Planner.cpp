@@ -865,9 +865,9 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
     out.joints.reserve(count * options.kinematics->jointCount());
   }
   if (everySegmentByJoints)
-    if (const InverseResult at = options.kinematics->inverse({input.start + options.workOffset, input.startAxis});
-        at.joints)
-      joints = *at.joints;
+    if (const InverseResult start = options.kinematics->inverse({input.start + options.workOffset, input.startAxis});
+        start.joints)
+      joints = *start.joints;
   // Each dwell segment's wait, in the order of the segments; the joints
   // recorded at the last segment's end (Trajectory::joints).
   std::vector<double> dwellTimes;
@@ -876,8 +876,8 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   // rotary axes kept where they are free).
   auto record = [&](const Segment &seg) {
     const Joints near = recorded.size() ? recorded : joints;
-    const InverseResult at = options.kinematics->inverse({seg.end + options.workOffset, seg.axis1}, &near);
-    recorded = at.joints ? *at.joints : near;
+    const InverseResult end = options.kinematics->inverse({seg.end + options.workOffset, seg.axis1}, &near);
+    recorded = end.joints ? *end.joints : near;
   };
   // A segment that tilts the tool and starts where the tool lies along a
   // rotary axis (upright, after a step that does not tilt it, or where its
@@ -905,27 +905,27 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
       for (size_t k = 3; k < machine.axes.size() && Eigen::Index(k) < near.size(); ++k)
         if (machine.axes[k].rotary)
           near[Eigen::Index(k)] = 0;
-    InverseResult at = kin.inverse({seg.start + offset, seg.axis0}, &near);
-    if (!at.joints)
+    InverseResult start = kin.inverse({seg.start + offset, seg.axis0}, &near);
+    if (!start.joints)
       return false;
-    if (at.singular && seg.length > 0) {
+    if (start.singular && seg.length > 0) {
       const double ahead = std::min(seg.length, 1e-3);
       const InverseResult next = kin.inverse({seg.at(ahead).p + offset, seg.axisAt(ahead)}, &joints);
       if (next.joints)
-        at = kin.inverse({seg.start + offset, seg.axis0}, &*next.joints);
-      if (!at.joints)
+        start = kin.inverse({seg.start + offset, seg.axis0}, &*next.joints);
+      if (!start.joints)
         return false;
     }
     // Joints that agree within what the inverse kinematics' rounding leaves
     // need no turn.
     double wait = 0;
     for (size_t k = 0; k < machine.axes.size() && Eigen::Index(k) < joints.size(); ++k) {
-      const double move = std::abs((*at.joints)[Eigen::Index(k)] - joints[Eigen::Index(k)]);
+      const double travel = std::abs((*start.joints)[Eigen::Index(k)] - joints[Eigen::Index(k)]);
       const Axis &axis = machine.axes[k];
-      if (move > kJointTurn)
-        wait = std::max(wait, planProfile(0, 0, move, {axis.velocity / 60, axis.acceleration, axis.jerk}).duration());
+      if (travel > kJointTurn)
+        wait = std::max(wait, planProfile(0, 0, travel, {axis.velocity / 60, axis.acceleration, axis.jerk}).duration());
     }
-    joints = *at.joints;
+    joints = *start.joints;
     if (!(wait > 0))
       return true;
     Segment moved = std::move(seg);
@@ -975,8 +975,7 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
         ends = e;
     } else if (seg.kind != SegmentKind::Dwell && seg.length > 0) {
       JointEnds e;
-      const Eigen::Index count = joints.size();
-      e.d1Start = e.d1End = e.d2Start = e.d2End = Joints::Zero(count);
+      e.d1Start = e.d1End = e.d2Start = e.d2End = Joints::Zero(joints.size());
       const PathPoint a = seg.at(0), b = seg.at(seg.length);
       e.d1Start.head<3>() = a.r1;
       e.d1End.head<3>() = b.r1;

@@ -648,9 +648,9 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
         const double s1 = std::min(here->length, along + 1e-3);
         ahead = ToolPose{here->at(s1).p + offset, here->axisAt(s1)};
       } else if (tilted && seg + 1 < n) {
-        const Segment &next = trajectory.segments[seg + 1];
-        const double s1 = std::min(next.length, 1e-3);
-        ahead = ToolPose{next.at(s1).p + offset, next.axisAt(s1)};
+        const Segment &after = trajectory.segments[seg + 1];
+        const double s1 = std::min(after.length, 1e-3);
+        ahead = ToolPose{after.at(s1).p + offset, after.axisAt(s1)};
       }
       const bool turning = tilted && trajectory.info[seg].feed == 0 && here->kind == SegmentKind::Line &&
                            here->axis0 != here->axis1;
