@@ -3,6 +3,7 @@
 #include "runtime/Machine.h"
 
 #include "../TestSupport.h"
+#include "ShippedMachine.h"
 
 #include <catch2/catch.hpp>
 
@@ -13,21 +14,9 @@ using namespace stepnc;
 
 namespace {
 
-struct Read {
-  std::unique_ptr<SourceFile> file;
-  std::optional<runtime::Machine> machine;
-  std::vector<std::string> errors;  ///< "line:col: message"
-};
+using Read = test::ReadMachine;
 
-Read read(const std::string &text) {
-  Read r;
-  r.file = SourceFile::fromString("m.toml", text);
-  DiagnosticCollector collector;
-  DiagnosticEngine diags(collector);
-  r.machine = runtime::readMachine(*r.file, diags);
-  r.errors = test::locatedMessages(collector, *r.file);
-  return r;
-}
+Read read(const std::string &text) { return test::readMachineText(text); }
 
 std::string slurp(const std::string &path) {
   std::ifstream in(path);
@@ -125,13 +114,7 @@ const std::string kFiveAxis =
     "[axes.c]\ntravel = [-360, 360]\nmax_velocity = 14400\nmax_acceleration = 2000\nmax_jerk = 20000\n"
     "pivot = [250, 200, 0]\n";
 
-std::string edited(const std::string &text, const std::string &from, const std::string &to) {
-  std::string t = text;
-  const size_t at = t.find(from);
-  REQUIRE(at != std::string::npos);
-  t.replace(at, from.size(), to);
-  return t;
-}
+using test::edited;
 
 } // namespace
 

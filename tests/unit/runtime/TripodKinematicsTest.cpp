@@ -43,28 +43,11 @@ std::string shippedText() {
   return s.str();
 }
 
-struct Read {
-  std::unique_ptr<SourceFile> file;
-  std::optional<runtime::Machine> machine;
-  std::vector<std::string> errors;  ///< "line:col: message"
-};
+using Read = test::ReadMachine;
 
-Read read(const std::string &text) {
-  Read r;
-  r.file = SourceFile::fromString("m.toml", text);
-  DiagnosticCollector collector;
-  DiagnosticEngine diags(collector);
-  r.machine = runtime::readMachine(*r.file, diags);
-  r.errors = test::locatedMessages(collector, *r.file);
-  return r;
-}
+Read read(const std::string &text) { return test::readMachineText(text); }
 
-std::string edited(std::string text, const std::string &from, const std::string &to) {
-  const size_t at = text.find(from);
-  REQUIRE(at != std::string::npos);
-  text.replace(at, from.size(), to);
-  return text;
-}
+using test::edited;
 
 /// The line (from 1) where `what` first stands in `text`.
 int lineOf(const std::string &text, const std::string &what) {
