@@ -560,6 +560,16 @@ struct SolvedPose {
   bool at(const Vec3 &t, const Vec3 &a) const { return valid && tip == t && axis == a; }
 };
 
+/// What jointDemand samples the joints with, for one plan.
+struct JointSampler {
+  const Kinematics &kin;
+  Vec3 offset;  ///< the work offset: where the workpiece's origin is on the machine
+  /// A serial chain (Kinematics::tipTurn gives the linear joints' turn),
+  /// known once for the plan.
+  bool serial;
+  SolvedPose solved;
+};
+
 /// The demand a segment that tilts the tool makes of the machine's joints:
 /// their first three derivatives with respect to the tip's path, from the
 /// joints at points along it (each solution the nearest the one before,
@@ -587,13 +597,15 @@ struct SolvedPose {
 /// shipped head-head machine); the path's own curvature as a floor.
 ///
 /// The joints at the start are not solved again where the last segment
-/// ended (`solved`); so on a path of short segments each costs three
+/// ended (`sampler.solved`); so on a path of short segments each costs three
 /// inverse kinematics (BM_PlanFiveAxis, docs/performance.md).
-bool jointDemand(const Segment &seg, const Kinematics &kin, const Vec3 &offset, Joints &near, AxisDemand &d,
-                 JointEnds &ends, bool startSolved, SolvedPose &solved) {
+bool jointDemand(const Segment &seg, JointSampler &sampler, Joints &near, AxisDemand &d, JointEnds &ends,
+                 bool startSolved) {
   constexpr double kMargin = 1.25;  // what the pieces' differences may miss of a peak
-  const std::optional<Mat3> turn0 = kin.tipTurn(near);
-  const bool serial = turn0.has_value();
+  const Kinematics &kin = sampler.kin;
+  const Vec3 &offset = sampler.offset;
+  const bool serial = sampler.serial;
+  SolvedPose &solved = sampler.solved;
   const GreatCircle circle(seg.axis0, seg.axis1);
   const double turned = std::acos(std::clamp(seg.axis0.dot(seg.axis1), -1.0, 1.0)) * 180 / std::numbers::pi;
   const int n = std::clamp(static_cast<int>(std::ceil(std::max(turned / 0.5, seg.length / 1.0))), serial ? 3 : 8, 64);
@@ -850,7 +862,7 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   // the joints' derivatives at the end of the segment before; and the speed
   // each junction may be passed at (joints' rates that jump there).
   Joints joints;
-  SolvedPose solved;  // where `joints` were solved, when jointDemand did
+  std::optional<JointSampler> sampler;  // and where they were solved, when jointDemand did
   std::optional<JointEnds> lastEnds;
   bool lastTilted = false;
   std::vector<double> junctionCap;
@@ -861,6 +873,8 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   const bool everySegmentByJoints = options.kinematics && !options.kinematics->linearJointsAreCartesian();
   if (options.kinematics) {
     joints = Joints::Zero(static_cast<Eigen::Index>(options.kinematics->jointCount()));
+    sampler.emplace(JointSampler{*options.kinematics, options.workOffset,
+                                 options.kinematics->tipTurn(joints).has_value(), SolvedPose{}});
     junctionCap.reserve(count);
     out.joints.reserve(count * options.kinematics->jointCount());
   }
@@ -897,9 +911,9 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
     // travel either way.
     // Starting where the last segment that tilted the tool ended, the
     // joints are already there.
-    if (!fromMiddle && solved.at(seg.start + offset, seg.axis0))
+    if (!fromMiddle && sampler->solved.at(seg.start + offset, seg.axis0))
       return true;
-    solved.valid = false;
+    sampler->solved.valid = false;
     Joints near = joints;
     if (fromMiddle)
       for (size_t k = 3; k < machine.axes.size() && Eigen::Index(k) < near.size(); ++k)
@@ -971,7 +985,7 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
     const bool byJoints = tilted || everySegmentByJoints;
     if (byJoints) {
       JointEnds e;
-      if (jointDemand(seg, *options.kinematics, options.workOffset, joints, d, e, startSolved, solved))
+      if (jointDemand(seg, *sampler, joints, d, e, startSolved))
         ends = e;
     } else if (seg.kind != SegmentKind::Dwell && seg.length > 0) {
       JointEnds e;
@@ -1044,10 +1058,12 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   };
   {
     Segment segments[2];  // piece i's in segments[i % 2]
+    Vec3 axisOut = input.startAxis;  // the tool axis where the last piece's blend starts
     for (size_t i = 0; i < pieces.size(); ++i) {
       const Piece &p = pieces[i];
       const Segment &before = segments[(i + 1) % 2], &here = segments[i % 2];
       p.segment(input, segments[i % 2]);
+      const Vec3 axisIn = here.axisAt(p.cutStart);  // where the blend before this piece ends
       if (i > 0 && p.stopReason != StopReason::None)
         stop = p.stopReason;
       pushDwells(i);
@@ -1061,19 +1077,18 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
             feed = std::max(prev.feed, p.feed);
           AxisDemand demand;
           out.segments.push_back(Segment::blend(blendBetween(prev, before, p, here), demand));
-          out.segments.back().axis0 = before.axisAt(before.length - prev.cutEnd);
-          out.segments.back().axis1 = here.axisAt(p.cutStart);
+          out.segments.back().axis0 = axisOut;
+          out.segments.back().axis1 = axisIn;
           push(feed, prev.move, p.move, stop, demand);
           stop = StopReason::None;
         }
       }
       if (p.keepsMiddle()) {
-        out.segments.push_back(here.part(p.cutStart, here.length - p.cutEnd));
-        out.segments.back().axis0 = here.axisAt(p.cutStart);
-        out.segments.back().axis1 = here.axisAt(here.length - p.cutEnd);
+        out.segments.push_back(here.part(p.cutStart, here.length - p.cutEnd));  // its axes turned with it
         push(p.feed, p.move, p.move, stop, out.segments.back().demand());
         stop = StopReason::None;
       }
+      axisOut = here.axisAt(here.length - p.cutEnd);
     }
     pushDwells(pieces.size());  // after the last move
   }

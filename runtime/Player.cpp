@@ -425,8 +425,24 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
       history.erase(history.begin());
     history.push_back(std::move(now));
   };
-  auto checkTravelAt = [&](const Vec3 &p, const Vec3 &toolAxis, bool tilted, double t, uint32_t sg,
-                           const std::optional<ToolPose> &ahead, bool fromMiddle) {
+  // Where the tool axis goes next from arc length `along` of segment `seg`:
+  // a little further along, or (a dwell) the next segment's start. Asked
+  // only at a singular pose.
+  auto poseAhead = [&](size_t seg, double along) -> std::optional<ToolPose> {
+    const Segment &here = trajectory.segments[seg];
+    if (here.length > 0) {
+      const double s1 = std::min(here.length, along + 1e-3);
+      return ToolPose{here.at(s1).p + offset, here.axisAt(s1)};
+    }
+    if (seg + 1 < trajectory.segments.size()) {
+      const Segment &after = trajectory.segments[seg + 1];
+      const double s1 = std::min(after.length, 1e-3);
+      return ToolPose{after.at(s1).p + offset, after.axisAt(s1)};
+    }
+    return std::nullopt;
+  };
+  auto checkTravelAt = [&](const Vec3 &p, const Vec3 &toolAxis, bool tilted, double t, uint32_t sg, double along,
+                           bool fromMiddle) {
     if (!checkTravel)
       return;
     const Vec3 tip = p + offset;
@@ -460,7 +476,7 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
       return;
     }
     outOfReach = false;
-    if (ir.singular && tilted && ahead) {
+    if (const std::optional<ToolPose> ahead = ir.singular && tilted ? poseAhead(sg, along) : std::nullopt) {
       // The tool along a rotary axis leaves the other free: it is where the
       // tool axis goes next (as the planner set it).
       const InverseResult next = kinematics->inverse(*ahead, &*ir.joints);
@@ -641,20 +657,9 @@ SimReport simulate(const Trajectory &trajectory, const Machine &machine, const S
       const bool tilted = here && here->tilted();
       const double along = tilted ? trajectory.profiles[seg].at(final ? durations[seg] : t - segStart).s : 0;
       const Vec3 toolAxis = tilted ? here->axisAt(along) : Vec3::UnitZ();
-      // Where the tool axis goes next: a little further along, or (a dwell)
-      // the next segment's start.
-      std::optional<ToolPose> ahead;
-      if (tilted && here->length > 0) {
-        const double s1 = std::min(here->length, along + 1e-3);
-        ahead = ToolPose{here->at(s1).p + offset, here->axisAt(s1)};
-      } else if (tilted && seg + 1 < n) {
-        const Segment &after = trajectory.segments[seg + 1];
-        const double s1 = std::min(after.length, 1e-3);
-        ahead = ToolPose{after.at(s1).p + offset, after.axisAt(s1)};
-      }
       const bool turning = tilted && trajectory.info[seg].feed == 0 && here->kind == SegmentKind::Line &&
                            here->axis0 != here->axis1;
-      checkTravelAt(s.p, toolAxis, tilted, s.t, s.segment, ahead, turning && seg != lastJointSegment);
+      checkTravelAt(s.p, toolAxis, tilted, s.t, s.segment, along, turning && seg != lastJointSegment);
       lastJointSegment = seg;
     }
     if (onSample)

@@ -56,6 +56,17 @@ TCPM_OFF = "FUNCTION RESET TCPM"
 KLARTEXT_WORD_RE = re.compile(r"^([XYZABC])([+-][0-9]+(?:\.[0-9]+)?)$")
 
 
+def switched(n, word, turning_on, on, at, problems):
+    """Tool-centre-point control switched on or off by `word` at line n: a
+    problem when it already is, or when it goes off with the rotary axes not
+    back at 0. Returns whether it is on after."""
+    if on == turning_on:
+        problems.append("line %d: %s while it is %s" % (n, word, "on" if on else "off"))
+    if not turning_on and any(abs(at[a]) > 1e-9 for a in "ABC"):
+        problems.append("line %d: %s with the rotary axes at A%g B%g C%g, not 0" % (n, word, at["A"], at["B"], at["C"]))
+    return turning_on
+
+
 def klartext_blocks(path):
     """The feed blocks (L without FMAX) under FUNCTION TCPM: their start and
     end tip and angles and F; and the problems of its use."""
@@ -72,17 +83,10 @@ def klartext_blocks(path):
             if body.startswith("FUNCTION TCPM"):
                 if body != TCPM_ON:
                     problems.append("line %d: %s is not %s, whose meaning this check reads" % (n, body, TCPM_ON))
-                if on:
-                    problems.append("line %d: FUNCTION TCPM while it is on" % n)
-                on = True
+                on = switched(n, "FUNCTION TCPM", True, on, at, problems)
                 continue
             if body == TCPM_OFF:
-                if not on:
-                    problems.append("line %d: FUNCTION RESET TCPM while it is off" % n)
-                if any(abs(at[a]) > 1e-9 for a in "ABC"):
-                    problems.append("line %d: FUNCTION RESET TCPM with the rotary axes at A%g B%g C%g, not 0" %
-                                    (n, at["A"], at["B"], at["C"]))
-                on = False
+                on = switched(n, "FUNCTION RESET TCPM", False, on, at, problems)
                 continue
             words = body.split()
             if not words or words[0] != "L":
@@ -117,17 +121,10 @@ def siemens_blocks(path):
         for n, line in enumerate(f, 1):
             code = line.split(";")[0].strip()
             if code == "TRAORI":
-                if on:
-                    problems.append("line %d: TRAORI while it is on" % n)
-                on = True
+                on = switched(n, "TRAORI", True, on, at, problems)
                 continue
             if code == "TRAFOOF":
-                if not on:
-                    problems.append("line %d: TRAFOOF while it is off" % n)
-                if any(abs(at[a]) > 1e-9 for a in "ABC"):
-                    problems.append("line %d: TRAFOOF with the rotary axes at A%g B%g C%g, not 0" %
-                                    (n, at["A"], at["B"], at["C"]))
-                on = False
+                on = switched(n, "TRAFOOF", False, on, at, problems)
                 continue
             words = dict((w, float(v)) for w, _, v in WORD_RE.findall(code) if w in ("G", "X", "Y", "Z", "A", "B", "C", "F"))
             if "G" in words and words["G"] in (0, 1):

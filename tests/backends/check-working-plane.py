@@ -69,14 +69,10 @@ def spatial(angles):
 
 def axis_by_axis(angles):
     """CYCLE800's turn axis by axis, Z then Y then X (deg), each about the
-    axis as the turns before left it: Rz(A) Ry(B) Rx(C) of a vector."""
+    axis as the turns before left it: Rz(A) Ry(B) Rx(C) of a vector, which
+    is PLANE SPATIAL's with the angles the other way round."""
     a, b, c = angles
-
-    def turn(v):
-        v = check_indexed.rotate(v, (1.0, 0.0, 0.0), c)
-        v = check_indexed.rotate(v, (0.0, 1.0, 0.0), b)
-        return check_indexed.rotate(v, (0.0, 0.0, 1.0), a)
-    return turn
+    return spatial((c, b, a))
 
 
 def placed(frame, faces, q):
