@@ -41,13 +41,30 @@ constexpr double kReachTol = 1e-9;
 
 Mat3 rotation(const Vec3 &axis, double deg) { return Eigen::AngleAxisd(deg * kDeg, axis).toRotationMatrix(); }
 
-/// The angle (deg) that turns p onto q about the unit axis w, when both have
-/// a part across w; nullopt when either lies along w (any angle does).
-std::optional<double> angleTaking(const Vec3 &w, const Vec3 &p, const Vec3 &q) {
+/// An angle by its cosine and sine: the inverse kinematics finds them
+/// without trigonometry, and the rotation is built from them so.
+struct Turning {
+  double cos = 1, sin = 0;
+  double degrees() const { return std::atan2(sin, cos) / kDeg; }
+  Turning reversed() const { return {cos, -sin}; }
+};
+
+/// The rotation by `t` about the unit axis w (Rodrigues).
+Mat3 rotation(const Vec3 &w, const Turning &t) {
+  Mat3 cross;
+  cross << 0, -w.z(), w.y(), w.z(), 0, -w.x(), -w.y(), w.x(), 0;
+  return t.cos * Mat3::Identity() + t.sin * cross + (1 - t.cos) * w * w.transpose();
+}
+
+/// The turn about the unit axis w that takes p onto q, when both have a part
+/// across w; nullopt when either lies along w (any angle does).
+std::optional<Turning> angleTaking(const Vec3 &w, const Vec3 &p, const Vec3 &q) {
   const Vec3 pp = p - w * w.dot(p), qp = q - w * w.dot(q);
-  if (pp.norm() < kSingular || qp.norm() < kSingular)
+  const double pn = pp.squaredNorm(), qn = qp.squaredNorm();
+  if (pn < kSingular * kSingular || qn < kSingular * kSingular)
     return std::nullopt;
-  return std::atan2(w.dot(pp.cross(qp)), pp.dot(qp)) / kDeg;
+  const double scale = 1 / std::sqrt(pn * qn);
+  return Turning{pp.dot(qp) * scale, w.dot(pp.cross(qp)) * scale};
 }
 
 bool inTravel(const Axis &a, double v) {
@@ -193,7 +210,59 @@ public:
   }
 
   InverseResult inverse(const ToolPose &pose, const Joints *nearIn) const override {
+    return solve(pose, nearIn, 0, nullptr);
+  }
+
+  InverseResult inverseWithRates(const ToolPose &pose, const Joints *near, double minSine,
+                                 std::optional<JointRates> &rates) const override {
+    return solve(pose, near, minSine, &rates);
+  }
+
+  std::optional<Mat3> tipTurn(const Joints &q) const override {
+    // The table's turns act on the tip innermost first (inverse above).
+    Mat3 m = Mat3::Identity();
+    for (const Rotary &t : table_)
+      m = m * rotation(t.direction, q[t.joint]);
+    return m;
+  }
+
+  std::optional<JointRates> rates(const Joints &q, double minSine) const override {
+    return ratesFrom(q, rotationsAt(q), minSine);
+  }
+
+  std::optional<Vec3> singularDirection() const override { return turns_[1].rotary.direction; }
+
+private:
+  struct Turn {
+    Rotary rotary;
+    double sign = 1;  ///< +1 for a head's axis, -1 for a table's (it turns the workpiece)
+  };
+
+  /// The rotations of the two rotary joints (each about its direction by
+  /// its angle): j1's, the joint of the last turn acting on k0 (turns_[1]),
+  /// and j2's.
+  struct Rotations {
+    Mat3 r1, r2;
+  };
+  Eigen::Index j1() const { return turns_[1].rotary.joint; }
+  Eigen::Index j2() const { return turns_[0].rotary.joint; }
+  const Mat3 &of(const Rotations &r, Eigen::Index joint) const { return joint == j1() ? r.r1 : r.r2; }
+  /// A turn's rotation as it acts on k0: the joint's, or its reverse for a
+  /// table's.
+  Mat3 acting(const Turn &t, const Rotations &r) const {
+    const Mat3 &m = of(r, t.rotary.joint);
+    return t.sign > 0 ? m : Mat3(m.transpose());
+  }
+  Rotations rotationsAt(const Joints &q) const {
+    return {rotation(turns_[1].rotary.direction, q[j1()]), rotation(turns_[0].rotary.direction, q[j2()])};
+  }
+
+  /// inverse(), and with `rates` the joints' rates at the solution.
+  InverseResult solve(const ToolPose &pose, const Joints *nearIn, double minSine,
+                      std::optional<JointRates> *rates) const {
     InverseResult none;
+    if (rates)
+      rates->reset();
     const Joints near = nearOrZero(nearIn, axes_.size());
     const Vec3 k = pose.axis.normalized();
     // k = R(w1, s1 t1) R(w2, s2 t2) k0: c = R(w2, s2 t2) k0 = R(w1, -s1 t1) k
@@ -217,69 +286,170 @@ public:
       return none;
     }
     const double g = std::sqrt(std::max(0.0, g2));
-    std::array<Joints, 2> solutions;
-    size_t found = 0;
-    bool singular = false;
+    const Eigen::Index j1 = this->j1(), j2 = this->j2();
+    // Each solution's two turns in the joints' own sense (a table's turns
+    // the workpiece: its joint is the turn reversed); a free one (k0 along
+    // w2, or k along w1) keeps its value in `near`.
+    struct Solution {
+      std::optional<Turning> turn1, turn2;  ///< joints j1 and j2; nullopt where free
+    };
+    auto jointSense = [](std::optional<Turning> t, const Turn &turn) {
+      if (t && turn.sign < 0)
+        t = t->reversed();
+      return t;
+    };
+    std::array<Solution, 2> found;
+    size_t count = 0;
     for (double sign : {1.0, -1.0}) {
       const Vec3 c = a * w1 + b * w2 + sign * g * across;
-      Joints &q = solutions[found++];
-      q = near;
-      // A free angle (k0 along w2, or k along w1) keeps its value in `near`.
-      const std::optional<double> t2 = angleTaking(w2, k0_, c);
-      const std::optional<double> t1 = angleTaking(w1, c, k);
-      singular |= !t2 || !t1;
-      const Eigen::Index j1 = last.rotary.joint, j2 = first.rotary.joint;
-      q[j2] = t2 ? wrapNear(axes_[static_cast<size_t>(j2)], *t2 / first.sign, near[j2]) : near[j2];
-      q[j1] = t1 ? wrapNear(axes_[static_cast<size_t>(j1)], *t1 / last.sign, near[j1]) : near[j1];
+      found[count++] = {jointSense(angleTaking(w1, c, k), last), jointSense(angleTaking(w2, k0_, c), first)};
       if (g == 0)
         break;  // the cones touch: one solution
     }
-    // The tip in machine coordinates: turned by the table (innermost
-    // first), less the head's offset.
-    auto place = [&](Joints &q) {
-      Vec3 tip = pose.tipMm;
-      for (auto it = table_.rbegin(); it != table_.rend(); ++it)
-        tip = it->pivotMm + rotation(it->direction, q[it->joint]) * (tip - it->pivotMm);
-      q.head<3>() = tip - headAt(q).first;
+    const bool singular = !found[0].turn1 || !found[0].turn2;
+    // A solution's joints (nearest `near` by whole turns) and rotations.
+    struct Candidate {
+      Joints q;
+      Rotations rotations;
     };
-    // The solution whose rotary axes turn least, when it is inside every
-    // axis's travel and the other turns them more, is what choose() takes:
-    // the other's positions are not needed (most calls, along a path).
-    auto turned = [&](const Joints &q) {
-      double sum = 0;
-      for (const Rotary &r : head_)
-        sum += std::abs(q[r.joint] - near[r.joint]);
-      for (const Rotary &r : table_)
-        sum += std::abs(q[r.joint] - near[r.joint]);
-      return sum;
+    auto angleOf = [&](const std::optional<Turning> &t, Eigen::Index j) {
+      return t ? wrapNear(axes_[static_cast<size_t>(j)], t->degrees(), near[j]) : near[j];
     };
-    const size_t least = found == 2 && turned(solutions[1]) < turned(solutions[0]) ? 1 : 0;
-    place(solutions[least]);
-    if (found == 1 || turned(solutions[1 - least]) > turned(solutions[least]) + 1e-9) {
-      bool in = true;
-      for (size_t j = 0; j < axes_.size(); ++j)
-        in &= inTravel(axes_[j], solutions[least][static_cast<Eigen::Index>(j)]);
-      if (in)
-        return verified(*this, pose, choose({&solutions[least], 1}, axes_, near, singular));
+    auto candidate = [&](const Solution &f, double q1, double q2) {
+      Candidate out{near, {}};
+      out.q[j1] = q1;
+      out.q[j2] = q2;
+      out.rotations = {f.turn1 ? rotation(w1, *f.turn1) : rotation(w1, q1),
+                       f.turn2 ? rotation(w2, *f.turn2) : rotation(w2, q2)};
+      place(pose.tipMm, out.q, out.rotations);
+      return out;
+    };
+    // The tool's direction the turns give, against the one asked for: the
+    // solver's last word on whether the pose is reachable (the tip follows
+    // by construction).
+    auto finish = [&](const Candidate &chosen, std::span<const Joints> solutions) {
+      if ((acting(last, chosen.rotations) * (acting(first, chosen.rotations) * k0_) - k).norm() > 1e-7) {
+        none.why = "the " + std::string(name()) + " chain cannot put the tool there with that direction";
+        return none;
+      }
+      InverseResult r = choose(solutions, axes_, near, singular);
+      if (rates && !singular)
+        *rates = ratesFrom(chosen.q, chosen.rotations, minSine);
+      return r;
+    };
+    // Along a path (most calls), one solution turns each rotary joint less
+    // than 1 deg from `near` and the other turns one of them more than 2
+    // (by the cosines of the differences): when the first is inside the
+    // travel it is what choose() takes, and the other's angles and
+    // positions are not needed.
+    if (count == 2 && !singular) {
+      static const double kClose = std::cos(1 * kDeg), kFar = std::cos(2 * kDeg);
+      const Turning near1{std::cos(near[j1] * kDeg), std::sin(near[j1] * kDeg)};
+      const Turning near2{std::cos(near[j2] * kDeg), std::sin(near[j2] * kDeg)};
+      auto cosFromNear = [&](const Solution &f) {
+        return std::min(f.turn1->cos * near1.cos + f.turn1->sin * near1.sin,
+                        f.turn2->cos * near2.cos + f.turn2->sin * near2.sin);
+      };
+      const double c0 = cosFromNear(found[0]), c1 = cosFromNear(found[1]);
+      const int close = c0 >= kClose && c1 < kFar ? 0 : c1 >= kClose && c0 < kFar ? 1 : -1;
+      if (close >= 0) {
+        const Solution &f = found[size_t(close)];
+        const Candidate c = candidate(f, angleOf(f.turn1, j1), angleOf(f.turn2, j2));
+        bool in = true;
+        for (size_t j = 0; j < axes_.size(); ++j)
+          in &= inTravel(axes_[j], c.q[static_cast<Eigen::Index>(j)]);
+        if (in)
+          return finish(c, {&c.q, 1});
+      }
     }
-    if (found == 2)
-      place(solutions[1 - least]);
-    return verified(*this, pose, choose({solutions.data(), found}, axes_, near, singular));
+    std::array<Candidate, 2> all;
+    std::array<Joints, 2> solutions;
+    for (size_t i = 0; i < count; ++i) {
+      all[i] = candidate(found[i], angleOf(found[i].turn1, j1), angleOf(found[i].turn2, j2));
+      solutions[i] = all[i].q;
+    }
+    // choose() takes the first of equals: the candidate whose joints it
+    // returns is found by them.
+    const InverseResult picked = choose({solutions.data(), count}, axes_, near, singular);
+    const size_t at = count == 2 && picked.joints && *picked.joints == solutions[1] ? 1 : 0;
+    return finish(all[at], {solutions.data(), count});
   }
 
-  std::optional<Mat3> tipTurn(const Joints &q) const override {
-    // The table's turns act on the tip innermost first (inverse above).
-    Mat3 m = Mat3::Identity();
-    for (const Rotary &t : table_)
-      m = m * rotation(t.direction, q[t.joint]);
-    return m;
+  /// JointRates at q, whose rotary joints turn by `r`: the forward map's
+  /// derivatives per degree of each rotary joint (tip and tool direction,
+  /// in the workpiece's frame), then solved for the joints' rates: the
+  /// direction's rate takes the rotary joints' (two unknowns, three
+  /// equations that agree), the tip's then the linear joints' through the
+  /// table's turn.
+  std::optional<JointRates> ratesFrom(const Joints &q, const Rotations &r, double minSine) const {
+    std::array<Eigen::Index, 2> joint{};
+    std::array<Vec3, 2> dTip, dAxis;
+    size_t n = 0;
+    Vec3 offset = Vec3::Zero(), k = k0_;
+    for (auto it = head_.rbegin(); it != head_.rend(); ++it) {  // innermost first, as headAt
+      const Mat3 &turn = of(r, it->joint);
+      offset = it->pivotMm + turn * (offset - it->pivotMm);
+      k = turn * k;
+      for (size_t c = 0; c < n; ++c) {
+        dTip[c] = turn * dTip[c];
+        dAxis[c] = turn * dAxis[c];
+      }
+      joint[n] = it->joint;
+      dTip[n] = kDeg * it->direction.cross(offset - it->pivotMm);
+      dAxis[n++] = kDeg * it->direction.cross(k);
+    }
+    Vec3 tip = q.head<3>() + offset;
+    Mat3 back = Mat3::Identity();  // the linear joints' part: the table's turns undone
+    for (const Rotary &t : table_) {  // outermost first, as forward
+      const Mat3 turn = of(r, t.joint).transpose();
+      tip = t.pivotMm + turn * (tip - t.pivotMm);
+      k = turn * k;
+      back = turn * back;
+      for (size_t c = 0; c < n; ++c) {
+        dTip[c] = turn * dTip[c];
+        dAxis[c] = turn * dAxis[c];
+      }
+      joint[n] = t.joint;
+      dTip[n] = -kDeg * t.direction.cross(tip - t.pivotMm);
+      dAxis[n++] = -kDeg * t.direction.cross(k);
+    }
+    if (turns_[1].rotary.direction.cross(k).norm() < minSine)
+      return std::nullopt;
+    Eigen::Matrix<double, 3, 2> axisRates;
+    axisRates << dAxis[0], dAxis[1];
+    const Eigen::Matrix2d normal = axisRates.transpose() * axisRates;
+    const double det = normal.determinant();
+    if (!(std::abs(det) > 1e-12 * kDeg * kDeg * kDeg * kDeg))
+      return std::nullopt;
+    // Rotary rates per unit of direction rate (least squares: exact on a
+    // rate the chain can follow).
+    const Eigen::Matrix<double, 2, 3> rotary = normal.inverse() * axisRates.transpose();
+    Eigen::Matrix<double, 3, 2> tipRates;
+    tipRates << dTip[0], dTip[1];
+    JointRates out;
+    out.tipTurn = back.transpose();
+    out.map = Eigen::Matrix<double, Eigen::Dynamic, 6, 0, kMaxJoints, 6>::Zero(q.size(), 6);
+    // x, y, z: the tip's rate less what the rotary joints move it by,
+    // turned back into the machine's frame.
+    out.map.topLeftCorner<3, 3>() = out.tipTurn;
+    out.map.topRightCorner<3, 3>() = -out.tipTurn * tipRates * rotary;
+    for (size_t j = 0; j < 2; ++j)
+      out.map.row(joint[j]).tail<3>() = rotary.row(Eigen::Index(j));
+    return out;
   }
 
-private:
-  struct Turn {
-    Rotary rotary;
-    double sign = 1;  ///< +1 for a head's axis, -1 for a table's (it turns the workpiece)
-  };
+  /// q's x, y, z for the tip at `tipMm` in the workpiece's frame, its rotary
+  /// joints turned by `r`: the tip turned by the table (innermost first),
+  /// less the head's offset.
+  void place(const Vec3 &tipMm, Joints &q, const Rotations &r) const {
+    Vec3 tip = tipMm;
+    for (auto it = table_.rbegin(); it != table_.rend(); ++it)
+      tip = it->pivotMm + of(r, it->joint) * (tip - it->pivotMm);
+    Vec3 offset = Vec3::Zero();
+    for (auto it = head_.rbegin(); it != head_.rend(); ++it)  // innermost first
+      offset = it->pivotMm + of(r, it->joint) * (offset - it->pivotMm);
+    q.head<3>() = tip - offset;
+  }
 
   /// The tip's offset from (x, y, z) and the tool's direction, in machine
   /// coordinates, with the head's axes at q.

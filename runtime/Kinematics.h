@@ -54,6 +54,19 @@ struct InverseResult {
   std::string why;  ///< for nullopt: why the pose cannot be reached
 };
 
+/// How a serial chain's joints move with the tool near joints q, to first
+/// order (Kinematics::rates): with the tip moving at dp (mm per unit, in the
+/// workpiece's frame) and the tool's direction at dk (per unit,
+/// perpendicular to it), the joints move at map * (dp, dk): mm and deg per
+/// unit.
+struct JointRates {
+  Eigen::Matrix3d tipTurn = Eigen::Matrix3d::Identity();  ///< Kinematics::tipTurn at q
+  Eigen::Matrix<double, Eigen::Dynamic, 6, 0, kMaxJoints, 6> map;
+  Joints of(const Eigen::Vector3d &dp, const Eigen::Vector3d &dk) const {
+    return map.leftCols<3>() * dp + map.rightCols<3>() * dk;
+  }
+};
+
 /// A machine's kinematic transform. Implementations are immutable after
 /// construction and safe to call from several threads.
 class Kinematics {
@@ -82,6 +95,29 @@ public:
     (void)q;
     return std::nullopt;
   }
+  /// The joints' rates at q (JointRates) where the chain has them in closed
+  /// form and q is not within `minSine` of a singularity (the sine of the
+  /// angle between the tool and the direction along which a rotary axis is
+  /// free, where the rates grow without bound). nullopt (the default) where
+  /// not: the planner then samples the joints.
+  virtual std::optional<JointRates> rates(const Joints &q, double minSine) const {
+    (void)q;
+    (void)minSine;
+    return std::nullopt;
+  }
+  /// inverse() and, where it has them, rates() at the solution (nullopt at a
+  /// singular pose): one call, which the serial chains make cheaper than two
+  /// (the rotations are the inverse's).
+  virtual InverseResult inverseWithRates(const ToolPose &pose, const Joints *near, double minSine,
+                                         std::optional<JointRates> &rates) const {
+    InverseResult r = inverse(pose, near);
+    rates = r.joints && !r.singular ? this->rates(*r.joints, minSine) : std::nullopt;
+    return r;
+  }
+  /// The tool direction, in the workpiece's frame, along which (or against
+  /// which) a rotary axis is free, where that is one fixed direction (the
+  /// serial 5-axis chains: the outer rotary axis's); nullopt otherwise.
+  virtual std::optional<Eigen::Vector3d> singularDirection() const { return std::nullopt; }
   /// Whether the linear joints (the first three) are the tool tip's x, y, z
   /// in machine coordinates while the tool is along +z: true on the serial
   /// chains, where a 3-axis program's positions are the axes'; false on a

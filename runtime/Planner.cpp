@@ -556,6 +556,7 @@ struct SolvedPose {
   Vec3 tip = Vec3::Zero();  ///< in machine coordinates at zero (the work offset added)
   Vec3 axis = Vec3::Zero();
   Mat3 turn = Mat3::Identity();  ///< Kinematics::tipTurn there (serial chains)
+  std::optional<JointRates> rates;  ///< Kinematics::rates there, when jointDemand took them
   bool valid = false;  ///< the planner's joints are that pose's, not singular there
   bool at(const Vec3 &t, const Vec3 &a) const { return valid && tip == t && axis == a; }
 };
@@ -567,8 +568,122 @@ struct JointSampler {
   /// A serial chain (Kinematics::tipTurn gives the linear joints' turn),
   /// known once for the plan.
   bool serial;
+  /// Kinematics::singularDirection, known once for the plan.
+  std::optional<Vec3> singular;
   SolvedPose solved;
 };
+
+/// Bounds of |q'|, |q''|, |q'''| over [0, length] of the cubic with values
+/// q0, q1 and derivatives m0, m1 at its ends (Hermite).
+struct Cubic {
+  double r1 = 0, r2 = 0, r3 = 0;
+};
+Cubic hermite(double q0, double q1, double m0, double m1, double length) {
+  const double perLength = 1 / length;
+  const double slope = (q1 - q0) * perLength;
+  const double start2 = (6 * slope - 4 * m0 - 2 * m1) * perLength;  // q'' at 0
+  const double end2 = (2 * m0 + 4 * m1 - 6 * slope) * perLength;    // q'' at length
+  const double third = (end2 - start2) * perLength;                 // q''', constant
+  Cubic c;
+  c.r1 = std::max(std::abs(m0), std::abs(m1));
+  // q' is a parabola: its extremum where q'' = start2 + third s vanishes
+  // inside.
+  if (third != 0) {
+    const double s = -start2 / third;
+    if (s > 0 && s < length)
+      c.r1 = std::max(c.r1, std::abs(m0 + start2 * s + 0.5 * third * s * s));
+  }
+  c.r2 = std::max(std::abs(start2), std::abs(end2));
+  c.r3 = std::abs(third);
+  return c;
+}
+
+/// jointDemand on a short segment that turns the tool little for how far it
+/// stays from the chain's singular direction, where the chain has its
+/// joints' rates in closed form (Kinematics::rates): the joints at the two
+/// ends and their rates there fix a cubic per joint (Hermite), whose
+/// derivatives bound the joints' as the differences of three pieces did, at
+/// one inverse kinematics per segment (the start's kept from the segment
+/// before). The linear joints as jointDemand splits them: the path's own
+/// derivatives turned, and the rest, rho = x - M0 p, by its cubic. nullopt
+/// where the rates are not to be had (jointDemand samples instead).
+std::optional<bool> jointDemandByRates(const Segment &seg, const GreatCircle &circle, JointSampler &sampler,
+                                       Joints &near, AxisDemand &d, JointEnds &ends, bool startSolved, double margin) {
+  const Kinematics &kin = sampler.kin;
+  SolvedPose &solved = sampler.solved;
+  const Vec3 tip0 = seg.start + sampler.offset, tip1 = seg.end + sampler.offset;
+  const bool continued = solved.at(tip0, seg.axis0);
+  Joints q0 = near;
+  bool singularStart = false;
+  if (!startSolved && !continued) {
+    const InverseResult r = kin.inverse({tip0, seg.axis0}, &near);
+    if (!r.joints)
+      return std::nullopt;
+    q0 = *r.joints;
+    singularStart = r.singular;
+  }
+  // The start's rates: the last segment's end's, else solved for.
+  std::optional<JointRates> own;
+  if (!(continued && solved.rates))
+    own = kin.rates(q0, 0);
+  const std::optional<JointRates> &g0 = own ? own : solved.rates;
+  if (!g0 || singularStart)
+    return std::nullopt;
+  std::optional<JointRates> g1;
+  const InverseResult end = kin.inverseWithRates({tip1, seg.axis1}, &q0, 0, g1);
+  if (!end.joints) {
+    solved.valid = false;
+    return false;
+  }
+  const Joints &q1 = *end.joints;
+  if (!g1)
+    return std::nullopt;
+  const PathPoint at0 = seg.atStart(), at1 = seg.atEnd();
+  const Vec3 &along0 = at0.r1, &along1 = at1.r1;
+  const Joints rate0 = g0->of(along0, circle.tangent(0) / seg.length);
+  const Joints rate1 = g1->of(along1, circle.tangent(1) / seg.length);
+  const Mat3 &m0 = g0->tipTurn, &m1 = g1->tipTurn;
+  // The rest: rho = x - M0 p, and the rotary joints as they are.
+  Joints rho0 = q0, rho1 = q1, m0rho = rate0, m1rho = rate1;
+  rho0.head<3>() -= m0 * tip0;
+  rho1.head<3>() -= m0 * tip1;
+  m0rho.head<3>() -= m0 * along0;
+  m1rho.head<3>() -= m0 * along1;
+  const Mat3 bound = m0.cwiseAbs() + (m1 - m0).cwiseAbs();
+  const Vec3 path1 = bound * d.r1, path2 = bound * d.r2, path3 = bound * d.r3;
+  AxisDemand out;
+  size_t rotary = 0;
+  // The junctions take the second derivatives' bounds (as jointDemand's).
+  ends.d2Start.resize(q1.size());
+  for (Eigen::Index k = 0; k < q1.size(); ++k) {
+    const Cubic c = hermite(rho0[k], rho1[k], m0rho[k], m1rho[k], seg.length);
+    if (k < 3) {
+      out.r1[k] = margin * (path1[k] + c.r1);
+      out.r2[k] = margin * (path2[k] + c.r2);
+      out.r3[k] = margin * (path3[k] + c.r3);
+      ends.d2Start[k] = out.r2[k];
+    } else if (rotary < out.rotary1.size()) {
+      out.rotary1[rotary] = margin * c.r1;
+      out.rotary2[rotary] = margin * c.r2;
+      out.rotary3[rotary] = margin * c.r3;
+      ends.d2Start[k] = out.rotary2[rotary];
+      ++rotary;
+    } else {
+      ends.d2Start[k] = 0;
+    }
+  }
+  ends.d2End = ends.d2Start;
+  d = out;
+  ends.d1Start = rate0;
+  ends.d1End = rate1;
+  near = q1;
+  solved.tip = tip1;
+  solved.axis = seg.axis1;
+  solved.turn = m1;
+  solved.rates = std::move(g1);
+  solved.valid = true;
+  return true;
+}
 
 /// The demand a segment that tilts the tool makes of the machine's joints:
 /// their first three derivatives with respect to the tip's path, from the
@@ -607,11 +722,23 @@ bool jointDemand(const Segment &seg, JointSampler &sampler, Joints &near, AxisDe
   const bool serial = sampler.serial;
   SolvedPose &solved = sampler.solved;
   const GreatCircle circle(seg.axis0, seg.axis1);
-  const double turned = std::acos(std::clamp(seg.axis0.dot(seg.axis1), -1.0, 1.0)) * 180 / std::numbers::pi;
+  const double turned = circle.angle() * 180 / std::numbers::pi;
   const int n = std::clamp(static_cast<int>(std::ceil(std::max(turned / 0.5, seg.length / 1.0))), serial ? 3 : 8, 64);
   const double h = seg.length / n;
   if (!(h > 0))
     return false;
+  // Where three pieces would do, a cubic from the ends' rates does as well
+  // when the rates change little along the segment: the rotary joints' grow
+  // as 1 / sin of the angle to the singular direction, so the turn must be
+  // small beside that sine (a tenth: the rates change by about a tenth).
+  if (serial && n == 3 && sampler.singular) {
+    const double cosine = circle.nearestCosine(*sampler.singular);
+    const double sine = std::sqrt(std::max(0.0, 1 - cosine * cosine));
+    if (circle.angle() <= 0.1 * sine)
+      if (const std::optional<bool> done =
+              jointDemandByRates(seg, circle, sampler, near, d, ends, startSolved, kMargin))
+        return *done;
+  }
   std::array<Joints, 65> q;
   std::array<Vec3, 65> tip;
   Joints at = near;
@@ -641,7 +768,7 @@ bool jointDemand(const Segment &seg, JointSampler &sampler, Joints &near, AxisDe
     for (int i = 0; i <= n; ++i)
       q[size_t(i)].head<3>() -= m0 * tip[size_t(i)];
   }
-  solved = {tip[size_t(n)], seg.axis1, m1, !singularEnd};
+  solved = {tip[size_t(n)], seg.axis1, m1, std::nullopt, !singularEnd};
   const Mat3 spread = (m1 - m0).cwiseAbs();
   ends.d1Start = (q[1] - q[0]) / h;
   ends.d1End = (q[size_t(n)] - q[size_t(n - 1)]) / h;
@@ -848,6 +975,11 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   size_t count = dwells.size();
   for (const Piece &p : pieces)
     count += size_t(p.blendBefore) + size_t(p.keepsMiddle());
+  // 5-axis: room for the dwells that turn the joints before a segment
+  // (turnFirst: after rapids, stops and upright runs, and at singular
+  // poses), so that one of them does not copy every segment to a new block.
+  if (options.kinematics)
+    count += count / 16 + 16;
   out.segments.reserve(count);
   out.info.reserve(count);
   preferHugePages(out.segments);
@@ -874,7 +1006,8 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   if (options.kinematics) {
     joints = Joints::Zero(static_cast<Eigen::Index>(options.kinematics->jointCount()));
     sampler.emplace(JointSampler{*options.kinematics, options.workOffset,
-                                 options.kinematics->tipTurn(joints).has_value(), SolvedPose{}});
+                                 options.kinematics->tipTurn(joints).has_value(),
+                                 options.kinematics->singularDirection(), SolvedPose{}});
     junctionCap.reserve(count);
     out.joints.reserve(count * options.kinematics->jointCount());
   }
@@ -990,7 +1123,7 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
     } else if (seg.kind != SegmentKind::Dwell && seg.length > 0) {
       JointEnds e;
       e.d1Start = e.d1End = e.d2Start = e.d2End = Joints::Zero(joints.size());
-      const PathPoint a = seg.at(0), b = seg.at(seg.length);
+      const PathPoint a = seg.atStart(), b = seg.atEnd();
       e.d1Start.head<3>() = a.r1;
       e.d1End.head<3>() = b.r1;
       e.d2Start.head<3>() = d.r2;

@@ -347,6 +347,27 @@ GreatCircle::GreatCircle(const Vec3 &u, const Vec3 &w) : u_(u), w_(w) {
   } else {
     angle_ = 0;  // equal to rounding
   }
+  // w in the plane's terms (cos, sin of the angle), as at(1) is w.
+  if (angle_ > 0) {
+    cos_ = w.dot(u);
+    sin_ = w.dot(across_);
+  }
+}
+
+double GreatCircle::nearestCosine(const Vec3 &v) const {
+  // v . at(a) = v.u cos a + v.across sin a: (cu, ca) is the nearest point
+  // of the circle's plane to v; it or its opposite lies on the arc when it
+  // is at most angle_ round from u (the arc turns at most half a circle: on
+  // the side of u towards w, and not past w). Elsewhere the ends are the
+  // nearest.
+  const double cu = v.dot(u_), ca = v.dot(across_);
+  double best = std::max(std::abs(cu), std::abs(v.dot(w_)));
+  if (angle_ > 0) {
+    const double sign = ca < 0 ? -1 : 1;
+    if (sign * (cu * sin_ - ca * cos_) >= 0)
+      best = std::max(best, std::hypot(cu, ca));
+  }
+  return std::min(best, 1.0);
 }
 
 Segment Segment::part(double s0, double s1) const {
@@ -454,6 +475,20 @@ Vec3 Segment::curvePointAt(double s) const {
   if (s <= 0)
     return q.point(0);  // what the inversion gives there, without it
   return q.point(blendParameter(q, s));
+}
+
+PathPoint Segment::atStart() const {
+  if (kind != SegmentKind::Blend)
+    return at(0);
+  const QuinticCurve q(ctrl);
+  return fromParameter(start, q.d1(0), q.d2(0), q.d3(0));
+}
+
+PathPoint Segment::atEnd() const {
+  if (kind != SegmentKind::Blend)
+    return at(length);
+  const QuinticCurve q(ctrl);
+  return fromParameter(end, q.d1(1), q.d2(1), q.d3(1));
 }
 
 PathPoint Segment::curveAt(double s) const {

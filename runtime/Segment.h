@@ -59,11 +59,27 @@ public:
     const double a = t * angle_;
     return (u_ * std::cos(a) + across_ * std::sin(a)).normalized();
   }
+  /// The direction's rate at t (0..1) per unit of t: at(t)'s derivative,
+  /// perpendicular to it, of length angle().
+  Vec3 tangent(double t) const {
+    if (t <= 0)
+      return angle_ * across_;
+    if (t >= 1)
+      return angle_ * (across_ * cos_ - u_ * sin_);
+    const double a = t * angle_;
+    return angle_ * (across_ * std::cos(a) - u_ * std::sin(a));
+  }
+  /// The angle turned from u to w (rad).
+  double angle() const { return angle_; }
+  /// The largest |v . at(t)| over t in 0..1 for a unit vector v: how near
+  /// the arc comes to v or -v (its cosine).
+  double nearestCosine(const Vec3 &v) const;
 
 private:
   Vec3 u_, w_;
   Vec3 across_ = Vec3::Zero();  ///< unit, in the plane of u and w, across u towards w
   double angle_ = 0;            ///< rad from u to w; 0 when they are equal
+  double cos_ = 1, sin_ = 0;    ///< of angle_
 };
 
 /// The tool axis a fraction t (0..1) of the way from unit vector u to w.
@@ -157,6 +173,10 @@ struct Segment {
     out.p = s >= length ? end : Vec3(start + out.r1 * s);
     return out;
   }
+  /// at(0) and at(length): a blend's from its curve's ends, without
+  /// inverting its arc length.
+  PathPoint atStart() const;
+  PathPoint atEnd() const;
   /// at() for arcs, blends and dwells.
   PathPoint curveAt(double s) const;
   /// at(s).p for arcs, blends and dwells.

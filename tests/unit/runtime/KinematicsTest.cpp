@@ -227,6 +227,96 @@ TEST_CASE("5-axis chains: tipTurn is how the tip's moves move x, y, z", "[kinema
   CHECK(*xyz->tipTurn(Joints::Zero(3)) == Eigen::Matrix3d::Identity());
 }
 
+/// rates(q) against the inverse kinematics' own central differences: the
+/// tip moved along a random direction and the tool turned across itself
+/// by a small step moves every joint by rates * (dp, dk) (to 1e-5 per unit:
+/// the differences' error), over random joints of `m` away from the
+/// singular direction; inverseWithRates gives the same joints as inverse
+/// and the same rates as rates(). Returns the number of poses checked.
+int ratesAgree(const runtime::Machine &m, uint32_t seed) {
+  const auto k = kinematicsOf(m);
+  const std::optional<Vec3> singular = k->singularDirection();
+  REQUIRE(singular);
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> normal;
+  int checked = 0;
+  double worst = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const Joints q = randomJoints(m, rng);
+    const ToolPose pose = k->forward(q);
+    if (singular->cross(pose.axis).norm() < 0.05)
+      continue;  // within 3 deg of the singular direction: rates() may refuse
+    const std::optional<runtime::JointRates> rates = k->rates(q, 0);
+    REQUIRE(rates);
+    CHECK((rates->tipTurn - *k->tipTurn(q)).norm() < 1e-12);
+    const Vec3 dp = Vec3(normal(rng), normal(rng), normal(rng)).normalized();
+    Vec3 dk = Vec3(normal(rng), normal(rng), normal(rng));
+    dk = (dk - pose.axis * pose.axis.dot(dk)).normalized();  // across the tool
+    constexpr double kStep = 1e-5;
+    auto at = [&](double h) {
+      const Vec3 axis = (pose.axis + h * dk).normalized();
+      const runtime::InverseResult r = k->inverse({pose.tipMm + h * dp, axis}, &q);
+      REQUIRE(r.joints);
+      return *r.joints;
+    };
+    const Joints seen = (at(kStep) - at(-kStep)) / (2 * kStep);
+    const Joints predicted = rates->of(dp, dk);
+    const double scale = 1 + predicted.cwiseAbs().maxCoeff();
+    INFO("joints " << q.transpose() << "; seen " << seen.transpose() << "; predicted " << predicted.transpose());
+    CHECK((seen - predicted).cwiseAbs().maxCoeff() < 1e-5 * scale);
+    worst = std::max(worst, (seen - predicted).cwiseAbs().maxCoeff() / scale);
+    // One call, the same answers.
+    std::optional<runtime::JointRates> both;
+    const runtime::InverseResult solved = k->inverseWithRates(pose, &q, 0, both);
+    const runtime::InverseResult alone = k->inverse(pose, &q);
+    REQUIRE(solved.joints);
+    REQUIRE(alone.joints);
+    CHECK(*solved.joints == *alone.joints);
+    REQUIRE(both);
+    const std::optional<runtime::JointRates> again = k->rates(*solved.joints, 0);
+    REQUIRE(again);
+    CHECK((both->map - again->map).cwiseAbs().maxCoeff() < 1e-9);
+    ++checked;
+  }
+  INFO(m.name << ": worst relative difference " << worst);
+  CHECK(checked > 1500);
+  return checked;
+}
+
+TEST_CASE("5-axis chains: rates are how the tip's and the tool's moves move the joints", "[kinematics]") {
+  ratesAgree(test::shippedMachine("table-table-5axis"), 21);
+  ratesAgree(test::shippedMachine("head-table-5axis"), 22);
+  ratesAgree(test::shippedMachine("head-head-5axis"), 23);
+  ratesAgree(machineFrom(fiveAxis("table-table", "[]", "[\"b\", \"c\"]",
+                                  rotary("b", -110, 110, "[10, -20, -150]") +
+                                      rotary("c", -36000, 36000, "[30, 40, -120]"))),
+             24);
+  ratesAgree(machineFrom(fiveAxis("head-head", "[\"c\", \"a\"]", "[]",
+                                  rotary("c", -360, 360, "[0, 0, 400]") + rotary("a", -100, 100, "[0, 0, 150]"))),
+             25);
+}
+
+TEST_CASE("5-axis chains: no rates at the singular direction; other chains have none", "[kinematics]") {
+  const auto k = kinematicsOf(test::shippedMachine("table-table-5axis"));
+  // The tool along the C axis: C is free.
+  const runtime::InverseResult upright = k->inverse({Vec3(10, 20, 30), Vec3::UnitZ()});
+  REQUIRE(upright.joints);
+  CHECK(upright.singular);
+  CHECK_FALSE(k->rates(*upright.joints, 0));
+  std::optional<runtime::JointRates> rates;
+  CHECK(k->inverseWithRates({Vec3(10, 20, 30), Vec3::UnitZ()}, nullptr, 0, rates).joints);
+  CHECK_FALSE(rates);
+  // minSine: refused within that sine of it.
+  const Vec3 near = Vec3(std::sin(0.01), 0, std::cos(0.01));
+  const runtime::InverseResult tilted = k->inverse({Vec3(10, 20, 30), near});
+  REQUIRE(tilted.joints);
+  CHECK(k->rates(*tilted.joints, 0));
+  CHECK_FALSE(k->rates(*tilted.joints, 0.02));
+  const auto xyz = kinematicsOf(test::shippedMachine("hsc-3axis"));
+  CHECK_FALSE(xyz->rates(Joints::Zero(3), 0));
+  CHECK_FALSE(xyz->singularDirection());
+}
+
 TEST_CASE("table-table A/C: poses worked out by hand", "[kinematics]") {
   // The shipped machine: A about +x through y = 225, z = -300; C about +z
   // through x = 250, y = 225.

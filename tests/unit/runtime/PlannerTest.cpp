@@ -591,3 +591,38 @@ TEST_CASE("GreatCircle: the tool axis between two poses, at an even rate on thei
   CHECK(std::abs(middle.norm() - 1) < 1e-12);
   CHECK(std::abs(half.at(0.25).dot(z) - std::cos(std::numbers::pi / 4)) < 1e-12);
 }
+
+TEST_CASE("GreatCircle: its tangent is at()'s derivative; nearestCosine how near the arc comes to a direction",
+          "[planner][five-axis]") {
+  std::mt19937 rng(6);
+  std::normal_distribution<double> n(0, 1);
+  auto unit = [&] { return Vec3(n(rng), n(rng), n(rng)).normalized(); };
+  for (int i = 0; i < 1000; ++i) {
+    const Vec3 u = unit(), w = unit(), v = unit();
+    const GreatCircle circle(u, w);
+    INFO("u " << u.transpose() << ", w " << w.transpose() << ", v " << v.transpose());
+    CHECK(std::abs(circle.angle() - std::acos(std::clamp(u.dot(w), -1.0, 1.0))) < 1e-7);
+    for (double t : {0.0, 0.3, 0.7, 1.0}) {
+      // Central differences inside, one-sided at the ends.
+      constexpr double h = 1e-6;
+      const double t0 = std::max(0.0, t - h), t1 = std::min(1.0, t + h);
+      const Vec3 seen = (circle.at(t1) - circle.at(t0)) / (t1 - t0);
+      CHECK((circle.tangent(t) - seen).norm() < 1e-5 * (1 + circle.angle()));
+      CHECK(std::abs(circle.tangent(t).dot(circle.at(t))) < 1e-9);
+    }
+    // The largest |v . at(t)| by sampling the arc finely: never above
+    // nearestCosine, and within the sampling's step of it.
+    double sampled = 0;
+    for (int k = 0; k <= 4000; ++k)
+      sampled = std::max(sampled, std::abs(v.dot(circle.at(k / 4000.0))));
+    const double nearest = circle.nearestCosine(v);
+    CHECK(sampled <= nearest + 1e-12);
+    CHECK(nearest - sampled < 1e-6);
+  }
+  // An arc passing over the direction, and one short of it.
+  const GreatCircle over(Vec3(1, 0, 1).normalized(), Vec3(-1, 0, 1).normalized());
+  CHECK(over.nearestCosine(Vec3::UnitZ()) == Approx(1.0));
+  const GreatCircle shortOf(Vec3(1, 0, 0), Vec3(1, 0, 1).normalized());
+  CHECK(shortOf.nearestCosine(Vec3::UnitZ()) == Approx(std::sqrt(0.5)));
+  CHECK(shortOf.nearestCosine(-Vec3::UnitZ()) == Approx(std::sqrt(0.5)));
+}
