@@ -29,8 +29,11 @@ namespace {
 /// version that holds it, so players of an older version go on reading what
 /// they can play: a mill's without dwells as version 1, with them as 2, a
 /// lathe's as 3, one that tilts the tool (5-axis: each segment's tool axes
-/// and the axis that capped it) as 4.
-constexpr int kVersion = 4;
+/// and the axis that capped it) as 4, one whose tool axis turns on a cubic
+/// somewhere (the planner's orientation smoothing: the axis's rates at each
+/// segment's ends) as 5.
+constexpr int kVersion = 5;
+constexpr int kVersionWithAxisRates = 5;
 constexpr int kVersionWithToolAxes = 4;
 constexpr int kVersionWithSpindle = 3;
 constexpr int kVersionWithDwells = 2;
@@ -39,9 +42,14 @@ constexpr std::string_view kMagic = "STEPNC-MOTION";
 
 /// The version a trajectory needs.
 int versionFor(const Trajectory &t) {
-  for (const Segment &seg : t.segments)
-    if (seg.tilted())
-      return kVersionWithToolAxes;
+  bool tilted = false;
+  for (const Segment &seg : t.segments) {
+    if (seg.axisCubic())
+      return kVersionWithAxisRates;
+    tilted = tilted || seg.tilted();
+  }
+  if (tilted)
+    return kVersionWithToolAxes;
   // Planned on the joints with the tool upright throughout (a
   // parallel-kinematic machine's sliders): the joints need version 4 too.
   if (!t.joints.empty())
@@ -177,6 +185,11 @@ std::string writeNative(const Trajectory &trajectory, const std::string &source)
     if (version >= kVersionWithToolAxes) {
       out += " tool";
       appendNumbers(out, {seg.axis0.x(), seg.axis0.y(), seg.axis0.z(), seg.axis1.x(), seg.axis1.y(), seg.axis1.z()});
+      if (version >= kVersionWithAxisRates) {
+        out += " turn";
+        appendNumbers(out, {seg.axisRate0.x(), seg.axisRate0.y(), seg.axisRate0.z(), seg.axisRate1.x(),
+                            seg.axisRate1.y(), seg.axisRate1.z()});
+      }
       out += " limited_axis ";
       out += info.axis >= 0 && size_t(info.axis) < t.axisNames.size() ? t.axisNames[size_t(info.axis)] : "none";
       // The joints at the segment's end, when planned on them.
@@ -658,7 +671,7 @@ void Reader::segment(Trajectory &t, bool first) {
     prof.phases[k].duration = nonNegative("a phase's duration");
     prof.phases[k].jerk = real("a phase's jerk");
   }
-  Vec3 axis0 = Vec3::UnitZ(), axis1 = Vec3::UnitZ();
+  Vec3 axis0 = Vec3::UnitZ(), axis1 = Vec3::UnitZ(), rate0 = Vec3::Zero(), rate1 = Vec3::Zero();
   if (version_ >= kVersionWithSpindle) {
     // The spindle: its speed at both ends; a thread pass keeps it.
     keyword("spindle");
@@ -684,6 +697,18 @@ void Reader::segment(Trajectory &t, bool first) {
       if (ok_ && !(std::abs(axis0.norm() - 1) <= kRelTolerance && std::abs(axis1.norm() - 1) <= kRelTolerance))
         fail(toolAt, "the tool axes are unit vectors, not of lengths " + number(axis0.norm()) + " and " +
                          number(axis1.norm()));
+      if (version_ >= kVersionWithAxisRates) {
+        // The axis's rates at the ends (per unit of the fraction along the
+        // segment), across the axis there: zero for an even turn.
+        keyword("turn");
+        const uint64_t turnAt = last_;
+        rate0 = point("the tool axis's rate at the start");
+        rate1 = point("the tool axis's rate at the end");
+        const double across = std::max(std::abs(rate0.dot(axis0)), std::abs(rate1.dot(axis1)));
+        if (ok_ && !(across <= kRelTolerance * (1 + rate0.norm() + rate1.norm())))
+          fail(turnAt, "the tool axis's rates at the ends are across the axis there, not along it by " +
+                           number(across));
+      }
       keyword("limited_axis");
       if (const Word *w = word("the limiting axis (a name, or none)"); w && w->text != "none") {
         auto it = std::find(t.axisNames.begin(), t.axisNames.end(), std::string(w->text));
@@ -782,8 +807,10 @@ void Reader::segment(Trajectory &t, bool first) {
   }
   v1_ = prof.v1();
   a1_ = prof.a1();
-  seg.axis0 = axis0.normalized();
-  seg.axis1 = axis1.normalized();
+  seg.axis0 = unitAsWritten(axis0);
+  seg.axis1 = unitAsWritten(axis1);
+  seg.axisRate0 = rate0;
+  seg.axisRate1 = rate1;
   t.joints.insert(t.joints.end(), jointsHere_.begin(), jointsHere_.end());
   jointsHere_.clear();
   t.segments.push_back(seg);

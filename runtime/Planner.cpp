@@ -548,7 +548,32 @@ private:
 /// at a segment's two ends (joint units per mm, per mm^2).
 struct JointEnds {
   Joints d1Start, d1End, d2Start, d2End;
+  /// Where the chain has its rates at both ends (Kinematics::rates): d1Start
+  /// and d1End are exact, and curveStart, curveEnd are the parts of the
+  /// joints' second derivatives there that the path's and the tool axis's
+  /// own second derivatives make (rates applied to p'' and k''). Across a
+  /// junction the rest of the second derivatives is continuous where the
+  /// first derivatives are, so the jump is the difference of these.
+  bool exact = false;
+  Joints curveStart, curveEnd;
 };
+
+/// JointEnds' exact parts from the rates at the two ends.
+/// The segment's path and tool axis at its two ends, each found once.
+struct SegmentEnds {
+  PathPoint start, end;
+  Segment::AxisEnds axis;
+  SegmentEnds(const Segment &seg, const GreatCircle &circle)
+      : start(seg.atStart()), end(seg.atEnd()), axis(seg.axisEnds(&circle)) {}
+};
+
+void exactEnds(const SegmentEnds &at, const JointRates &start, const JointRates &end, JointEnds &ends) {
+  ends.d1Start = start.of(at.start.r1, at.axis.rate0);
+  ends.d1End = end.of(at.end.r1, at.axis.rate1);
+  ends.curveStart = start.of(at.start.r2, at.axis.curve0);
+  ends.curveEnd = end.of(at.end.r2, at.axis.curve1);
+  ends.exact = true;
+}
 
 /// The pose the joints were last solved at by jointDemand (a segment's end),
 /// so that the next segment starting there need not solve it again.
@@ -572,6 +597,33 @@ struct JointSampler {
   std::optional<Vec3> singular;
   SolvedPose solved;
 };
+
+/// Orientation smoothing: where the tool turns on both sides of a junction
+/// it passes without stopping, the axis turns through the junction at one
+/// rate instead of each side's own (whose jump would make the joints' rates
+/// jump, and the tool stop): the three-point rule on the two sides' rates
+/// (each weighted by the other side's length, exact where the orientation
+/// is a quadratic of the arc length), across the axis there. Each side then
+/// follows a cubic (Segment::axisRate0, axisRate1) with that rate at the
+/// junction and its great circle's (or the shared one) at its other end. A
+/// side whose axis does not turn keeps it (a flank's fixed tilt stays
+/// fixed: the tool stops where the turning starts).
+void smoothJunction(Segment &a, const GreatCircle &ca, Segment &b, const GreatCircle &cb) {
+  if (a.kind == SegmentKind::Dwell || b.kind == SegmentKind::Dwell || !(a.length > 0) || !(b.length > 0))
+    return;
+  if (!a.tilted() || !b.tilted() || a.axis1 != b.axis0)
+    return;
+  if (!(ca.angle() > 1e-9) || !(cb.angle() > 1e-9))
+    return;
+  if (!a.axisCubic())
+    a.axisRate0 = ca.tangent(0);
+  const Vec3 rateA = ca.tangent(1) / a.length, rateB = cb.tangent(0) / b.length;  // per mm
+  Vec3 shared = (a.length * rateB + b.length * rateA) / (a.length + b.length);
+  shared -= a.axis1 * a.axis1.dot(shared);
+  a.axisRate1 = shared * a.length;
+  b.axisRate0 = shared * b.length;
+  b.axisRate1 = cb.tangent(1);
+}
 
 /// Bounds of |q'|, |q''|, |q'''| over [0, length] of the cubic with values
 /// q0, q1 and derivatives m0, m1 at its ends (Hermite).
@@ -638,10 +690,10 @@ std::optional<bool> jointDemandByRates(const Segment &seg, const GreatCircle &ci
   const Joints &q1 = *end.joints;
   if (!g1)
     return std::nullopt;
-  const PathPoint at0 = seg.atStart(), at1 = seg.atEnd();
-  const Vec3 &along0 = at0.r1, &along1 = at1.r1;
-  const Joints rate0 = g0->of(along0, circle.tangent(0) / seg.length);
-  const Joints rate1 = g1->of(along1, circle.tangent(1) / seg.length);
+  const SegmentEnds at(seg, circle);
+  exactEnds(at, *g0, *g1, ends);
+  const Vec3 &along0 = at.start.r1, &along1 = at.end.r1;
+  const Joints &rate0 = ends.d1Start, &rate1 = ends.d1End;
   const Mat3 &m0 = g0->tipTurn, &m1 = g1->tipTurn;
   // The rest: rho = x - M0 p, and the rotary joints as they are.
   Joints rho0 = q0, rho1 = q1, m0rho = rate0, m1rho = rate1;
@@ -674,8 +726,6 @@ std::optional<bool> jointDemandByRates(const Segment &seg, const GreatCircle &ci
   }
   ends.d2End = ends.d2Start;
   d = out;
-  ends.d1Start = rate0;
-  ends.d1End = rate1;
   near = q1;
   solved.tip = tip1;
   solved.axis = seg.axis1;
@@ -712,17 +762,20 @@ std::optional<bool> jointDemandByRates(const Segment &seg, const GreatCircle &ci
 /// shipped head-head machine); the path's own curvature as a floor.
 ///
 /// The joints at the start are not solved again where the last segment
-/// ended (`sampler.solved`); so on a path of short segments each costs three
-/// inverse kinematics (BM_PlanFiveAxis, docs/performance.md).
-bool jointDemand(const Segment &seg, JointSampler &sampler, Joints &near, AxisDemand &d, JointEnds &ends,
-                 bool startSolved) {
+/// ended (`sampler.solved`); on a path of short segments (jointDemandByRates)
+/// each costs one inverse kinematics (BM_PlanFiveAxis, docs/performance.md).
+bool jointDemand(const Segment &seg, const GreatCircle &circle, JointSampler &sampler, Joints &near, AxisDemand &d,
+                 JointEnds &ends, bool startSolved) {
   constexpr double kMargin = 1.25;  // what the pieces' differences may miss of a peak
   const Kinematics &kin = sampler.kin;
   const Vec3 &offset = sampler.offset;
   const bool serial = sampler.serial;
   SolvedPose &solved = sampler.solved;
-  const GreatCircle circle(seg.axis0, seg.axis1);
-  const double turned = circle.angle() * 180 / std::numbers::pi;
+  // How far the axis turns: its great circle's angle (`circle` is the one
+  // from axis0 to axis1), or a cubic's rates at the ends where they are
+  // more.
+  const double turn = std::max({circle.angle(), seg.axisRate0.norm(), seg.axisRate1.norm()});
+  const double turned = turn * 180 / std::numbers::pi;
   const int n = std::clamp(static_cast<int>(std::ceil(std::max(turned / 0.5, seg.length / 1.0))), serial ? 3 : 8, 64);
   const double h = seg.length / n;
   if (!(h > 0))
@@ -731,10 +784,14 @@ bool jointDemand(const Segment &seg, JointSampler &sampler, Joints &near, AxisDe
   // when the rates change little along the segment: the rotary joints' grow
   // as 1 / sin of the angle to the singular direction, so the turn must be
   // small beside that sine (a tenth: the rates change by about a tenth).
+  // (A cubic's axis leaves the great circle by less than a sixth of how far
+  // its rates at the ends are from the circle's: taken off the sine.)
   if (serial && n == 3 && sampler.singular) {
     const double cosine = circle.nearestCosine(*sampler.singular);
-    const double sine = std::sqrt(std::max(0.0, 1 - cosine * cosine));
-    if (circle.angle() <= 0.1 * sine)
+    double sine = std::sqrt(std::max(0.0, 1 - cosine * cosine));
+    if (seg.axisCubic())
+      sine -= 0.25 * ((seg.axisRate0 - circle.tangent(0)).norm() + (seg.axisRate1 - circle.tangent(1)).norm());
+    if (turn <= 0.1 * sine)
       if (const std::optional<bool> done =
               jointDemandByRates(seg, circle, sampler, near, d, ends, startSolved, kMargin))
         return *done;
@@ -750,7 +807,7 @@ bool jointDemand(const Segment &seg, JointSampler &sampler, Joints &near, AxisDe
   for (int i = startSolved ? 1 : 0; i <= n; ++i) {
     const double s = seg.length * i / n;
     tip[size_t(i)] = seg.pointAt(s) + offset;
-    const InverseResult r = kin.inverse({tip[size_t(i)], circle.at(seg.fraction(s))}, &at);
+    const InverseResult r = kin.inverse({tip[size_t(i)], seg.axisAt(s)}, &at);
     if (!r.joints) {
       solved.valid = false;
       return false;
@@ -760,6 +817,7 @@ bool jointDemand(const Segment &seg, JointSampler &sampler, Joints &near, AxisDe
     singularEnd = r.singular;
   }
   near = at;
+  const Joints q0 = q[0];
   // On a serial chain the linear joints' differences are taken of rho.
   Mat3 m0 = Mat3::Identity(), m1 = Mat3::Identity();
   if (serial) {
@@ -768,13 +826,23 @@ bool jointDemand(const Segment &seg, JointSampler &sampler, Joints &near, AxisDe
     for (int i = 0; i <= n; ++i)
       q[size_t(i)].head<3>() -= m0 * tip[size_t(i)];
   }
-  solved = {tip[size_t(n)], seg.axis1, m1, std::nullopt, !singularEnd};
+  // The ends' rates exactly where the chain has them there.
+  std::optional<JointRates> startRates = continued && solved.rates ? solved.rates : std::nullopt;
+  if (serial && !startRates)
+    startRates = kin.rates(q0, 0);
+  std::optional<JointRates> endRates = serial && !singularEnd ? kin.rates(near, 0) : std::nullopt;
+  solved = {tip[size_t(n)], seg.axis1, m1, endRates, !singularEnd};
   const Mat3 spread = (m1 - m0).cwiseAbs();
-  ends.d1Start = (q[1] - q[0]) / h;
-  ends.d1End = (q[size_t(n)] - q[size_t(n - 1)]) / h;
-  if (serial) {
-    ends.d1Start.head<3>() += m0 * seg.at(0).r1;
-    ends.d1End.head<3>() += m0 * seg.at(seg.length).r1;
+  ends.exact = false;
+  if (startRates && endRates) {
+    exactEnds(SegmentEnds(seg, circle), *startRates, *endRates, ends);
+  } else {
+    ends.d1Start = (q[1] - q[0]) / h;
+    ends.d1End = (q[size_t(n)] - q[size_t(n - 1)]) / h;
+    if (serial) {
+      ends.d1Start.head<3>() += m0 * seg.at(0).r1;
+      ends.d1End.head<3>() += m0 * seg.at(seg.length).r1;
+    }
   }
   // The path's own bounds as the linear joints see them.
   const Mat3 bound = m0.cwiseAbs() + spread;
@@ -1092,7 +1160,8 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
     stop = StopReason::Dwell;
     return true;
   };
-  auto push = [&](double feed, uint32_t move, uint32_t next, StopReason stop, const AxisDemand &given) {
+  auto push = [&](double feed, uint32_t move, uint32_t next, StopReason stop, const AxisDemand &given,
+                  const GreatCircle *circle) {
     bool startSolved = false;
     if (options.kinematics && (out.segments.back().tilted() || everySegmentByJoints)) {
       const Segment &here = out.segments.back();
@@ -1118,7 +1187,7 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
     const bool byJoints = tilted || everySegmentByJoints;
     if (byJoints) {
       JointEnds e;
-      if (jointDemand(seg, *sampler, joints, d, e, startSolved))
+      if (jointDemand(seg, circle ? *circle : GreatCircle(seg.axis0, seg.axis1), *sampler, joints, d, e, startSolved))
         ends = e;
     } else if (seg.kind != SegmentKind::Dwell && seg.length > 0) {
       JointEnds e;
@@ -1140,10 +1209,15 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
       const double cycle = machine.cycleTime > 0 ? machine.cycleTime : 0.001;
       for (Eigen::Index k = 0; k < joints.size() && size_t(k) < machine.axes.size(); ++k) {
         const double jk = machine.axes[size_t(k)].jerk;
-        // The rates' jump; the second derivatives' by their bounds on the
-        // two sides (what finite differences give at an end is not sharp).
+        // The rates' jump; the second derivatives': where both sides have
+        // their rates, what the path's and the axis's own second
+        // derivatives change by (JointEnds::curveStart), else by their
+        // bounds on the two sides (what finite differences give at an end
+        // is not sharp).
         const double dv = std::abs(ends->d1Start[k] - lastEnds->d1End[k]);
-        const double da = std::abs(ends->d2Start[k]) + std::abs(lastEnds->d2End[k]);
+        const double da = ends->exact && lastEnds->exact
+                              ? std::abs(ends->curveStart[k] - lastEnds->curveEnd[k])
+                              : std::abs(ends->d2Start[k]) + std::abs(lastEnds->d2End[k]);
         // Half of each to the velocity's jump and to the acceleration's,
         // and half again for the ends' rates, which the differences over a
         // piece of the segment see less sharp than they are.
@@ -1167,11 +1241,53 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
       record(seg);
     out.joints.insert(out.joints.end(), recorded.data(), recorded.data() + recorded.size());
   };
+  // With the joints planned, each segment waits in out.segments until the
+  // one after it is known, so that the orientation can be smoothed across
+  // their junction (smoothJunction) before either is planned.
+  // (Each with its axis's great circle, found once.)
+  struct Pending {
+    double feed = 0;
+    uint32_t move = 0, next = 0;
+    StopReason stop = StopReason::None;
+    AxisDemand demand;
+    GreatCircle circle;
+  };
+  std::optional<Pending> pending;
+  auto flush = [&] {
+    if (pending) {
+      const Pending p = *pending;
+      pending.reset();
+      push(p.feed, p.move, p.next, p.stop, p.demand, &p.circle);
+    }
+  };
+  auto emit = [&](double feed, uint32_t move, uint32_t next, StopReason stop, const AxisDemand &demand) {
+    if (!options.kinematics) {
+      push(feed, move, next, stop, demand, nullptr);
+      return;
+    }
+    Segment &mine = out.segments.back();
+    const GreatCircle circle(mine.axis0, mine.axis1);
+    if (pending) {
+      // out.segments ends with the pending segment and this one. Not next
+      // to a rapid: one that turns the tool starts its rotary axes afresh
+      // (turnFirst).
+      const size_t n = out.segments.size();
+      if (stop == StopReason::None && pending->feed > 0 && feed > 0)
+        smoothJunction(out.segments[n - 2], pending->circle, mine, circle);
+      Segment held = std::move(mine);
+      out.segments.pop_back();
+      flush();
+      out.segments.push_back(std::move(held));
+    }
+    pending = Pending{feed, move, next, stop, demand, circle};
+  };
   StopReason stop = StopReason::Start;
   // The dwells before piece `piece`: a segment each, at rest (their limits
   // zero: nothing moves), and the segment after them starts at rest.
   size_t nextDwell = 0;
   auto pushDwells = [&](size_t piece) {
+    if (nextDwell < dwells.size() && dwells[nextDwell].beforePiece == piece)
+      flush();
     for (; nextDwell < dwells.size() && dwells[nextDwell].beforePiece == piece; ++nextDwell) {
       const PieceDwell &d = dwells[nextDwell];
       out.segments.push_back(Segment::dwell(input.moves[d.move].to));
@@ -1196,7 +1312,11 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
       const Piece &p = pieces[i];
       const Segment &before = segments[(i + 1) % 2], &here = segments[i % 2];
       p.segment(input, segments[i % 2]);
-      const Vec3 axisIn = here.axisAt(p.cutStart);  // where the blend before this piece ends
+      // The piece's axis turns evenly on one great circle (a cubic only
+      // once the planner smooths it).
+      const GreatCircle hereCircle(here.axis0, here.axis1);
+      auto hereAxis = [&](double s) { return here.length > 0 ? hereCircle.at(here.fraction(s)) : here.axis1; };
+      const Vec3 axisIn = hereAxis(p.cutStart);  // where the blend before this piece ends
       if (i > 0 && p.stopReason != StopReason::None)
         stop = p.stopReason;
       pushDwells(i);
@@ -1212,17 +1332,18 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
           out.segments.push_back(Segment::blend(blendBetween(prev, before, p, here), demand));
           out.segments.back().axis0 = axisOut;
           out.segments.back().axis1 = axisIn;
-          push(feed, prev.move, p.move, stop, demand);
+          emit(feed, prev.move, p.move, stop, demand);
           stop = StopReason::None;
         }
       }
       if (p.keepsMiddle()) {
         out.segments.push_back(here.part(p.cutStart, here.length - p.cutEnd));  // its axes turned with it
-        push(p.feed, p.move, p.move, stop, out.segments.back().demand());
+        emit(p.feed, p.move, p.move, stop, out.segments.back().demand());
         stop = StopReason::None;
       }
-      axisOut = here.axisAt(here.length - p.cutEnd);
+      axisOut = hereAxis(here.length - p.cutEnd);
     }
+    flush();
     pushDwells(pieces.size());  // after the last move
   }
   std::vector<Piece>().swap(pieces);  // not needed any more: its memory serves the steps below

@@ -370,20 +370,108 @@ double GreatCircle::nearestCosine(const Vec3 &v) const {
   return std::min(best, 1.0);
 }
 
+Vec3 Segment::axisRateAt(double s) const {
+  if (!(length > 0))
+    return Vec3::Zero();
+  const double t = fraction(s);
+  if (!axisCubic())
+    return GreatCircle(axis0, axis1).tangent(t) / length;
+  // d/dt of c / |c| is the part of c' across c, over |c|.
+  const double t2 = t * t;
+  const Vec3 c = cubicPoint(t);
+  const Vec3 d = (6 * t2 - 6 * t) * axis0 + (3 * t2 - 4 * t + 1) * axisRate0 + (6 * t - 6 * t2) * axis1 +
+                 (3 * t2 - 2 * t) * axisRate1;
+  const double n = c.norm();
+  const Vec3 u = c / n;
+  return (d - u * u.dot(d)) / (n * length);
+}
+
+Vec3 Segment::axisCurvatureAt(double s) const {
+  if (!(length > 0))
+    return Vec3::Zero();
+  const double t = fraction(s);
+  if (!axisCubic()) {
+    // Evenly on a great circle: towards its centre, the rate squared.
+    const double rate = GreatCircle(axis0, axis1).angle() / length;
+    return -rate * rate * axisAt(s);
+  }
+  // u = c / n: u'' = (c'' - 2 u' n' - u n'') / n, with n' = u . c' and
+  // n'' = u' . c' + u . c'' (derivatives in t).
+  const double t2 = t * t;
+  const Vec3 c = cubicPoint(t);
+  const Vec3 d1 = (6 * t2 - 6 * t) * axis0 + (3 * t2 - 4 * t + 1) * axisRate0 + (6 * t - 6 * t2) * axis1 +
+                  (3 * t2 - 2 * t) * axisRate1;
+  const Vec3 d2 = (12 * t - 6) * axis0 + (6 * t - 4) * axisRate0 + (6 - 12 * t) * axis1 + (6 * t - 2) * axisRate1;
+  const double n = c.norm();
+  const Vec3 u = c / n;
+  const double n1 = u.dot(d1);
+  const Vec3 u1 = (d1 - u * n1) / n;
+  const double n2 = u1.dot(d1) + u.dot(d2);
+  return (d2 - 2 * u1 * n1 - u * n2) / (n * length * length);
+}
+
+Segment::AxisEnds Segment::axisEnds(const GreatCircle *circle) const {
+  AxisEnds e;
+  if (!(length > 0)) {
+    e.rate0 = e.rate1 = e.curve0 = e.curve1 = Vec3::Zero();
+    return e;
+  }
+  const double perLength = 1 / length;
+  if (!axisCubic()) {
+    if (!circle) {
+      const GreatCircle own(axis0, axis1);
+      return axisEnds(&own);
+    }
+    const GreatCircle &c = *circle;
+    e.rate0 = c.tangent(0) * perLength;
+    e.rate1 = c.tangent(1) * perLength;
+    const double rate = c.angle() * perLength;
+    e.curve0 = -rate * rate * axis0;
+    e.curve1 = -rate * rate * axis1;
+    return e;
+  }
+  // At the ends the cubic is the unit axis itself (|c| = 1) and its rate
+  // lies across it: u' = c', u'' = c'' - u (u' . c' + u . c'') (the general
+  // formula of axisCurvatureAt with n = 1, n' = 0).
+  const Vec3 second0 = -6 * axis0 - 4 * axisRate0 + 6 * axis1 - 2 * axisRate1;
+  const Vec3 second1 = 6 * axis0 + 2 * axisRate0 - 6 * axis1 + 4 * axisRate1;
+  auto rateAt = [](const Vec3 &u, const Vec3 &d1) { return Vec3(d1 - u * u.dot(d1)); };
+  const Vec3 u10 = rateAt(axis0, axisRate0), u11 = rateAt(axis1, axisRate1);
+  const double n10 = axis0.dot(axisRate0), n11 = axis1.dot(axisRate1);
+  e.rate0 = u10 * perLength;
+  e.rate1 = u11 * perLength;
+  e.curve0 = (second0 - 2 * u10 * n10 - axis0 * (u10.dot(axisRate0) + axis0.dot(second0))) * perLength * perLength;
+  e.curve1 = (second1 - 2 * u11 * n11 - axis1 * (u11.dot(axisRate1) + axis1.dot(second1))) * perLength * perLength;
+  return e;
+}
+
 Segment Segment::part(double s0, double s1) const {
   s0 = std::clamp(s0, 0.0, length);
   s1 = std::clamp(s1, s0, length);
   if (s0 <= 0 && s1 >= length)
     return *this;
+  // The part's axes at its ends; a cubic's rates there, per unit of the
+  // part's fraction (the part then follows a cubic of its own, within the
+  // cubic's change of curvature of the whole's).
+  auto axesOf = [&](Segment &out) {
+    if (axisCubic()) {
+      out.axis0 = axisAt(s0);
+      out.axis1 = axisAt(s1);
+      out.axisRate0 = axisRateAt(s0) * (s1 - s0);
+      out.axisRate1 = axisRateAt(s1) * (s1 - s0);
+    } else if (length > 0) {
+      const GreatCircle circle(axis0, axis1);
+      out.axis0 = circle.at(fraction(s0));
+      out.axis1 = circle.at(fraction(s1));
+    }
+  };
   if (kind == SegmentKind::Line) {
     Segment out = line(at(s0).p, at(s1).p);
-    out.axis0 = axisAt(s0);
-    out.axis1 = axisAt(s1);
+    axesOf(out);
     return out;
   }
   Segment out = *this;
-  out.axis0 = axisAt(s0);
-  out.axis1 = axisAt(s1);
+  axesOf(out);
   if (kind == SegmentKind::Arc) {
     const double rise = sweep > 0 ? (end.z() - start.z()) / sweep : 0;
     const double k = std::sqrt(radius * radius + rise * rise);

@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <limits>
 
 namespace stepnc::runtime {
 
@@ -82,6 +83,12 @@ private:
   double cos_ = 1, sin_ = 0;    ///< of angle_
 };
 
+/// A unit vector read back from a file: as written when it is unit to
+/// rounding (so that it reads back bit for bit), else scaled to unit length.
+inline Vec3 unitAsWritten(const Vec3 &v) {
+  return std::abs(v.squaredNorm() - 1) <= 8 * std::numeric_limits<double>::epsilon() ? v : Vec3(v.normalized());
+}
+
 /// The tool axis a fraction t (0..1) of the way from unit vector u to w.
 inline Vec3 axisBetween(const Vec3 &u, const Vec3 &w, double t) { return GreatCircle(u, w).at(t); }
 
@@ -127,9 +134,33 @@ struct Segment {
   // the fraction of its length); +z on a 3-axis path.
   Vec3 axis0 = Vec3::UnitZ();
   Vec3 axis1 = Vec3::UnitZ();
+  // Where the planner smooths the orientation across a junction (the tool
+  // turning on at the rate it had): the axis's derivative per unit of the
+  // fraction at the start and at the end, the axis then the cubic
+  // (Hermite) between axis0 and axis1 with these derivatives, scaled to
+  // unit length. Both zero (the default): evenly on the great circle.
+  Vec3 axisRate0 = Vec3::Zero();
+  Vec3 axisRate1 = Vec3::Zero();
   bool tilted() const { return axis0 != Vec3::UnitZ() || axis1 != Vec3::UnitZ(); }
+  /// Whether the axis follows the cubic (axisRate0, axisRate1).
+  bool axisCubic() const { return !axisRate0.isZero(0) || !axisRate1.isZero(0); }
   /// The tool axis at arc length s.
-  Vec3 axisAt(double s) const { return length > 0 ? axisBetween(axis0, axis1, fraction(s)) : axis1; }
+  Vec3 axisAt(double s) const {
+    if (!(length > 0))
+      return axis1;
+    return axisCubic() ? cubicAxis(fraction(s)) : axisBetween(axis0, axis1, fraction(s));
+  }
+  /// The tool axis's derivative with respect to arc length at s (per mm).
+  Vec3 axisRateAt(double s) const;
+  /// Its second derivative (per mm^2).
+  Vec3 axisCurvatureAt(double s) const;
+  /// Both at the two ends, in closed form (the planner asks for them at
+  /// every segment): `circle`, when given, is GreatCircle(axis0, axis1).
+  struct AxisEnds {
+    Vec3 rate0, rate1;    ///< per mm
+    Vec3 curve0, curve1;  ///< per mm^2
+  };
+  AxisEnds axisEnds(const GreatCircle *circle = nullptr) const;
   /// Blends: the curve's parameter at arc length s.
   double blendParameter(const QuinticCurve &q, double s) const;
   /// How far along the segment arc length s is, 0..1 (axisAt's fraction).
@@ -185,6 +216,22 @@ struct Segment {
   Vec3 pointAt(double s) const { return kind == SegmentKind::Line ? at(s).p : curvePointAt(s); }
   /// Upper bounds of the derivatives per axis over the whole segment.
   AxisDemand demand() const;
+
+private:
+  /// The cubic between axis0 and axis1 at fraction t, before and after
+  /// scaling to unit length.
+  Vec3 cubicPoint(double t) const {
+    const double t2 = t * t, t3 = t2 * t;
+    return (2 * t3 - 3 * t2 + 1) * axis0 + (t3 - 2 * t2 + t) * axisRate0 + (3 * t2 - 2 * t3) * axis1 +
+           (t3 - t2) * axisRate1;
+  }
+  Vec3 cubicAxis(double t) const {
+    if (t <= 0)
+      return axis0;
+    if (t >= 1)
+      return axis1;
+    return cubicPoint(t).normalized();
+  }
 };
 
 } // namespace stepnc::runtime

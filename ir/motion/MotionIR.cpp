@@ -171,6 +171,9 @@ void attachMotion(ir::Module &module, const ProgramPath &program, const runtime:
     if (seg.tilted())
       s.set("axes", ir::Value::reals({seg.axis0.x(), seg.axis0.y(), seg.axis0.z(), seg.axis1.x(), seg.axis1.y(),
                                       seg.axis1.z()}));
+    if (seg.axisCubic())
+      s.set("axis_rates", ir::Value::reals({seg.axisRate0.x(), seg.axisRate0.y(), seg.axisRate0.z(),
+                                            seg.axisRate1.x(), seg.axisRate1.y(), seg.axisRate1.z()}));
     // The joint that capped the segment: on one that tilts the tool, and on
     // any whose limiting axis is not the tip's own coordinate (a
     // parallel-kinematic machine's slider; on the serial chains an upright
@@ -298,8 +301,15 @@ std::optional<runtime::Trajectory> readMotion(const ir::Module &module, Diagnost
           fail(s, "a segment's 'axes' are two unit vectors, its tool axis at its start and at its end");
           continue;
         }
-        seg.axis0 = a0.normalized();
-        seg.axis1 = a1.normalized();
+        seg.axis0 = runtime::unitAsWritten(a0);
+        seg.axis1 = runtime::unitAsWritten(a1);
+      }
+      if (s.has("axis_rates")) {
+        const auto rates = numbersOf(s, "axis_rates", 6);
+        if (!rates)
+          continue;
+        seg.axisRate0 = Vec3((*rates)[0], (*rates)[1], (*rates)[2]);
+        seg.axisRate1 = Vec3((*rates)[3], (*rates)[4], (*rates)[5]);
       }
       if (const ir::Value *j = s.get("joints"); j && j->type == ir::ValueType::Reals)
         out.joints.insert(out.joints.end(), j->numbers.begin(), j->numbers.end());

@@ -153,6 +153,10 @@ void requireSame(const Trajectory &a, const Trajectory &b) {
     CHECK(s.startAngle == r.startAngle);
     CHECK(s.sweep == r.sweep);
     CHECK(s.ccw == r.ccw);
+    CHECK(s.axis0 == r.axis0);
+    CHECK(s.axis1 == r.axis1);
+    CHECK(s.axisRate0 == r.axisRate0);
+    CHECK(s.axisRate1 == r.axisRate1);
     if (s.kind == SegmentKind::Blend) {  // lines and arcs leave ctrl uninitialised (Eigen)
       CHECK(s.ctrl == r.ctrl);
       CHECK(s.arcTable == r.arcTable);
@@ -284,6 +288,53 @@ TEST_CASE("a lathe's trajectory is version 3: its axes and each segment's spindl
         std::string::npos);
 }
 
+TEST_CASE("tool axes are version 4, an axis turning on a cubic version 5", "[native][five-axis]") {
+  Trajectory t = sample();
+  const Vec3 a0 = Vec3(0.1, 0.2, 1).normalized(), a1 = Vec3(0.15, 0.1, 1).normalized();
+  const Vec3 a2 = Vec3(0.2, 0.05, 1).normalized();
+  t.segments[0].axis0 = a0;
+  t.segments[0].axis1 = t.segments[1].axis0 = a1;
+  t.segments[1].axis1 = a2;
+  const std::string v4 = writeNative(t, "tilted");
+  INFO(v4);
+  CHECK(v4.rfind("STEPNC-MOTION 4\n", 0) == 0);
+  CHECK(v4.find(" turn ") == std::string::npos);
+  // The orientation smoothed across the first junction: rates across the
+  // axis at each end.
+  auto across = [](const Vec3 &axis, const Vec3 &v) { return Vec3(v - axis * axis.dot(v)); };
+  t.segments[0].axisRate0 = across(a0, a1 - a0);
+  t.segments[0].axisRate1 = across(a1, Vec3(0.01, -0.02, 0.003));
+  t.segments[1].axisRate0 = across(a1, Vec3(0.02, -0.04, 0.006));
+  t.segments[1].axisRate1 = across(a2, a2 - a1);
+  const std::string v5 = writeNative(t, "tilted");
+  INFO(v5);
+  CHECK(v5.rfind("STEPNC-MOTION 5\n", 0) == 0);
+  CHECK(v5.find(" turn 0 0 0 0 0 0 limited_axis ") != std::string::npos);  // the segments that turn evenly
+  Read r = read(v5);
+  REQUIRE(r.errors.empty());
+  REQUIRE(r.trajectory);
+  requireSame(t, *r.trajectory);
+  CHECK(writeNative(*r.trajectory, "tilted") == v5);
+  // The cubic passes through both ends with those rates.
+  const Segment &seg = r.trajectory->segments[0];
+  CHECK((seg.axisAt(0) - a0).norm() == 0);
+  CHECK((seg.axisAt(seg.length) - a1).norm() == 0);
+  CHECK((seg.axisRateAt(0) - seg.axisRate0 / seg.length).norm() < 1e-12);
+  // A rate along the axis is no turn of it: refused where it is.
+  const std::string along = "turn " + [&] {
+    std::ostringstream o;
+    o.precision(17);
+    o << a0.x() << ' ' << a0.y() << ' ' << a0.z();
+    return o.str();
+  }();
+  const size_t turnAt = v5.find(" turn ") + 1;
+  const size_t rateEnd = v5.find(' ', v5.find(' ', v5.find(' ', turnAt + 5) + 1) + 1);
+  std::string bad = v5;
+  bad.replace(turnAt, rateEnd - turnAt, along);
+  CHECK(error(bad).find("the tool axis's rates at the ends are across the axis there, not along it by") !=
+        std::string::npos);
+}
+
 TEST_CASE("native dwells are checked", "[native][dwell]") {
   const std::string text = writeNative(dwelling(), "p");
   REQUIRE(read(text).errors.empty());
@@ -392,10 +443,10 @@ TEST_CASE("the native text of a small trajectory", "[native]") {
 TEST_CASE("native format mistakes are located", "[native]") {
   REQUIRE(read(kSmall).errors.empty());
   // Another version: refused at the version number.
-  CHECK(error(replaced(kSmall, "STEPNC-MOTION 1", "STEPNC-MOTION 5")) ==
-        "1:15: unsupported native format version 5; this stepnc reads versions 1 to 4");
+  CHECK(error(replaced(kSmall, "STEPNC-MOTION 1", "STEPNC-MOTION 6")) ==
+        "1:15: unsupported native format version 6; this stepnc reads versions 1 to 5");
   const std::string notMotion =
-      ": not a stepnc native motion file: the first line must be 'STEPNC-MOTION N', N the format version (1 to 4)";
+      ": not a stepnc native motion file: the first line must be 'STEPNC-MOTION N', N the format version (1 to 5)";
   CHECK(error("G01 X1\n") == "1:1" + notMotion);
   CHECK(error("\n" + kSmall) == "2:1" + notMotion);
   CHECK(error("") == "1:1" + notMotion);

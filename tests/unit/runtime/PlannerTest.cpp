@@ -555,6 +555,80 @@ TEST_CASE("a segment that tilts the tool is capped by the joint that binds, and 
   CHECK(r.jointMaxVelocity[c] * 60 >= 0.3 * m.axes[c].velocity);
 }
 
+TEST_CASE("the tool axis turns at one rate through a junction where it turns on both sides, and the tool does "
+          "not stop there",
+          "[planner][five-axis]") {
+  const Machine m = test::shippedMachine("table-table-5axis");
+  std::string error;
+  const std::unique_ptr<Kinematics> k = makeKinematics(m, error);
+  REQUIRE(k);
+  // 200 moves of 0.5 to 1.5 mm along a gentle curve at 2000 mm/min, the
+  // tool leaning 25 deg and swinging its lean round +z by 0.3 deg a mm (as
+  // CAM output that samples a smooth orientation: the moves' own great
+  // circles turn at one rate, their junctions between them); then 20 moves
+  // with the lean held (the axis fixed) and 20 turning again.
+  const double deg = 3.14159265358979323846 / 180;
+  auto leaning = [&](double heading) {
+    return Vec3(std::sin(25 * deg) * std::cos(heading), std::sin(25 * deg) * std::sin(heading), std::cos(25 * deg));
+  };
+  PathInput p;
+  p.start = Vec3(0, 0, 0);
+  p.startAxis = leaning(0);
+  double x = 0, heading = 0;
+  for (int i = 1; i <= 240; ++i) {
+    const double step = 0.5 + (i % 3) * 0.5;
+    x += step;
+    if (i <= 200 || i > 220)
+      heading += 0.3 * deg * step;
+    PathMove move;
+    move.to = Vec3(x, 5 * std::sin(x / 40), 0);
+    move.feed = 2000;
+    move.axis = leaning(heading);
+    p.moves.push_back(move);
+  }
+  PlanOptions options;
+  options.kinematics = k.get();
+  options.workOffset = Vec3(100, 225, -250);
+  const Trajectory t = plan(p, m, options);
+  // Junctions between segments that both turn the axis: the same axis and
+  // the same rate per mm on both sides, the speed there not a stop (but
+  // where the tool slows for the stop where the fixed stretch ends).
+  size_t smoothed = 0, fixedKept = 0, fast = 0;
+  for (size_t i = 1; i < t.segments.size(); ++i) {
+    const Segment &a = t.segments[i - 1], &b = t.segments[i];
+    if (a.kind == SegmentKind::Dwell || b.kind == SegmentKind::Dwell)
+      continue;
+    INFO("junction " << i);
+    CHECK((a.axisAt(a.length) - b.axisAt(0)).norm() < 1e-12);
+    if (a.axis0 == a.axis1) {  // the fixed stretch keeps its axis throughout
+      CHECK_FALSE(a.axisCubic());
+      CHECK((a.axisAt(0.5 * a.length) - a.axis0).norm() < 1e-12);
+      ++fixedKept;
+      continue;
+    }
+    if (b.axis0 == b.axis1)
+      continue;
+    CHECK((a.axisRateAt(a.length) - b.axisRateAt(0)).norm() < 1e-9);
+    fast += t.profiles[i].v0 > 0.5 * 2000.0 / 60;
+    ++smoothed;
+  }
+  CHECK(smoothed > 300);
+  CHECK(fast > 0.95 * double(smoothed));
+  CHECK(fixedKept >= 20);
+  // The player finds every joint within its limits; most of the time at
+  // the programmed feed (without the smoothing the tool nearly stops at
+  // every junction: more than twice as long).
+  SimOptions sim;
+  sim.workOffsetMm = options.workOffset;
+  const SimReport r = simulate(t, m, sim);
+  CHECK(r.violationCount == 0);
+  double length = 0;
+  for (const Segment &s : t.segments)
+    length += s.length;
+  INFO("motion " << r.duration << " s over " << length << " mm");
+  CHECK(r.duration < 1.3 * length / (2000.0 / 60) + 2);
+}
+
 TEST_CASE("GreatCircle: the tool axis between two poses, at an even rate on their great circle",
           "[planner][five-axis]") {
   std::mt19937 rng(5);
