@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Checks the joints a native motion file (version 4) gives at each
+"""Checks the joints a native motion file (version 4 or 5) gives at each
 segment's end: through the machine's forward kinematics (written in
 tests/backends/check-indexed.py from the machine file alone, or, for the
 linear tripod, below) they put the tool tip at the segment's end point (the
