@@ -447,11 +447,14 @@ std::optional<Machine> readMachine(const SourceFile &file, DiagnosticEngine &dia
   }
 
   if (const toml::table *c = r.table(root, "controller", "controller")) {
-    r.onlyKnown(*c, {"cycle_time", "lookahead", "path_tolerance", "max_feed"}, "[controller]");
+    r.onlyKnown(*c, {"cycle_time", "lookahead", "path_tolerance", "orientation_tolerance", "max_feed"},
+                "[controller]");
     m.cycleTime = r.number(*c, "cycle_time", "controller", "s", 1e-5, 0.1, true).value_or(m.cycleTime);
     m.lookahead = static_cast<int>(r.number(*c, "lookahead", "controller", "segments", 1, 1e6, true).value_or(100));
     m.pathTolerance = r.number(*c, "path_tolerance", "controller", "mm", 1e-5, 10, true).value_or(m.pathTolerance);
     m.maxFeed = r.number(*c, "max_feed", "controller", "mm/min", 1, 1e7, false);
+    m.orientationTolerance = r.number(*c, "orientation_tolerance", "controller", "deg", 0, 5, false)
+                                 .value_or(m.orientationTolerance);
   }
   if (const toml::table *d = r.table(root, "deposition", "deposition", false)) {
     r.onlyKnown(*d, {"target", "energy_on", "energy_off", "power", "powder", "wire", "max_power", "max_powder",

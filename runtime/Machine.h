@@ -124,6 +124,9 @@ struct Machine {
   double cycleTime = 0.001;    ///< s, the interpolator's period
   int lookahead = 100;         ///< segments the planner may look ahead
   double pathTolerance = 0.01;  ///< mm, how far blending may leave the programmed path
+  /// deg, how far the planner's orientation smoothing may turn the tool axis
+  /// away from each move's even turn (docs/five-axis.md, "Motion")
+  double orientationTolerance = 0.01;
   std::optional<double> maxFeed;  ///< mm/min along the path, when lower than the axes allow
   /// The processes it does: "milling" (and drilling), "turning",
   /// "deposition" (the file's `processes`, else from its kinematics and its

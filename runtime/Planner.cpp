@@ -608,18 +608,34 @@ struct JointSampler {
 /// junction and its great circle's (or the shared one) at its other end. A
 /// side whose axis does not turn keeps it (a flank's fixed tilt stays
 /// fixed: the tool stops where the turning starts).
-void smoothJunction(Segment &a, const GreatCircle &ca, Segment &b, const GreatCircle &cb) {
-  if (a.kind == SegmentKind::Dwell || b.kind == SegmentKind::Dwell || !(a.length > 0) || !(b.length > 0))
+///
+/// The cubic leaves the great circle by at most 4/27 of the change of each
+/// end's rate (per unit of the fraction: the Hermite basis's peak), so the
+/// shared rate is kept within (27/8) tolerance / length of each side's own
+/// rate: each segment then stays within `tolerance` (rad) of its even turn.
+/// Where no rate is that close to both, the junction is not smoothed.
+void smoothJunction(Segment &a, const GreatCircle &ca, Segment &b, const GreatCircle &cb, double tolerance) {
+  if (!(tolerance > 0) || a.kind == SegmentKind::Dwell || b.kind == SegmentKind::Dwell || !(a.length > 0) ||
+      !(b.length > 0))
     return;
   if (!a.tilted() || !b.tilted() || a.axis1 != b.axis0)
     return;
   if (!(ca.angle() > 1e-9) || !(cb.angle() > 1e-9))
     return;
+  const Vec3 rateA = ca.tangent(1) / a.length, rateB = cb.tangent(0) / b.length;  // per mm
+  // The shared rate on the line from rateA to rateB, at the three-point
+  // rule's place, moved into the reach of both sides' tolerance.
+  const double reachA = 27.0 / 8 * tolerance / a.length, reachB = 27.0 / 8 * tolerance / b.length;
+  const double apart = (rateB - rateA).norm();
+  if (apart > reachA + reachB)
+    return;
+  double along = a.length / (a.length + b.length);
+  if (apart > 0)
+    along = std::clamp(along, std::max(0.0, 1 - reachB / apart), std::min(1.0, reachA / apart));
+  Vec3 shared = rateA + along * (rateB - rateA);
+  shared -= a.axis1 * a.axis1.dot(shared);
   if (!a.axisCubic())
     a.axisRate0 = ca.tangent(0);
-  const Vec3 rateA = ca.tangent(1) / a.length, rateB = cb.tangent(0) / b.length;  // per mm
-  Vec3 shared = (a.length * rateB + b.length * rateA) / (a.length + b.length);
-  shared -= a.axis1 * a.axis1.dot(shared);
   a.axisRate1 = shared * a.length;
   b.axisRate0 = shared * b.length;
   b.axisRate1 = cb.tangent(1);
@@ -1253,6 +1269,8 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
     GreatCircle circle;
   };
   std::optional<Pending> pending;
+  const double axisTolerance =
+      options.axisToleranceDeg.value_or(machine.orientationTolerance) * std::numbers::pi / 180;
   auto flush = [&] {
     if (pending) {
       const Pending p = *pending;
@@ -1273,7 +1291,7 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
       // (turnFirst).
       const size_t n = out.segments.size();
       if (stop == StopReason::None && pending->feed > 0 && feed > 0)
-        smoothJunction(out.segments[n - 2], pending->circle, mine, circle);
+        smoothJunction(out.segments[n - 2], pending->circle, mine, circle, axisTolerance);
       Segment held = std::move(mine);
       out.segments.pop_back();
       flush();

@@ -38,6 +38,7 @@
 #include "runtime/Trajectory.h"
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 namespace stepnc::runtime {
@@ -74,6 +75,12 @@ struct PlanOptions {
   /// inverse kinematics along them. Without it the path is the axes'.
   const Kinematics *kinematics = nullptr;
   Vec3 workOffset = Vec3::Zero();
+  /// deg; how far the orientation smoothing may take the tool axis from each
+  /// move's even turn on its great circle (docs/five-axis.md, "Motion"): a
+  /// junction whose two sides turn at rates too far apart to share one
+  /// within it is not smoothed. 0: no smoothing; nullopt: the machine's
+  /// orientation tolerance.
+  std::optional<double> axisToleranceDeg;
 };
 
 /// Plans the moves on the machine. Moves of zero length and dwells of no

@@ -612,6 +612,41 @@ TEST_CASE("the tool axis turns at one rate through a junction where it turns on 
     fast += t.profiles[i].v0 > 0.5 * 2000.0 / 60;
     ++smoothed;
   }
+  // Every segment's axis within the machine's orientation tolerance of its
+  // even turn on the great circle (deg), here and where the moves' rates
+  // alternate between 0.3 and 0.37 deg/mm on moves of 4 and 0.5 mm, where
+  // the tolerance holds the shared rates back (near the long side's).
+  auto worstOff = [&](const Trajectory &plan) {
+    double worst = 0;
+    for (const Segment &s : plan.segments)
+      if (s.axisCubic())
+        for (int piece = 1; piece < 40; ++piece) {
+          const double f = piece / 40.0;
+          const double cosine = s.axisAt(f * s.length).dot(axisBetween(s.axis0, s.axis1, f));
+          worst = std::max(worst, std::acos(std::clamp(cosine, -1.0, 1.0)) / deg);
+        }
+    return worst;
+  };
+  CHECK(worstOff(t) <= m.orientationTolerance * (1 + 1e-6));
+  CHECK(worstOff(t) > 0);
+  PathInput alternating;
+  alternating.start = Vec3(0, 0, 0);
+  alternating.startAxis = leaning(0);
+  double turned = 0, along = 0;
+  for (int i = 1; i <= 20; ++i) {
+    const double step = i % 2 ? 4 : 0.5;
+    along += step;
+    turned += (i % 2 ? 0.3 : 0.37) * step * deg;
+    PathMove move;
+    move.to = Vec3(along, 0, 0);
+    move.feed = 2000;
+    move.axis = leaning(turned);
+    alternating.moves.push_back(move);
+  }
+  const double held = worstOff(plan(alternating, m, options));
+  INFO("alternating rates: " << held << " deg off the even turns");
+  CHECK(held <= m.orientationTolerance * (1 + 1e-6));
+  CHECK(held > 0.25 * m.orientationTolerance);
   CHECK(smoothed > 300);
   CHECK(fast > 0.95 * double(smoothed));
   CHECK(fixedKept >= 20);
@@ -627,6 +662,25 @@ TEST_CASE("the tool axis turns at one rate through a junction where it turns on 
     length += s.length;
   INFO("motion " << r.duration << " s over " << length << " mm");
   CHECK(r.duration < 1.3 * length / (2000.0 / 60) + 2);
+  // A junction whose two sides turn at rates too far apart to share one
+  // within the tolerance keeps its kink; with the tolerance 0 none is
+  // smoothed.
+  PathInput jump;
+  jump.start = Vec3(0, 0, 0);
+  jump.startAxis = leaning(0);
+  for (int i = 1; i <= 2; ++i) {
+    PathMove move;
+    move.to = Vec3(10 * i, 0, 0);
+    move.feed = 2000;
+    move.axis = leaning(i == 1 ? 1 * deg : 11 * deg);  // 0.1 deg/mm, then 1 deg/mm
+    jump.moves.push_back(move);
+  }
+  for (const Segment &s : plan(jump, m, options).segments)
+    CHECK_FALSE(s.axisCubic());
+  PlanOptions off = options;
+  off.axisToleranceDeg = 0;
+  for (const Segment &s : plan(p, m, off).segments)
+    CHECK_FALSE(s.axisCubic());
 }
 
 TEST_CASE("GreatCircle: the tool axis between two poses, at an even rate on their great circle",
