@@ -1117,9 +1117,12 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   // joints that must move to get there turn first, the tip at rest: a
   // dwell as long as the slowest of them takes, from rest to rest within
   // its limits (the tool stops there).
+  // The segment is out.segments[index] (the last, or the one before the last
+  // when the last waits for orientation smoothing); a turning dwell goes in
+  // before it, and `index` moves on to it again.
   // True when `joints` is then the solution at the segment's start.
-  auto turnFirst = [&](StopReason &stop, uint32_t move, bool fromMiddle) {
-    Segment &seg = out.segments.back();
+  auto turnFirst = [&](size_t &index, StopReason &stop, uint32_t move, bool fromMiddle) {
+    const Segment &seg = out.segments[index];
     const Kinematics &kin = *options.kinematics;
     const Vec3 offset = options.workOffset;
     // At a rapid that turns the tool, the rotary axes start again from the
@@ -1159,11 +1162,10 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
     joints = *start.joints;
     if (!(wait > 0))
       return true;
-    Segment moved = std::move(seg);
-    out.segments.pop_back();
-    Segment turn = Segment::dwell(moved.start);
-    turn.axis0 = turn.axis1 = moved.axis0;
-    out.segments.push_back(std::move(turn));
+    Segment turn = Segment::dwell(seg.start);
+    turn.axis0 = turn.axis1 = seg.axis0;
+    out.segments.insert(out.segments.begin() + std::ptrdiff_t(index), std::move(turn));
+    ++index;
     lengths.push_back(0);
     SegmentInfo &info = out.info.emplace_back();
     info.stop = StopReason::Dwell;
@@ -1172,18 +1174,20 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
     dwellTimes.push_back(wait);
     recorded = joints;  // turned: the new ones
     out.joints.insert(out.joints.end(), recorded.data(), recorded.data() + recorded.size());
-    out.segments.push_back(std::move(moved));
     stop = StopReason::Dwell;
     return true;
   };
-  auto push = [&](double feed, uint32_t move, uint32_t next, StopReason stop, const AxisDemand &given,
+  // Plans out.segments[index]: the last segment, or the one before it when
+  // the last waits (orientation smoothing).
+  auto push = [&](size_t index, double feed, uint32_t move, uint32_t next, StopReason stop, const AxisDemand &given,
                   const GreatCircle *circle) {
     bool startSolved = false;
-    if (options.kinematics && (out.segments.back().tilted() || everySegmentByJoints)) {
-      const Segment &here = out.segments.back();
-      startSolved = turnFirst(stop, move, feed == 0 && here.kind == SegmentKind::Line && here.axis0 != here.axis1);
+    if (options.kinematics && (out.segments[index].tilted() || everySegmentByJoints)) {
+      const Segment &here = out.segments[index];
+      const bool fromMiddle = feed == 0 && here.kind == SegmentKind::Line && here.axis0 != here.axis1;
+      startSolved = turnFirst(index, stop, move, fromMiddle);
     }
-    const Segment &seg = out.segments.back();
+    const Segment &seg = out.segments[index];
     lengths.push_back(seg.length);
     SegmentInfo &info = out.info.emplace_back();
     info.feed = feed;
@@ -1271,31 +1275,29 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
   std::optional<Pending> pending;
   const double axisTolerance =
       options.axisToleranceDeg.value_or(machine.orientationTolerance) * std::numbers::pi / 180;
-  auto flush = [&] {
+  // The pending segment: out.segments' last, or the one before the last
+  // (`behind`) while the one after it is being joined to it.
+  auto flush = [&](size_t behind = 0) {
     if (pending) {
-      const Pending p = *pending;
+      push(out.segments.size() - 1 - behind, pending->feed, pending->move, pending->next, pending->stop,
+           pending->demand, &pending->circle);
       pending.reset();
-      push(p.feed, p.move, p.next, p.stop, p.demand, &p.circle);
     }
   };
   auto emit = [&](double feed, uint32_t move, uint32_t next, StopReason stop, const AxisDemand &demand) {
     if (!options.kinematics) {
-      push(feed, move, next, stop, demand, nullptr);
+      push(out.segments.size() - 1, feed, move, next, stop, demand, nullptr);
       return;
     }
-    Segment &mine = out.segments.back();
-    const GreatCircle circle(mine.axis0, mine.axis1);
+    const GreatCircle circle(out.segments.back().axis0, out.segments.back().axis1);
     if (pending) {
       // out.segments ends with the pending segment and this one. Not next
       // to a rapid: one that turns the tool starts its rotary axes afresh
       // (turnFirst).
       const size_t n = out.segments.size();
       if (stop == StopReason::None && pending->feed > 0 && feed > 0)
-        smoothJunction(out.segments[n - 2], pending->circle, mine, circle, axisTolerance);
-      Segment held = std::move(mine);
-      out.segments.pop_back();
-      flush();
-      out.segments.push_back(std::move(held));
+        smoothJunction(out.segments[n - 2], pending->circle, out.segments[n - 1], circle, axisTolerance);
+      flush(1);
     }
     pending = Pending{feed, move, next, stop, demand, circle};
   };
