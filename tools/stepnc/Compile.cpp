@@ -8,6 +8,7 @@
 #include "tools/stepnc/Compile.h"
 
 #include "backends/Backend.h"
+#include "backends/TargetFile.h"
 #include "backends/common/ToolTable.h"
 #include "backends/step-nc/OptimisedFile.h"
 #include "driver/LoadModule.h"
@@ -365,6 +366,9 @@ int compileSource(const CompileOptions &opts, const std::string &emit, std::uniq
 } // namespace
 
 int runCompile(const CompileOptions &opts) {
+  // A target descriptor's files, which its diagnostics point into: they
+  // outlive the session that prints them.
+  std::vector<std::unique_ptr<SourceFile>> targetFiles;
   // First, so that with --diagnostics=json every message of the command is
   // in the one array on stderr.
   DiagnosticSession session(opts.diag);
@@ -375,10 +379,17 @@ int runCompile(const CompileOptions &opts) {
       printToolError("compile: --emit=program needs a --target (" + targetList() + ")");
       return kExitUsage;
     }
-    backend = backends::createBackend(opts.target);
+    // A built-in target, or a descriptor file (docs/targets.md), whose
+    // mistakes are reported at their place.
+    std::string usageError;
+    backend = backends::loadTarget(opts.target, targetFiles, session.engine(), usageError);
     if (!backend) {
-      printToolError("compile: unknown target '" + opts.target + "' (" + targetList() + ")");
-      return kExitUsage;
+      if (!usageError.empty()) {
+        printToolError("compile: " + usageError + " (" + targetList() + ", or a descriptor file NAME.toml)");
+        return kExitUsage;
+      }
+      printStatus("the target descriptor " + opts.target + " has errors; nothing written");
+      return kExitDiagnostics;
     }
     if (opts.tolerance && !(*opts.tolerance > 0 && *opts.tolerance < 10)) {
       printToolError("compile: --tolerance " + formatShortest(*opts.tolerance) +
@@ -451,7 +462,8 @@ void registerCompile(CLI::App &app, std::function<void(int)> setResult) {
                  "Nothing is written when the input has errors.");
   cmd->add_option("input", opts->input, "STEP-NC file (Part 21)");
   cmd->add_option("--target", opts->target, "Controller to write for: siemens-840d, heidenhain-tnc, rs274, "
-                                            "native (--list-targets)");
+                                            "native (--list-targets), or a target descriptor file NAME.toml "
+                                            "(docs/targets.md)");
   cmd->add_option("--emit", opts->emit,
                   "What to write: program (with --target, the default then), feature-ir (the lowered\n"
                   "process IR; the default without --target), toolpath-ir (with moves, verified) or\n"
