@@ -386,30 +386,6 @@ Vec3 Segment::axisRateAt(double s) const {
   return (d - u * u.dot(d)) / (n * length);
 }
 
-Vec3 Segment::axisCurvatureAt(double s) const {
-  if (!(length > 0))
-    return Vec3::Zero();
-  const double t = fraction(s);
-  if (!axisCubic()) {
-    // Evenly on a great circle: towards its centre, the rate squared.
-    const double rate = GreatCircle(axis0, axis1).angle() / length;
-    return -rate * rate * axisAt(s);
-  }
-  // u = c / n: u'' = (c'' - 2 u' n' - u n'') / n, with n' = u . c' and
-  // n'' = u' . c' + u . c'' (derivatives in t).
-  const double t2 = t * t;
-  const Vec3 c = cubicPoint(t);
-  const Vec3 d1 = (6 * t2 - 6 * t) * axis0 + (3 * t2 - 4 * t + 1) * axisRate0 + (6 * t - 6 * t2) * axis1 +
-                  (3 * t2 - 2 * t) * axisRate1;
-  const Vec3 d2 = (12 * t - 6) * axis0 + (6 * t - 4) * axisRate0 + (6 - 12 * t) * axis1 + (6 * t - 2) * axisRate1;
-  const double n = c.norm();
-  const Vec3 u = c / n;
-  const double n1 = u.dot(d1);
-  const Vec3 u1 = (d1 - u * n1) / n;
-  const double n2 = u1.dot(d1) + u.dot(d2);
-  return (d2 - 2 * u1 * n1 - u * n2) / (n * length * length);
-}
-
 Segment::AxisEnds Segment::axisEnds(const GreatCircle *circle) const {
   AxisEnds e;
   if (!(length > 0)) {
@@ -430,9 +406,9 @@ Segment::AxisEnds Segment::axisEnds(const GreatCircle *circle) const {
     e.curve1 = -rate * rate * axis1;
     return e;
   }
-  // At the ends the cubic is the unit axis itself (|c| = 1) and its rate
-  // lies across it: u' = c', u'' = c'' - u (u' . c' + u . c'') (the general
-  // formula of axisCurvatureAt with n = 1, n' = 0).
+  // u = c / |c|, n = |c|: u' = (c' - u n') / n and u'' = (c'' - 2 u' n' -
+  // u n'') / n, with n' = u . c' and n'' = u' . c' + u . c'' (derivatives in
+  // the fraction). At the ends n = 1 (the axes are unit).
   const Vec3 second0 = -6 * axis0 - 4 * axisRate0 + 6 * axis1 - 2 * axisRate1;
   const Vec3 second1 = 6 * axis0 + 2 * axisRate0 - 6 * axis1 + 4 * axisRate1;
   auto rateAt = [](const Vec3 &u, const Vec3 &d1) { return Vec3(d1 - u * u.dot(d1)); };

@@ -152,10 +152,9 @@ struct Segment {
   }
   /// The tool axis's derivative with respect to arc length at s (per mm).
   Vec3 axisRateAt(double s) const;
-  /// Its second derivative (per mm^2).
-  Vec3 axisCurvatureAt(double s) const;
-  /// Both at the two ends, in closed form (the planner asks for them at
-  /// every segment): `circle`, when given, is GreatCircle(axis0, axis1).
+  /// It and the second derivative (per mm^2) at the two ends, in closed
+  /// form (the planner asks for them at every segment): `circle`, when
+  /// given, is GreatCircle(axis0, axis1).
   struct AxisEnds {
     Vec3 rate0, rate1;    ///< per mm
     Vec3 curve0, curve1;  ///< per mm^2

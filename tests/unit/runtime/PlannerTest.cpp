@@ -683,6 +683,37 @@ TEST_CASE("the tool axis turns at one rate through a junction where it turns on 
     CHECK_FALSE(s.axisCubic());
 }
 
+TEST_CASE("a segment's axis rates and curvatures at its ends are its axis's derivatives", "[planner][five-axis]") {
+  std::mt19937 rng(9);
+  std::normal_distribution<double> n(0, 1);
+  auto unit = [&] { return Vec3(n(rng), n(rng), n(rng)).normalized(); };
+  for (int i = 0; i < 500; ++i) {
+    Segment s = Segment::line(Vec3(0, 0, 0), Vec3(1 + 3 * std::abs(n(rng)), 0, 0));
+    s.axis0 = unit();
+    s.axis1 = (s.axis0 + 0.05 * unit()).normalized();
+    if (i % 2) {  // a cubic: rates across the axes
+      const Vec3 r0 = 0.05 * unit(), r1 = 0.05 * unit();
+      s.axisRate0 = r0 - s.axis0 * s.axis0.dot(r0);
+      s.axisRate1 = r1 - s.axis1 * s.axis1.dot(r1);
+    }
+    const Segment::AxisEnds e = s.axisEnds();
+    // One-sided differences of the axis itself (second order).
+    const double h = 1e-4 * s.length, L = s.length;
+    auto at = [&](double x) { return s.axisAt(x); };
+    const Vec3 d0 = (-3 * at(0) + 4 * at(h) - at(2 * h)) / (2 * h);
+    const Vec3 d1 = (3 * at(L) - 4 * at(L - h) + at(L - 2 * h)) / (2 * h);
+    const Vec3 c0 = (2 * at(0) - 5 * at(h) + 4 * at(2 * h) - at(3 * h)) / (h * h);
+    const Vec3 c1 = (2 * at(L) - 5 * at(L - h) + 4 * at(L - 2 * h) - at(L - 3 * h)) / (h * h);
+    INFO("segment " << i << (s.axisCubic() ? " (cubic)" : " (great circle)"));
+    CHECK((e.rate0 - d0).norm() < 1e-6);
+    CHECK((e.rate1 - d1).norm() < 1e-6);
+    CHECK((e.curve0 - c0).norm() < 1e-3 * (1 + e.curve0.norm()));
+    CHECK((e.curve1 - c1).norm() < 1e-3 * (1 + e.curve1.norm()));
+    CHECK((s.axisRateAt(0) - e.rate0).norm() < 1e-12);
+    CHECK((s.axisRateAt(L) - e.rate1).norm() < 1e-12);
+  }
+}
+
 TEST_CASE("GreatCircle: the tool axis between two poses, at an even rate on their great circle",
           "[planner][five-axis]") {
   std::mt19937 rng(5);
