@@ -338,28 +338,28 @@ private:
       return r;
     };
     // Along a path (most calls), one solution turns each rotary joint less
-    // than 1 deg from `near` and the other turns one of them more than 2
-    // (by the cosines of the differences): when the first is inside the
-    // travel it is what choose() takes, and the other's angles and
-    // positions are not needed.
+    // than 1 deg from `near` and the other differs from it by more than 3
+    // deg in one of them (so turns it more than 2 from `near`): when the
+    // first is inside the travel it is what choose() takes, and the other's
+    // angles and positions are not needed. The second solution is tried
+    // first: on the shipped chains along a path it is the one taken.
     if (count == 2 && !singular) {
-      static const double kClose = std::cos(1 * kDeg), kFar = std::cos(2 * kDeg);
-      const Turning near1{std::cos(near[j1] * kDeg), std::sin(near[j1] * kDeg)};
-      const Turning near2{std::cos(near[j2] * kDeg), std::sin(near[j2] * kDeg)};
-      auto cosFromNear = [&](const Solution &f) {
-        return std::min(f.turn1->cos * near1.cos + f.turn1->sin * near1.sin,
-                        f.turn2->cos * near2.cos + f.turn2->sin * near2.sin);
-      };
-      const double c0 = cosFromNear(found[0]), c1 = cosFromNear(found[1]);
-      const int close = c0 >= kClose && c1 < kFar ? 0 : c1 >= kClose && c0 < kFar ? 1 : -1;
-      if (close >= 0) {
-        const Solution &f = found[size_t(close)];
-        const Candidate c = candidate(f, angleOf(f.turn1, j1), angleOf(f.turn2, j2));
+      static const double kApart = std::cos(3 * kDeg);
+      for (const size_t i : {size_t(1), size_t(0)}) {
+        const Solution &f = found[i], &other = found[1 - i];
+        const double q1 = angleOf(f.turn1, j1), q2 = angleOf(f.turn2, j2);
+        if (!(std::abs(q1 - near[j1]) < 1 && std::abs(q2 - near[j2]) < 1))
+          continue;
+        auto cosApart = [](const Turning &x, const Turning &y) { return x.cos * y.cos + x.sin * y.sin; };
+        if (std::min(cosApart(*f.turn1, *other.turn1), cosApart(*f.turn2, *other.turn2)) >= kApart)
+          break;
+        const Candidate c = candidate(f, q1, q2);
         bool in = true;
         for (size_t j = 0; j < axes_.size(); ++j)
           in &= inTravel(axes_[j], c.q[static_cast<Eigen::Index>(j)]);
         if (in)
           return finish(c, {&c.q, 1});
+        break;
       }
     }
     std::array<Candidate, 2> all;
