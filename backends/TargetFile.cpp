@@ -15,7 +15,7 @@ namespace {
 namespace fs = std::filesystem;
 
 /// A TOML value as written, for messages.
-std::string toml_text(const toml::node &n) {
+std::string tomlText(const toml::node &n) {
   std::ostringstream out;
   n.visit([&](const auto &v) { out << v; });
   return out.str();
@@ -69,7 +69,7 @@ public:
       return nullptr;
     }
     if (format->value<int64_t>() != 1) {
-      r.error(format->source(), "format " + toml_text(*format) + " is not a descriptor format this stepnc reads (1)");
+      r.error(format->source(), "format " + tomlText(*format) + " is not a descriptor format this stepnc reads (1)");
       return nullptr;
     }
     const std::optional<std::string> name = r.text(*root, "name", "the target descriptor", true);

@@ -1332,11 +1332,9 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
       const Piece &p = pieces[i];
       const Segment &before = segments[(i + 1) % 2], &here = segments[i % 2];
       p.segment(input, segments[i % 2]);
-      // The piece's axis turns evenly on one great circle (a cubic only
-      // once the planner smooths it).
+      // The piece's axis on its great circle, found once for both ends.
       const GreatCircle hereCircle(here.axis0, here.axis1);
-      auto hereAxis = [&](double s) { return here.length > 0 ? hereCircle.at(here.fraction(s)) : here.axis1; };
-      const Vec3 axisIn = hereAxis(p.cutStart);  // where the blend before this piece ends
+      const Vec3 axisIn = here.axisAt(p.cutStart, hereCircle);  // where the blend before this piece ends
       if (i > 0 && p.stopReason != StopReason::None)
         stop = p.stopReason;
       pushDwells(i);
@@ -1361,7 +1359,7 @@ Trajectory plan(const PathInput &input, const Machine &machine, const PlanOption
         emit(p.feed, p.move, p.move, stop, out.segments.back().demand());
         stop = StopReason::None;
       }
-      axisOut = hereAxis(here.length - p.cutEnd);
+      axisOut = here.axisAt(here.length - p.cutEnd, hereCircle);
     }
     flush();
     pushDwells(pieces.size());  // after the last move

@@ -435,10 +435,10 @@ Segment Segment::part(double s0, double s1) const {
       out.axis1 = axisAt(s1);
       out.axisRate0 = axisRateAt(s0) * (s1 - s0);
       out.axisRate1 = axisRateAt(s1) * (s1 - s0);
-    } else if (length > 0) {
+    } else {
       const GreatCircle circle(axis0, axis1);
-      out.axis0 = circle.at(fraction(s0));
-      out.axis1 = circle.at(fraction(s1));
+      out.axis0 = axisAt(s0, circle);
+      out.axis1 = axisAt(s1, circle);
     }
   };
   if (kind == SegmentKind::Line) {

@@ -150,6 +150,13 @@ struct Segment {
       return axis1;
     return axisCubic() ? cubicAxis(fraction(s)) : axisBetween(axis0, axis1, fraction(s));
   }
+  /// The same with `circle` = GreatCircle(axis0, axis1) found once by the
+  /// caller (several points of one segment).
+  Vec3 axisAt(double s, const GreatCircle &circle) const {
+    if (!(length > 0))
+      return axis1;
+    return axisCubic() ? cubicAxis(fraction(s)) : circle.at(fraction(s));
+  }
   /// The tool axis's derivative with respect to arc length at s (per mm).
   Vec3 axisRateAt(double s) const;
   /// It and the second derivative (per mm^2) at the two ends, in closed
